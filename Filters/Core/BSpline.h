@@ -1,0 +1,113 @@
+/**
+ * @file BSpline.h
+ * @brief B-spline curves and tensor-product surfaces of any degree (paper eqs. 1-2),
+ * with derivatives and global interpolation through ordered points.
+ *
+ * Knot vectors are clamped and normalised to [0, 1]. Basis functions follow the
+ * Cox-de Boor recursion (paper eq. 2), evaluated with the numerically stable triangular
+ * scheme of Piegl & Tiller (The NURBS Book, A2.2/A2.3).
+ */
+#pragma once
+
+#include "Curve.h"
+#include "Surface.h"
+
+namespace blockforge
+{
+/// How interpolation parameters are assigned to the data points.
+enum class ParameterMethod
+{
+  Uniform,     ///< equally spaced
+  ChordLength, ///< proportional to the distance between successive points
+  Centripetal  ///< proportional to the square root of that distance (Lee 1989)
+};
+
+namespace bspline
+{
+/// Index of the knot span containing t (p <= span <= n), with t = 1 in the last span.
+int findSpan(int degree, const std::vector<double>& knots, int controlPointCount, double t);
+/// The degree+1 non-zero basis functions at t in knot span `span`.
+void basisFunctions(int span, double t, int degree, const std::vector<double>& knots,
+  double* values);
+/// Basis functions and their derivatives up to `order`: ders[k][j], k = 0..order,
+/// j = 0..degree, stored row-major in `ders` ((order+1) x (degree+1)).
+void basisDerivatives(int span, double t, int degree, int order,
+  const std::vector<double>& knots, double* ders);
+/// Parameters in [0, 1] for interpolating `points` (first 0, last 1, non-decreasing).
+std::vector<double> interpolationParameters(const std::vector<Vec3>& points, ParameterMethod);
+/// Clamped knot vector by averaging the parameters (NURBS book eq. 9.8).
+std::vector<double> averagedKnots(const std::vector<double>& parameters, int degree);
+} // namespace bspline
+
+/**
+ * @class BSplineCurve
+ * @brief Non-rational B-spline curve of arbitrary degree, t in [0, 1].
+ */
+class BSplineCurve : public Curve
+{
+public:
+  BSplineCurve(int degree, std::vector<double> knots, std::vector<Vec3> controlPoints);
+
+  /**
+   * Global interpolation: the curve passes through every point, in order, at the
+   * parameters of `method`. The degree is lowered to points.size()-1 when there are too
+   * few points. Throws GeometryError for fewer than 2 points, non-finite coordinates or
+   * coincident consecutive points.
+   */
+  static BSplineCurve interpolate(const std::vector<Vec3>& points, int degree = 3,
+    ParameterMethod method = ParameterMethod::ChordLength);
+
+  Vec3 point(double t) const override;
+  Vec3 derivative(double t, int order = 1) const override;
+  /// Point and derivatives up to `order`: out[0] = P(t), out[k] = d^k P / dt^k.
+  void derivatives(double t, int order, Vec3* out) const;
+
+  int degree() const { return Degree; }
+  const std::vector<double>& knots() const { return Knots; }
+  const std::vector<Vec3>& controlPoints() const { return ControlPoints; }
+  /// Parameters at which interpolate() put the data points (empty otherwise).
+  const std::vector<double>& dataParameters() const { return DataParameters; }
+
+private:
+  int Degree;
+  std::vector<double> Knots;
+  std::vector<Vec3> ControlPoints;
+  std::vector<double> DataParameters;
+};
+
+/**
+ * @class BSplineSurface
+ * @brief Tensor-product B-spline surface P(s, t) (paper eq. 1), any degree in each
+ * direction. Control points are stored with s varying fastest: index i + j * countS.
+ */
+class BSplineSurface : public Surface
+{
+public:
+  BSplineSurface(int degreeS, int degreeT, std::vector<double> knotsS,
+    std::vector<double> knotsT, int countS, int countT, std::vector<Vec3> controlPoints);
+
+  /**
+   * Interpolates a grid of points (countS x countT, s fastest): first each row in s, then
+   * the resulting control points in t, with parameters averaged over rows/columns.
+   */
+  static BSplineSurface interpolate(const std::vector<Vec3>& grid, int countS, int countT,
+    int degreeS = 3, int degreeT = 3, ParameterMethod method = ParameterMethod::ChordLength);
+
+  Vec3 point(double s, double t) const override;
+  void derivatives(double s, double t, SurfaceDerivatives& out) const override;
+
+  int degreeS() const { return DegreeS; }
+  int degreeT() const { return DegreeT; }
+  int countS() const { return CountS; }
+  int countT() const { return CountT; }
+  const std::vector<double>& knotsS() const { return KnotsS; }
+  const std::vector<double>& knotsT() const { return KnotsT; }
+  const std::vector<Vec3>& controlPoints() const { return ControlPoints; }
+
+private:
+  int DegreeS, DegreeT;
+  std::vector<double> KnotsS, KnotsT;
+  int CountS, CountT;
+  std::vector<Vec3> ControlPoints;
+};
+} // namespace blockforge

@@ -1,0 +1,75 @@
+/**
+ * @file Curve.h
+ * @brief Parametric space curves on t in [0, 1]: straight lines, circular arcs and the
+ * abstract interface the B-spline curves, projections and Coons patches work with.
+ */
+#pragma once
+
+#include "Types.h"
+
+#include <memory>
+
+namespace blockforge
+{
+/**
+ * @class Curve
+ * @brief A C1 space curve parametrised on t in [0, 1].
+ *
+ * point(0) and point(1) are the curve's end points. derivative() returns dP/dt
+ * (order 1) or d2P/dt2 (order 2); higher orders may return zero for curves that
+ * do not need them.
+ */
+class Curve
+{
+public:
+  virtual ~Curve() = default;
+  virtual Vec3 point(double t) const = 0;
+  virtual Vec3 derivative(double t, int order = 1) const = 0;
+};
+
+using CurvePtr = std::shared_ptr<const Curve>;
+
+/// Straight segment from a to b.
+class LineCurve : public Curve
+{
+public:
+  LineCurve(const Vec3& a, const Vec3& b);
+  Vec3 point(double t) const override;
+  Vec3 derivative(double t, int order = 1) const override;
+
+private:
+  Vec3 A, B;
+};
+
+/**
+ * @class ArcCurve
+ * @brief Circular arc from `start` to `end`, parametrised proportionally to arc length.
+ *
+ * Built either from a centre (the arc is the shorter one of the circle through start and
+ * end about that centre, unless `longWay`) or through a third point on the arc
+ * (blockMesh's convention). Start and end must be at the same distance from the centre
+ * (relative mismatch below 1e-6) or a GeometryError is thrown. The points are
+ * evaluated as centre + R (cos(phi) e1 + sin(phi) e2), so every point lies at radius R
+ * up to rounding.
+ */
+class ArcCurve : public Curve
+{
+public:
+  static ArcCurve fromCentre(const Vec3& start, const Vec3& end, const Vec3& centre,
+    bool longWay = false);
+  static ArcCurve throughPoint(const Vec3& start, const Vec3& through, const Vec3& end);
+
+  Vec3 point(double t) const override;
+  Vec3 derivative(double t, int order = 1) const override;
+
+  const Vec3& centre() const { return Centre; }
+  double radius() const { return Radius; }
+  double sweepAngle() const { return Sweep; } ///< radians, in (0, 2*pi)
+
+private:
+  ArcCurve() = default;
+  Vec3 Centre, E1, E2; // E1 points to the start, E2 completes the arc's plane
+  double Radius = 0.0, Sweep = 0.0;
+  Vec3 Start, End;     // returned exactly at t = 0 and t = 1
+};
+} // namespace blockforge

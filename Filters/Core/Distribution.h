@@ -1,0 +1,54 @@
+/**
+ * @file Distribution.h
+ * @brief Node distribution laws along a block edge (paper eq. 7 and the laws CFD
+ * engineers expect): each returns exactly the requested node count, 0 and 1 exactly at
+ * the ends, strictly increasing in between.
+ */
+#pragma once
+
+#include "Types.h"
+
+namespace blockforge
+{
+/**
+ * @brief A distribution law along an edge, from its start vertex to its end vertex.
+ */
+struct DistributionLaw
+{
+  enum class Kind
+  {
+    Uniform,   ///< equal cells
+    Geometric, ///< paper eq. 7: each cell is ExpansionRatio times the previous one
+    TwoSided,  ///< cells grow by ExpansionRatio from both ends towards the middle
+    FirstCell  ///< first cell of FirstCellSize, growing by at most ExpansionRatio
+  };
+  Kind kind = Kind::Uniform;
+  /// Geometric/TwoSided: ratio of successive cell sizes (k in eq. 7, > 0).
+  /// FirstCell: the largest allowed ratio (> 1); cells grow geometrically from
+  /// FirstCellSize and stay constant once large enough to fill the edge. 0 for
+  /// FirstCell means "solve the ratio so that all cells grow geometrically".
+  double expansionRatio = 1.0;
+  /// FirstCell: size of the first cell in length units of the edge (> 0).
+  double firstCellSize = 0.0;
+
+  bool operator==(const DistributionLaw& o) const
+  {
+    return kind == o.kind && expansionRatio == o.expansionRatio &&
+      firstCellSize == o.firstCellSize;
+  }
+  bool operator!=(const DistributionLaw& o) const { return !(*this == o); }
+};
+
+/**
+ * Relative node positions s_0 = 0 < s_1 < ... < s_(n-1) = 1 for `nodeCount` nodes
+ * (>= 2) on an edge of length `edgeLength` (used only by FirstCell). Throws
+ * GeometryError when the law cannot be met (non-positive ratio, first cell too large
+ * or too small for the edge with the given ratio), the message says why in user terms.
+ */
+std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
+  double edgeLength = 1.0);
+
+/// The law seen from the other end of the edge (Geometric k -> 1/k). FirstCell cannot be
+/// reversed into a law of the same kind; callers reverse its node parameters instead.
+DistributionLaw reversedLaw(const DistributionLaw& law);
+} // namespace blockforge

@@ -1,0 +1,83 @@
+/**
+ * @file Projection.h
+ * @brief Closest-point projection onto curves and surfaces: the nearest point of a
+ * precomputed sample, then Newton iterations with a safeguarded fallback (bisection of the
+ * bracketing interval for curves, a damped step inside the current cell for surfaces),
+ * to a tight tolerance. Parameters are clamped to [0, 1].
+ */
+#pragma once
+
+#include "Surface.h"
+
+namespace blockforge
+{
+struct CurveProjection
+{
+  double t = 0.0;    ///< curve parameter of the closest point
+  Vec3 point;        ///< the closest point
+  double distance = 0.0;
+};
+
+struct SurfaceProjection
+{
+  double s = 0.0, t = 0.0;
+  Vec3 point;
+  double distance = 0.0;
+};
+
+/**
+ * @class CurveProjector
+ * @brief Projects many points onto one curve; the sample is computed once.
+ */
+class CurveProjector
+{
+public:
+  explicit CurveProjector(CurvePtr curve, int samples = 128);
+  /// Closest point to p; `tolerance` bounds the parameter step at convergence.
+  CurveProjection project(const Vec3& p, double tolerance = 1e-14) const;
+
+private:
+  CurvePtr TheCurve;
+  std::vector<double> SampleT;
+  std::vector<Vec3> SamplePoints;
+};
+
+/**
+ * @class SurfaceProjector
+ * @brief Projects many points onto one surface; the sample grid is computed once.
+ */
+class SurfaceProjector
+{
+public:
+  explicit SurfaceProjector(SurfacePtr surface, int samplesS = 48, int samplesT = 48);
+  SurfaceProjection project(const Vec3& p, double tolerance = 1e-14) const;
+
+private:
+  SurfacePtr TheSurface;
+  int SamplesS, SamplesT;
+  std::vector<Vec3> SamplePoints; // s fastest
+};
+
+/**
+ * @class ArcLength
+ * @brief Arc-length parametrisation of a curve: length(t) by adaptive Gauss-Legendre
+ * quadrature, and its inverse by Newton with bisection fallback.
+ */
+class ArcLength
+{
+public:
+  explicit ArcLength(CurvePtr curve, int segments = 64);
+  double totalLength() const { return Total; }
+  /// Length of the curve from 0 to t.
+  double lengthAt(double t) const;
+  /// Parameter t at which lengthAt(t) == fraction * totalLength(), |error| < 1e-12 * total.
+  double parameterAtFraction(double fraction) const;
+
+private:
+  CurvePtr TheCurve;
+  std::vector<double> Breaks;     // segment boundaries in t
+  std::vector<double> Cumulative; // length up to each break
+  double Total = 0.0;
+  double segmentLength(double a, double b) const;
+};
+} // namespace blockforge

@@ -1,0 +1,77 @@
+/**
+ * @file Quality.h
+ * @brief Per-cell quality of hexahedral structured grids: element angles (the paper's
+ * criterion), OpenFOAM-style non-orthogonality and skewness (also across block
+ * interfaces), aspect ratio and the Verdict hex scaled Jacobian.
+ *
+ * Hexahedron corners are in VTK order. Angles are in degrees.
+ */
+#pragma once
+
+#include "Types.h"
+
+#include <array>
+#include <functional>
+
+namespace blockforge
+{
+/// Smallest and largest corner angle of the 6 quadrilateral faces (24 angles), degrees.
+/// Degenerate faces (a collapsed edge) count as triangles; collapsed faces are skipped.
+void hexFaceAngles(const std::array<Vec3, 8>& corners, double& minAngle, double& maxAngle);
+
+/// Verdict's hex scaled Jacobian (as vtkMeshQuality::HexScaledJacobian): the minimum of
+/// the normalised Jacobian determinant at the 8 corners and the centre; 1 for a cube,
+/// negative for an inverted cell.
+double hexScaledJacobian(const std::array<Vec3, 8>& corners);
+
+/// Longest over shortest of the cell's three mean widths (mean of 4 parallel edges).
+double hexAspectRatio(const std::array<Vec3, 8>& corners);
+
+/// Cell centre (mean of the corners, as OpenFOAM's cell centre for a planar hex).
+Vec3 hexCentre(const std::array<Vec3, 8>& corners);
+
+/// Face area vector (sum of the triangle fan about the face centre) and face centre.
+void quadAreaAndCentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
+  Vec3& area, Vec3& centre);
+
+/// OpenFOAM's non-orthogonality of a face, degrees: angle between the face area vector
+/// and the vector from owner to neighbour cell centre.
+double faceNonOrthogonality(const Vec3& ownerCentre, const Vec3& neighbourCentre,
+  const Vec3& faceArea);
+
+/// OpenFOAM's face skewness: distance from the face centre to the point where the
+/// owner-neighbour line crosses the face plane, over the owner-neighbour distance.
+double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre,
+  const Vec3& faceArea, const Vec3& faceCentre);
+
+/// OpenFOAM's boundary-face skewness (neighbour replaced by the face centre mirrored
+/// along the face normal).
+double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea,
+  const Vec3& faceCentre);
+
+/// Quality measures of every cell of a multiblock structured grid.
+struct StructuredBlock
+{
+  const double* xyz = nullptr; ///< nodes, interleaved, i fastest
+  int ni = 0, nj = 0, nk = 0;  ///< node counts
+};
+
+struct CellQualityArrays
+{
+  std::vector<double> minAngle, maxAngle, nonOrthogonality, skewness, aspectRatio,
+    scaledJacobian;
+};
+
+/**
+ * Computes all measures for every cell of every block. NonOrthogonality and Skewness of a
+ * cell are the maxima over its faces; faces on a block boundary that coincide with a
+ * face of another block (same four node coordinates, bit for bit) are treated as
+ * internal faces, so interfaces are measured like the interior. `progress` (may be
+ * empty) is called with a fraction in [0, 1].
+ */
+std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::function<void(double)>& progress = {});
+
+/// Counts of cells per MinAngle class: [0,20), [20,40), [40,60), [60,80), [80,90].
+std::array<long long, 5> minAngleClasses(const std::vector<CellQualityArrays>& quality);
+} // namespace blockforge

@@ -1,0 +1,47 @@
+/**
+ * @file Surface.h
+ * @brief Parametric surfaces on (s, t) in [0, 1]^2: the interface of B-spline surfaces,
+ * Coons patches and (later) surfaces of revolution and Gordon surfaces.
+ */
+#pragma once
+
+#include "Curve.h"
+
+namespace blockforge
+{
+/// Point and partial derivatives of a surface at (s, t).
+struct SurfaceDerivatives
+{
+  Vec3 P, Ps, Pt, Pss, Pst, Ptt;
+};
+
+class Surface
+{
+public:
+  virtual ~Surface() = default;
+  virtual Vec3 point(double s, double t) const = 0;
+  virtual void derivatives(double s, double t, SurfaceDerivatives& out) const = 0;
+};
+
+using SurfacePtr = std::shared_ptr<const Surface>;
+
+/**
+ * @class CoonsPatch
+ * @brief Bilinearly blended Coons patch (paper eq. 3) from four boundary curves.
+ *
+ * bottom = P(s, 0), top = P(s, 1), left = P(0, t), right = P(1, t); every curve runs in
+ * the direction of increasing s or t. Corners are taken from bottom/top; the constructor
+ * throws GeometryError when the curves do not meet (gap above 1e-9 of the patch size).
+ */
+class CoonsPatch : public Surface
+{
+public:
+  CoonsPatch(CurvePtr bottom, CurvePtr right, CurvePtr top, CurvePtr left);
+  Vec3 point(double s, double t) const override;
+  void derivatives(double s, double t, SurfaceDerivatives& out) const override;
+
+private:
+  CurvePtr Bottom, Right, Top, Left;
+  Vec3 C00, C10, C01, C11;
+};
+} // namespace blockforge

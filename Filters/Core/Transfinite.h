@@ -1,0 +1,66 @@
+/**
+ * @file Transfinite.h
+ * @brief Discrete transfinite interpolation of faces (2-D Coons, paper eq. 3) and blocks
+ * (trilinear TFI from 6 faces, 12 edges and 8 vertices, paper eq. 6).
+ *
+ * Node arrays are interleaved xyz doubles. Structured ordering is VTK's: i fastest,
+ * then j, then k. Boundary nodes are copied bit for bit from the given edges/faces, so
+ * two blocks built from the same face grid share identical coordinates there.
+ *
+ * Local block notation (paper Fig. 7, 0-based here): vertices V0..V7 in VTK hexahedron
+ * order ((s,t,u) = (0,0,0),(1,0,0),(1,1,0),(0,1,0),(0,0,1),(1,0,1),(1,1,1),(0,1,1)),
+ * i runs along s, j along t, k along u.
+ * Edges (paper E1..E12 -> index 0..11), each directed along increasing s, t or u:
+ *   0: V0->V1 (t=0,u=0)   1: V1->V2 (s=1,u=0)   2: V3->V2 (t=1,u=0)   3: V0->V3 (s=0,u=0)
+ *   4: V4->V5 (t=0,u=1)   5: V5->V6 (s=1,u=1)   6: V7->V6 (t=1,u=1)   7: V4->V7 (s=0,u=1)
+ *   8: V0->V4 (s=0,t=0)   9: V1->V5 (s=1,t=0)  10: V2->V6 (s=1,t=1)  11: V3->V7 (s=0,t=1)
+ * Faces (paper S1..S6 -> index 0..5), each a grid in the block's own index order:
+ *   0: s=0 (j,k) j fastest   1: s=1 (j,k)
+ *   2: t=0 (i,k) i fastest   3: t=1 (i,k)
+ *   4: u=0 (i,j) i fastest   5: u=1 (i,j)
+ */
+#pragma once
+
+#include "Types.h"
+
+#include <array>
+
+namespace blockforge
+{
+/// Nodes of one edge and their relative positions (distribution parameters) in [0, 1].
+struct EdgeNodes
+{
+  const double* xyz = nullptr;    ///< count * 3 coordinates
+  const double* params = nullptr; ///< count parameters, 0 first, 1 last
+  int count = 0;
+};
+
+/**
+ * 2-D TFI of a face grid of ni x nj nodes (i fastest) from its four edges:
+ * bottom (j = 0) and top (j = nj-1) with ni nodes in increasing i, left (i = 0) and
+ * right (i = ni-1) with nj nodes in increasing j. Edge parameters may differ on opposite
+ * edges; the interior (s, t) of each node is the intersection of the lines joining
+ * matching parameters, which makes the interpolation exact on every edge. `out` holds
+ * ni * nj * 3 doubles.
+ */
+void transfiniteFace(const EdgeNodes& bottom, const EdgeNodes& top, const EdgeNodes& left,
+  const EdgeNodes& right, double* out);
+
+/// Boundary of one block in its local orientation (see the file comment).
+struct BlockBoundary
+{
+  std::array<const double*, 6> faces{};    ///< face grids, interleaved xyz
+  std::array<const double*, 12> edgeParams{}; ///< distribution parameters of each edge
+};
+
+/**
+ * 3-D TFI (paper eq. 6) of a block with ni x nj x nk nodes. Boundary nodes come from
+ * the faces (bit-identical copies); interior nodes blend the 6 faces, 12 edges (read
+ * from the faces) and 8 vertices. When the four parallel edges in a direction share the
+ * same parameters the interpolation variables are separable and the loop is the fast
+ * path; otherwise (s, t, u) of each node solve the coupled bilinear blends of the edge
+ * parameters. Degenerate blocks (collapsed edges or faces) need no special treatment.
+ * `out` holds ni * nj * nk * 3 doubles.
+ */
+void transfiniteBlock(const BlockBoundary& boundary, int ni, int nj, int nk, double* out);
+} // namespace blockforge
