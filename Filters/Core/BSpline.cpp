@@ -1,1 +1,744 @@
-// placeholder
+#include "BSpline.h"
+
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace blockforge
+{
+namespace
+{
+using bspline::MaxDegree;
+constexpr int MaxBasis = MaxDegree + 1;
+
+bool isFinite(const Vec3& v)
+{
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
+
+std::string toString(double value)
+{
+  std::ostringstream s;
+  s.precision(10);
+  s << value;
+  return s.str();
+}
+
+std::string toString(const Vec3& v)
+{
+  return "(" + toString(v.x()) + ", " + toString(v.y()) + ", " + toString(v.z()) + ")";
+}
+
+void requireDegree(int degree, const char* what)
+{
+  if (degree < 1 || degree > MaxDegree)
+  {
+    throw GeometryError(std::string(what) + ": degree " + std::to_string(degree) +
+      " is outside the supported range 1.." + std::to_string(MaxDegree));
+  }
+}
+
+void requireFinitePoints(const std::vector<Vec3>& points, const char* what)
+{
+  for (std::size_t i = 0; i < points.size(); ++i)
+  {
+    if (!isFinite(points[i]))
+    {
+      throw GeometryError(std::string(what) + ": point " + std::to_string(i) +
+        " has a non-finite coordinate " + toString(points[i]));
+    }
+  }
+}
+
+/// Checks a clamped knot vector for `count` control points and maps it onto [0, 1]
+/// (an affine change of parameter does not change the shape).
+void validateKnots(int degree, std::vector<double>& knots, int count, const char* what)
+{
+  if (count < degree + 1)
+  {
+    throw GeometryError(std::string(what) + ": " + std::to_string(count) +
+      " control points are too few for degree " + std::to_string(degree));
+  }
+  if (static_cast<int>(knots.size()) != count + degree + 1)
+  {
+    throw GeometryError(std::string(what) + ": expected " +
+      std::to_string(count + degree + 1) + " knots for " + std::to_string(count) +
+      " control points of degree " + std::to_string(degree) + ", got " +
+      std::to_string(knots.size()));
+  }
+  for (std::size_t i = 0; i < knots.size(); ++i)
+  {
+    if (!std::isfinite(knots[i]))
+    {
+      throw GeometryError(std::string(what) + ": knot " + std::to_string(i) + " is not finite");
+    }
+    if (i > 0 && knots[i] < knots[i - 1])
+    {
+      throw GeometryError(std::string(what) + ": the knots must not decrease (knot " +
+        std::to_string(i) + ")");
+    }
+  }
+  const double first = knots.front(), last = knots.back();
+  if (!(last > first))
+  {
+    throw GeometryError(std::string(what) + ": all knots are equal");
+  }
+  for (int i = 1; i <= degree; ++i)
+  {
+    if (knots[i] != first || knots[knots.size() - 1 - i] != last)
+    {
+      throw GeometryError(std::string(what) +
+        ": the knot vector must be clamped (first and last knots repeated degree+1 times)");
+    }
+  }
+  for (int i = degree + 1; i < count; ++i)
+  {
+    int multiplicity = 1;
+    while (i + multiplicity < count && knots[i + multiplicity] == knots[i])
+    {
+      ++multiplicity;
+    }
+    if (multiplicity > degree)
+    {
+      throw GeometryError(std::string(what) + ": interior knot " + toString(knots[i]) +
+        " is repeated more than degree times, which would break the curve");
+    }
+  }
+  if (first != 0.0 || last != 1.0)
+  {
+    const double span = last - first;
+    for (double& knot : knots)
+    {
+      knot = (knot - first) / span;
+    }
+    for (int i = 0; i <= degree; ++i)
+    {
+      knots[i] = 0.0;
+      knots[knots.size() - 1 - i] = 1.0;
+    }
+  }
+}
+
+double clampUnit(double t)
+{
+  return t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+}
+
+/**
+ * Solves the collocation system N_j(params_k) x_j = rhs_k of global interpolation
+ * (NURBS book A9.1). The matrix is banded (degree+1 non-zeros a row); a sparse LU keeps
+ * the cost linear in the point count, and one step of iterative refinement recovers the
+ * last digits lost to pivoting growth.
+ */
+Eigen::MatrixXd solveCollocation(const std::vector<double>& params,
+  const std::vector<double>& knots, int degree, const Eigen::MatrixXd& rhs, const char* what)
+{
+  const int n = static_cast<int>(params.size());
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<std::size_t>(n) * (degree + 1));
+  double basis[MaxBasis];
+  for (int k = 0; k < n; ++k)
+  {
+    const int span = bspline::findSpan(degree, knots, n, params[k]);
+    bspline::basisFunctions(span, params[k], degree, knots, basis);
+    for (int j = 0; j <= degree; ++j)
+    {
+      if (basis[j] != 0.0)
+      {
+        entries.emplace_back(k, span - degree + j, basis[j]);
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> matrix(n, n);
+  matrix.setFromTriplets(entries.begin(), entries.end());
+  matrix.makeCompressed();
+
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::NaturalOrdering<int>> solver;
+  solver.compute(matrix);
+  if (solver.info() != Eigen::Success)
+  {
+    throw GeometryError(std::string(what) +
+      ": the interpolation system is singular (points too close together?)");
+  }
+  Eigen::MatrixXd solution = solver.solve(rhs);
+  const Eigen::MatrixXd residual = rhs - matrix * solution;
+  solution += solver.solve(residual);
+  if (!solution.allFinite())
+  {
+    throw GeometryError(std::string(what) + ": the interpolation system could not be solved");
+  }
+  return solution;
+}
+
+/// Parameters of one row of points; false when the row has zero length (a collapsed
+/// grid line, e.g. at a pole), which then must not take part in averaging.
+bool rowParameters(const std::vector<Vec3>& points, ParameterMethod method,
+  std::vector<double>& params)
+{
+  const std::size_t n = points.size();
+  params.assign(n, 0.0);
+  if (method == ParameterMethod::Uniform)
+  {
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      params[i] = static_cast<double>(i) / static_cast<double>(n - 1);
+    }
+    params[n - 1] = 1.0;
+    return true;
+  }
+  double total = 0.0;
+  for (std::size_t i = 1; i < n; ++i)
+  {
+    double step = (points[i] - points[i - 1]).norm();
+    if (method == ParameterMethod::Centripetal)
+    {
+      step = std::sqrt(step);
+    }
+    total += step;
+    params[i] = total;
+  }
+  if (!(total > 0.0))
+  {
+    return false;
+  }
+  for (std::size_t i = 1; i + 1 < n; ++i)
+  {
+    params[i] /= total;
+  }
+  params[n - 1] = 1.0;
+  return true;
+}
+} // namespace
+
+// =======================================================================================
+namespace bspline
+{
+int findSpan(int degree, const std::vector<double>& knots, int controlPointCount, double t)
+{
+  const int n = controlPointCount - 1;
+  if (t >= knots[n + 1])
+  {
+    return n;
+  }
+  if (t <= knots[degree])
+  {
+    return degree;
+  }
+  int low = degree, high = n + 1;
+  int mid = (low + high) / 2;
+  while (t < knots[mid] || t >= knots[mid + 1])
+  {
+    if (t < knots[mid])
+    {
+      high = mid;
+    }
+    else
+    {
+      low = mid;
+    }
+    mid = (low + high) / 2;
+  }
+  return mid;
+}
+
+/// At the ends of a clamped knot vector the triangular scheme yields 1 only up to
+/// rounding (x * (1/x)); the exact value makes curves start and end exactly on their
+/// first and last control points, which joins neighbouring entities without gaps.
+static bool exactEndBasis(int span, double t, int degree, const std::vector<double>& knots,
+  double* values)
+{
+  const int count = static_cast<int>(knots.size()) - degree - 1;
+  if (span == degree && t <= knots[degree] && knots[0] == knots[degree])
+  {
+    std::fill(values, values + degree + 1, 0.0);
+    values[0] = 1.0;
+    return true;
+  }
+  if (span == count - 1 && t >= knots[count] && knots[count] == knots.back())
+  {
+    std::fill(values, values + degree + 1, 0.0);
+    values[degree] = 1.0;
+    return true;
+  }
+  return false;
+}
+
+void basisFunctions(int span, double t, int degree, const std::vector<double>& knots,
+  double* values)
+{
+  if (exactEndBasis(span, t, degree, knots, values))
+  {
+    return;
+  }
+  double left[MaxBasis], right[MaxBasis];
+  values[0] = 1.0;
+  for (int j = 1; j <= degree; ++j)
+  {
+    left[j] = t - knots[span + 1 - j];
+    right[j] = knots[span + j] - t;
+    double saved = 0.0;
+    for (int r = 0; r < j; ++r)
+    {
+      const double temp = values[r] / (right[r + 1] + left[j - r]);
+      values[r] = saved + right[r + 1] * temp;
+      saved = left[j - r] * temp;
+    }
+    values[j] = saved;
+  }
+}
+
+void basisDerivatives(int span, double t, int degree, int order,
+  const std::vector<double>& knots, double* ders)
+{
+  const int p = degree;
+  const int width = p + 1;
+  // ndu holds the basis functions (upper triangle) and knot differences (lower triangle).
+  double ndu[MaxBasis][MaxBasis];
+  double left[MaxBasis], right[MaxBasis];
+  double a[2][MaxBasis];
+
+  ndu[0][0] = 1.0;
+  for (int j = 1; j <= p; ++j)
+  {
+    left[j] = t - knots[span + 1 - j];
+    right[j] = knots[span + j] - t;
+    double saved = 0.0;
+    for (int r = 0; r < j; ++r)
+    {
+      ndu[j][r] = right[r + 1] + left[j - r];
+      const double temp = ndu[r][j - 1] / ndu[j][r];
+      ndu[r][j] = saved + right[r + 1] * temp;
+      saved = left[j - r] * temp;
+    }
+    ndu[j][j] = saved;
+  }
+  for (int j = 0; j <= p; ++j)
+  {
+    ders[j] = ndu[j][p];
+  }
+
+  const int computed = std::min(order, p);
+  for (int r = 0; r <= p; ++r)
+  {
+    int s1 = 0, s2 = 1;
+    a[0][0] = 1.0;
+    for (int k = 1; k <= computed; ++k)
+    {
+      double d = 0.0;
+      const int rk = r - k, pk = p - k;
+      if (r >= k)
+      {
+        a[s2][0] = a[s1][0] / ndu[pk + 1][rk];
+        d = a[s2][0] * ndu[rk][pk];
+      }
+      const int j1 = rk >= -1 ? 1 : -rk;
+      const int j2 = (r - 1 <= pk) ? k - 1 : p - r;
+      for (int j = j1; j <= j2; ++j)
+      {
+        a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][rk + j];
+        d += a[s2][j] * ndu[rk + j][pk];
+      }
+      if (r <= pk)
+      {
+        a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
+        d += a[s2][k] * ndu[r][pk];
+      }
+      ders[k * width + r] = d;
+      std::swap(s1, s2);
+    }
+  }
+  double factor = p;
+  for (int k = 1; k <= computed; ++k)
+  {
+    for (int j = 0; j <= p; ++j)
+    {
+      ders[k * width + j] *= factor;
+    }
+    factor *= (p - k);
+  }
+  for (int k = computed + 1; k <= order; ++k)
+  {
+    std::fill(ders + k * width, ders + (k + 1) * width, 0.0);
+  }
+  // Same exact end values as basisFunctions(), so point and derivatives agree bit for bit.
+  exactEndBasis(span, t, degree, knots, ders);
+}
+
+std::vector<double> interpolationParameters(const std::vector<Vec3>& points,
+  ParameterMethod method)
+{
+  if (points.size() < 2)
+  {
+    throw GeometryError("interpolation needs at least 2 points, got " +
+      std::to_string(points.size()));
+  }
+  requireFinitePoints(points, "interpolation");
+  std::vector<double> params;
+  if (!rowParameters(points, method, params))
+  {
+    throw GeometryError("interpolation: all " + std::to_string(points.size()) +
+      " points coincide");
+  }
+  return params;
+}
+
+std::vector<double> averagedKnots(const std::vector<double>& parameters, int degree)
+{
+  requireDegree(degree, "knot averaging");
+  const int n = static_cast<int>(parameters.size()) - 1;
+  if (n < degree)
+  {
+    throw GeometryError("knot averaging: " + std::to_string(parameters.size()) +
+      " parameters are too few for degree " + std::to_string(degree));
+  }
+  std::vector<double> knots(parameters.size() + degree + 1, 0.0);
+  for (int j = 1; j <= n - degree; ++j)
+  {
+    // Summing each window afresh (instead of a sliding sum) keeps every knot accurate
+    // to rounding, independent of its position.
+    double sum = 0.0;
+    for (int i = j; i < j + degree; ++i)
+    {
+      sum += parameters[i];
+    }
+    knots[j + degree] = sum / degree;
+  }
+  for (int i = 0; i <= degree; ++i)
+  {
+    knots[n + 1 + i] = 1.0;
+  }
+  return knots;
+}
+} // namespace bspline
+
+// =======================================================================================
+BSplineCurve::BSplineCurve(int degree, std::vector<double> knots,
+  std::vector<Vec3> controlPoints)
+  : Degree(degree)
+  , Knots(std::move(knots))
+  , ControlPoints(std::move(controlPoints))
+{
+  requireDegree(degree, "B-spline curve");
+  validateKnots(degree, Knots, static_cast<int>(ControlPoints.size()), "B-spline curve");
+  requireFinitePoints(ControlPoints, "B-spline curve control points");
+}
+
+BSplineCurve BSplineCurve::interpolate(const std::vector<Vec3>& points, int degree,
+  ParameterMethod method)
+{
+  const int count = static_cast<int>(points.size());
+  if (count < 2)
+  {
+    throw GeometryError("curve interpolation needs at least 2 points, got " +
+      std::to_string(count));
+  }
+  requireDegree(degree, "curve interpolation");
+  requireFinitePoints(points, "curve interpolation");
+
+  // Coincidence is judged relative to the size of the point set, so that the check works
+  // the same in metres and millimetres.
+  Vec3 lower = points[0], upper = points[0];
+  for (const Vec3& q : points)
+  {
+    lower = lower.cwiseMin(q);
+    upper = upper.cwiseMax(q);
+  }
+  const double size = (upper - lower).norm();
+  for (int i = 1; i < count; ++i)
+  {
+    const double gap = (points[i] - points[i - 1]).norm();
+    if (!(gap > 1e-12 * size))
+    {
+      throw GeometryError("curve interpolation: points " + std::to_string(i - 1) + " and " +
+        std::to_string(i) + " coincide at " + toString(points[i]) +
+        "; remove the duplicate point");
+    }
+  }
+
+  const int usedDegree = std::min(degree, count - 1);
+  std::vector<double> params = bspline::interpolationParameters(points, method);
+  std::vector<double> knots = bspline::averagedKnots(params, usedDegree);
+
+  Eigen::MatrixXd rhs(count, 3);
+  for (int i = 0; i < count; ++i)
+  {
+    rhs.row(i) = points[i].transpose();
+  }
+  const Eigen::MatrixXd solution =
+    solveCollocation(params, knots, usedDegree, rhs, "curve interpolation");
+  std::vector<Vec3> control(count);
+  for (int i = 0; i < count; ++i)
+  {
+    control[i] = solution.row(i).transpose();
+  }
+  control.front() = points.front();
+  control.back() = points.back();
+
+  BSplineCurve curve(usedDegree, std::move(knots), std::move(control));
+  curve.DataParameters = std::move(params);
+  return curve;
+}
+
+Vec3 BSplineCurve::point(double t) const
+{
+  t = clampUnit(t);
+  const int count = static_cast<int>(ControlPoints.size());
+  const int span = bspline::findSpan(Degree, Knots, count, t);
+  double basis[MaxBasis];
+  bspline::basisFunctions(span, t, Degree, Knots, basis);
+  Vec3 result = Vec3::Zero();
+  for (int j = 0; j <= Degree; ++j)
+  {
+    result += basis[j] * ControlPoints[span - Degree + j];
+  }
+  return result;
+}
+
+Vec3 BSplineCurve::derivative(double t, int order) const
+{
+  if (order <= 0)
+  {
+    return point(t);
+  }
+  if (order > Degree)
+  {
+    return Vec3::Zero();
+  }
+  Vec3 values[MaxBasis];
+  derivatives(t, order, values);
+  return values[order];
+}
+
+void BSplineCurve::derivatives(double t, int order, Vec3* out) const
+{
+  t = clampUnit(t);
+  const int count = static_cast<int>(ControlPoints.size());
+  const int span = bspline::findSpan(Degree, Knots, count, t);
+  const int computed = std::min(order, Degree);
+  double ders[MaxBasis * MaxBasis];
+  bspline::basisDerivatives(span, t, Degree, computed, Knots, ders);
+  const int width = Degree + 1;
+  for (int k = 0; k <= computed; ++k)
+  {
+    Vec3 sum = Vec3::Zero();
+    for (int j = 0; j <= Degree; ++j)
+    {
+      sum += ders[k * width + j] * ControlPoints[span - Degree + j];
+    }
+    out[k] = sum;
+  }
+  for (int k = computed + 1; k <= order; ++k)
+  {
+    out[k] = Vec3::Zero();
+  }
+}
+
+// =======================================================================================
+BSplineSurface::BSplineSurface(int degreeS, int degreeT, std::vector<double> knotsS,
+  std::vector<double> knotsT, int countS, int countT, std::vector<Vec3> controlPoints)
+  : DegreeS(degreeS)
+  , DegreeT(degreeT)
+  , KnotsS(std::move(knotsS))
+  , KnotsT(std::move(knotsT))
+  , CountS(countS)
+  , CountT(countT)
+  , ControlPoints(std::move(controlPoints))
+{
+  requireDegree(degreeS, "B-spline surface (s direction)");
+  requireDegree(degreeT, "B-spline surface (t direction)");
+  if (countS < 2 || countT < 2 ||
+    static_cast<long long>(countS) * countT != static_cast<long long>(ControlPoints.size()))
+  {
+    throw GeometryError("B-spline surface: " + std::to_string(ControlPoints.size()) +
+      " control points do not form a " + std::to_string(countS) + " x " +
+      std::to_string(countT) + " grid");
+  }
+  validateKnots(degreeS, KnotsS, countS, "B-spline surface (s direction)");
+  validateKnots(degreeT, KnotsT, countT, "B-spline surface (t direction)");
+  requireFinitePoints(ControlPoints, "B-spline surface control points");
+}
+
+BSplineSurface BSplineSurface::interpolate(const std::vector<Vec3>& grid, int countS,
+  int countT, int degreeS, int degreeT, ParameterMethod method)
+{
+  if (countS < 2 || countT < 2)
+  {
+    throw GeometryError("surface interpolation needs at least 2 x 2 points, got " +
+      std::to_string(countS) + " x " + std::to_string(countT));
+  }
+  if (static_cast<long long>(countS) * countT != static_cast<long long>(grid.size()))
+  {
+    throw GeometryError("surface interpolation: " + std::to_string(grid.size()) +
+      " points do not form a " + std::to_string(countS) + " x " + std::to_string(countT) +
+      " grid");
+  }
+  requireDegree(degreeS, "surface interpolation (s direction)");
+  requireDegree(degreeT, "surface interpolation (t direction)");
+  requireFinitePoints(grid, "surface interpolation");
+
+  // Parameters averaged over all grid lines (NURBS book A9.4); collapsed lines, such as
+  // a row shrunk to a pole, carry no information and are left out.
+  auto averagedParameters = [&](int count, int lines, bool alongS) {
+    std::vector<double> sum(count, 0.0), params;
+    std::vector<Vec3> line(count);
+    int used = 0;
+    for (int l = 0; l < lines; ++l)
+    {
+      for (int i = 0; i < count; ++i)
+      {
+        line[i] = alongS ? grid[i + l * countS] : grid[l + i * countS];
+      }
+      if (rowParameters(line, method, params))
+      {
+        for (int i = 0; i < count; ++i)
+        {
+          sum[i] += params[i];
+        }
+        ++used;
+      }
+    }
+    const char* direction = alongS ? "s" : "t";
+    if (used == 0)
+    {
+      throw GeometryError(std::string("surface interpolation: every grid line in ") +
+        direction + " has zero length");
+    }
+    for (int i = 1; i + 1 < count; ++i)
+    {
+      sum[i] /= used;
+    }
+    sum[0] = 0.0;
+    sum[count - 1] = 1.0;
+    for (int i = 1; i < count; ++i)
+    {
+      if (!(sum[i] > sum[i - 1]))
+      {
+        throw GeometryError(std::string("surface interpolation: grid lines ") +
+          std::to_string(i - 1) + " and " + std::to_string(i) + " in " + direction +
+          " coincide everywhere; remove the duplicate line");
+      }
+    }
+    return sum;
+  };
+  const std::vector<double> paramsS = averagedParameters(countS, countT, true);
+  const std::vector<double> paramsT = averagedParameters(countT, countS, false);
+  const int usedDegreeS = std::min(degreeS, countS - 1);
+  const int usedDegreeT = std::min(degreeT, countT - 1);
+  std::vector<double> knotsS = bspline::averagedKnots(paramsS, usedDegreeS);
+  std::vector<double> knotsT = bspline::averagedKnots(paramsT, usedDegreeT);
+
+  // First every row in s (one right-hand side column per row and coordinate)...
+  Eigen::MatrixXd rowsRhs(countS, 3 * countT);
+  for (int j = 0; j < countT; ++j)
+  {
+    for (int i = 0; i < countS; ++i)
+    {
+      rowsRhs.block<1, 3>(i, 3 * j) = grid[i + j * countS].transpose();
+    }
+  }
+  const Eigen::MatrixXd rows = solveCollocation(
+    paramsS, knotsS, usedDegreeS, rowsRhs, "surface interpolation (s direction)");
+
+  // ... then the resulting control points column by column in t.
+  Eigen::MatrixXd columnsRhs(countT, 3 * countS);
+  for (int j = 0; j < countT; ++j)
+  {
+    for (int i = 0; i < countS; ++i)
+    {
+      columnsRhs.block<1, 3>(j, 3 * i) = rows.block<1, 3>(i, 3 * j);
+    }
+  }
+  const Eigen::MatrixXd columns = solveCollocation(
+    paramsT, knotsT, usedDegreeT, columnsRhs, "surface interpolation (t direction)");
+
+  std::vector<Vec3> control(grid.size());
+  for (int j = 0; j < countT; ++j)
+  {
+    for (int i = 0; i < countS; ++i)
+    {
+      control[i + j * countS] = columns.block<1, 3>(j, 3 * i).transpose();
+    }
+  }
+  // The corners are interpolated exactly by construction; keep them bit-identical.
+  control[0] = grid[0];
+  control[countS - 1] = grid[countS - 1];
+  control[(countT - 1) * countS] = grid[(countT - 1) * countS];
+  control[grid.size() - 1] = grid.back();
+
+  return BSplineSurface(usedDegreeS, usedDegreeT, std::move(knotsS), std::move(knotsT),
+    countS, countT, std::move(control));
+}
+
+Vec3 BSplineSurface::point(double s, double t) const
+{
+  s = clampUnit(s);
+  t = clampUnit(t);
+  const int spanS = bspline::findSpan(DegreeS, KnotsS, CountS, s);
+  const int spanT = bspline::findSpan(DegreeT, KnotsT, CountT, t);
+  double basisS[MaxBasis], basisT[MaxBasis];
+  bspline::basisFunctions(spanS, s, DegreeS, KnotsS, basisS);
+  bspline::basisFunctions(spanT, t, DegreeT, KnotsT, basisT);
+  Vec3 result = Vec3::Zero();
+  for (int l = 0; l <= DegreeT; ++l)
+  {
+    const Vec3* row = &ControlPoints[(spanS - DegreeS) + (spanT - DegreeT + l) * CountS];
+    Vec3 rowSum = Vec3::Zero();
+    for (int k = 0; k <= DegreeS; ++k)
+    {
+      rowSum += basisS[k] * row[k];
+    }
+    result += basisT[l] * rowSum;
+  }
+  return result;
+}
+
+void BSplineSurface::derivatives(double s, double t, SurfaceDerivatives& out) const
+{
+  s = clampUnit(s);
+  t = clampUnit(t);
+  const int spanS = bspline::findSpan(DegreeS, KnotsS, CountS, s);
+  const int spanT = bspline::findSpan(DegreeT, KnotsT, CountT, t);
+  // Rows beyond the degree are zero, so order 2 is always safe to request.
+  double dersS[3 * MaxBasis], dersT[3 * MaxBasis];
+  bspline::basisDerivatives(spanS, s, DegreeS, 2, KnotsS, dersS);
+  bspline::basisDerivatives(spanT, t, DegreeT, 2, KnotsT, dersT);
+  const int widthS = DegreeS + 1, widthT = DegreeT + 1;
+
+  Vec3 d[3][3]; // d[a][b] = d^(a+b) P / ds^a dt^b, a + b <= 2
+  for (auto& row : d)
+  {
+    for (Vec3& v : row)
+    {
+      v.setZero();
+    }
+  }
+  for (int l = 0; l <= DegreeT; ++l)
+  {
+    const Vec3* row = &ControlPoints[(spanS - DegreeS) + (spanT - DegreeT + l) * CountS];
+    Vec3 rowSum[3] = { Vec3::Zero(), Vec3::Zero(), Vec3::Zero() };
+    for (int k = 0; k <= DegreeS; ++k)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        rowSum[a] += dersS[a * widthS + k] * row[k];
+      }
+    }
+    for (int a = 0; a < 3; ++a)
+    {
+      for (int b = 0; a + b < 3; ++b)
+      {
+        d[a][b] += dersT[b * widthT + l] * rowSum[a];
+      }
+    }
+  }
+  out.P = d[0][0];
+  out.Ps = d[1][0];
+  out.Pt = d[0][1];
+  out.Pss = d[2][0];
+  out.Pst = d[1][1];
+  out.Ptt = d[0][2];
+}
+} // namespace blockforge

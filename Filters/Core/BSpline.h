@@ -24,6 +24,9 @@ enum class ParameterMethod
 
 namespace bspline
 {
+/// Highest supported degree: evaluation uses fixed-size stack buffers of this size + 1.
+constexpr int MaxDegree = 15;
+
 /// Index of the knot span containing t (p <= span <= n), with t = 1 in the last span.
 int findSpan(int degree, const std::vector<double>& knots, int controlPointCount, double t);
 /// The degree+1 non-zero basis functions at t in knot span `span`.

@@ -1,1 +1,685 @@
-// placeholder
+#include "Projection.h"
+
+#include "BSpline.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace blockforge
+{
+namespace
+{
+constexpr double Epsilon = std::numeric_limits<double>::epsilon();
+/// Local minima of the sampled distance refined per projection: more than one guards
+/// against points near the medial axis, where the nearest sample may sit in the basin
+/// of the slightly farther foot point.
+constexpr std::size_t MaxCandidates = 6;
+
+/// Point, first and second derivative of a curve; B-spline curves compute all three from
+/// one basis evaluation.
+struct CurveJet
+{
+  Vec3 P, D1, D2;
+};
+
+class CurveEvaluator
+{
+public:
+  explicit CurveEvaluator(const Curve& curve)
+    : TheCurve(curve)
+    , Spline(dynamic_cast<const BSplineCurve*>(&curve))
+  {
+  }
+
+  void evaluate(double t, CurveJet& jet) const
+  {
+    if (Spline)
+    {
+      Vec3 values[3];
+      Spline->derivatives(t, 2, values);
+      jet.P = values[0];
+      jet.D1 = values[1];
+      jet.D2 = values[2];
+    }
+    else
+    {
+      jet.P = TheCurve.point(t);
+      jet.D1 = TheCurve.derivative(t, 1);
+      jet.D2 = TheCurve.derivative(t, 2);
+    }
+  }
+
+  Vec3 point(double t) const { return TheCurve.point(t); }
+
+private:
+  const Curve& TheCurve;
+  const BSplineCurve* Spline;
+};
+
+double clampUnit(double t)
+{
+  return t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+}
+
+struct Candidate
+{
+  double distance;
+  int index;
+  bool operator<(const Candidate& o) const
+  {
+    return distance < o.distance || (distance == o.distance && index < o.index);
+  }
+};
+
+/// Keeps the `MaxCandidates` best candidates in a fixed array (no heap allocation).
+class CandidateList
+{
+public:
+  void offer(const Candidate& c)
+  {
+    if (Count < MaxCandidates)
+    {
+      Items[Count++] = c;
+    }
+    else if (c < Items[Count - 1])
+    {
+      Items[Count - 1] = c;
+    }
+    else
+    {
+      return;
+    }
+    std::sort(Items.begin(), Items.begin() + Count);
+  }
+  std::size_t size() const { return Count; }
+  const Candidate& operator[](std::size_t i) const { return Items[i]; }
+
+private:
+  std::array<Candidate, MaxCandidates> Items{};
+  std::size_t Count = 0;
+};
+
+// ---------------------------------------------------------------------------------------
+// Curves: the closest point is a root of g(t) = (C(t) - p) . C'(t) with g' > 0 there, or a
+// clamped end of [0, 1]. Within a sign-changing bracket Newton is safeguarded by bisection
+// (rtsafe), which always converges.
+
+double gradient(const CurveJet& jet, const Vec3& p)
+{
+  return (jet.P - p).dot(jet.D1);
+}
+
+double solveBracketed(const CurveEvaluator& curve, const Vec3& p, double lo, double hi,
+  double gLo, double gHi, double tolerance)
+{
+  // Regula falsi start: better than the midpoint when g is nearly linear.
+  double t = lo + gLo / (gLo - gHi) * (hi - lo);
+  if (!(t > lo && t < hi))
+  {
+    t = 0.5 * (lo + hi);
+  }
+  double previousStep = hi - lo, lastStep = previousStep;
+  CurveJet jet;
+  for (int iteration = 0; iteration < 200; ++iteration)
+  {
+    curve.evaluate(t, jet);
+    const double g = gradient(jet, p);
+    if (g == 0.0)
+    {
+      return t;
+    }
+    (g < 0.0 ? lo : hi) = t;
+    const double slope = jet.D1.squaredNorm() + (jet.P - p).dot(jet.D2);
+    double next = slope > 0.0 ? t - g / slope : lo - 1.0;
+    // Bisect when Newton leaves the bracket or does not halve the step every two
+    // iterations (the rtsafe rule), so the bracket shrinks geometrically.
+    if (!(next > lo && next < hi) || std::abs(next - t) > 0.5 * previousStep)
+    {
+      next = 0.5 * (lo + hi);
+    }
+    previousStep = lastStep;
+    lastStep = std::abs(next - t);
+    t = next;
+    if (lastStep <= tolerance || hi - lo <= tolerance)
+    {
+      break;
+    }
+  }
+  return t;
+}
+
+// ---------------------------------------------------------------------------------------
+// Surfaces: minimise f = |S(s,t) - p|^2 / 2 on the unit square by projected Newton steps
+// (bound constraints handled by an active set), falling back to Gauss-Newton or steepest
+// descent where the Hessian is not positive definite, with a backtracking line search.
+
+struct SurfaceState
+{
+  double s, t;
+  SurfaceDerivatives d;
+  Vec3 residual;
+  double f;
+  double gs, gt; // gradient of f
+};
+
+void evaluateState(const Surface& surface, const Vec3& p, SurfaceState& state)
+{
+  surface.derivatives(state.s, state.t, state.d);
+  state.residual = state.d.P - p;
+  state.f = 0.5 * state.residual.squaredNorm();
+  state.gs = state.residual.dot(state.d.Ps);
+  state.gt = state.residual.dot(state.d.Pt);
+}
+
+/// Gradient with the components that push against an active bound removed.
+void projectedGradient(const SurfaceState& x, double& ps, double& pt)
+{
+  ps = ((x.s <= 0.0 && x.gs > 0.0) || (x.s >= 1.0 && x.gs < 0.0)) ? 0.0 : x.gs;
+  pt = ((x.t <= 0.0 && x.gt > 0.0) || (x.t >= 1.0 && x.gt < 0.0)) ? 0.0 : x.gt;
+}
+
+void descentDirection(const SurfaceState& x, bool freeS, bool freeT, double& ds, double& dt)
+{
+  const SurfaceDerivatives& d = x.d;
+  const double jss = d.Ps.squaredNorm(), jst = d.Ps.dot(d.Pt), jtt = d.Pt.squaredNorm();
+  const double hss = jss + x.residual.dot(d.Pss);
+  const double hst = jst + x.residual.dot(d.Pst);
+  const double htt = jtt + x.residual.dot(d.Ptt);
+  const double gs = freeS ? x.gs : 0.0, gt = freeT ? x.gt : 0.0;
+  ds = dt = 0.0;
+
+  auto solve2 = [&](double a, double b, double c) {
+    // [a b; b c] positive definite with a margin against near-singular steps.
+    const double det = a * c - b * b;
+    if (a > 0.0 && c > 0.0 && det > 1e-12 * a * c)
+    {
+      ds = -(c * gs - b * gt) / det;
+      dt = -(a * gt - b * gs) / det;
+      return true;
+    }
+    return false;
+  };
+  auto solve1 = [](double h, double g, double& step) {
+    if (h > 0.0)
+    {
+      step = -g / h;
+      return true;
+    }
+    return false;
+  };
+
+  bool solved = false;
+  if (freeS && freeT)
+  {
+    solved = solve2(hss, hst, htt) || solve2(jss, jst, jtt);
+  }
+  else if (freeS)
+  {
+    solved = solve1(hss, gs, ds) || solve1(jss, gs, ds);
+  }
+  else if (freeT)
+  {
+    solved = solve1(htt, gt, dt) || solve1(jtt, gt, dt);
+  }
+  if (!solved || !(ds * gs + dt * gt < 0.0))
+  {
+    // Steepest descent scaled by the metric, so its size is that of a Gauss-Newton step.
+    const double scale = std::max(jss + jtt, std::numeric_limits<double>::min());
+    ds = -gs / scale;
+    dt = -gt / scale;
+  }
+}
+
+SurfaceState refineOnSurface(const Surface& surface, const Vec3& p, double s0, double t0,
+  double maxStep, double tolerance)
+{
+  SurfaceState x;
+  x.s = s0;
+  x.t = t0;
+  evaluateState(surface, p, x);
+  SurfaceState trial;
+  for (int iteration = 0; iteration < 100; ++iteration)
+  {
+    double pgs, pgt;
+    projectedGradient(x, pgs, pgt);
+    if (pgs == 0.0 && pgt == 0.0)
+    {
+      break;
+    }
+    double ds, dt;
+    descentDirection(x, pgs != 0.0 || (x.s > 0.0 && x.s < 1.0),
+      pgt != 0.0 || (x.t > 0.0 && x.t < 1.0), ds, dt);
+    // Damping: far from the solution Newton may jump across the surface; a step is
+    // limited to a few sample cells.
+    const double largest = std::max(std::abs(ds), std::abs(dt));
+    if (largest > maxStep)
+    {
+      ds *= maxStep / largest;
+      dt *= maxStep / largest;
+    }
+    const double gradientNorm = std::hypot(pgs, pgt);
+    bool accepted = false;
+    double stepS = 0.0, stepT = 0.0;
+    for (double alpha = 1.0; alpha > 1e-12; alpha *= 0.5)
+    {
+      trial.s = clampUnit(x.s + alpha * ds);
+      trial.t = clampUnit(x.t + alpha * dt);
+      stepS = trial.s - x.s;
+      stepT = trial.t - x.t;
+      if (stepS == 0.0 && stepT == 0.0)
+      {
+        break;
+      }
+      evaluateState(surface, p, trial);
+      const double predicted = x.gs * stepS + x.gt * stepT; // < 0 for a descent step
+      if (trial.f <= x.f + 1e-4 * predicted)
+      {
+        accepted = true;
+        break;
+      }
+      // Near the minimum f changes below its rounding; progress shows in the gradient.
+      double tgs, tgt;
+      projectedGradient(trial, tgs, tgt);
+      if (trial.f <= x.f * (1.0 + 8.0 * Epsilon) && std::hypot(tgs, tgt) < gradientNorm)
+      {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted)
+    {
+      break;
+    }
+    x = trial;
+    if (std::max(std::abs(stepS), std::abs(stepT)) <= tolerance)
+    {
+      break;
+    }
+  }
+  return x;
+}
+} // namespace
+
+// =======================================================================================
+CurveProjector::CurveProjector(CurvePtr curve, int samples)
+  : TheCurve(std::move(curve))
+{
+  if (!TheCurve)
+  {
+    throw GeometryError("curve projection: no curve given");
+  }
+  if (samples < 2)
+  {
+    throw GeometryError("curve projection needs at least 2 samples, got " +
+      std::to_string(samples));
+  }
+  SampleT.resize(samples);
+  SamplePoints.resize(samples);
+  for (int i = 0; i < samples; ++i)
+  {
+    SampleT[i] = static_cast<double>(i) / (samples - 1);
+  }
+  SampleT.back() = 1.0;
+  for (int i = 0; i < samples; ++i)
+  {
+    SamplePoints[i] = TheCurve->point(SampleT[i]);
+  }
+}
+
+CurveProjection CurveProjector::project(const Vec3& p, double tolerance) const
+{
+  const int n = static_cast<int>(SamplePoints.size());
+  const CurveEvaluator curve(*TheCurve);
+
+  // Local minima of the sampled distance; one whose distance minus its sample spacing
+  // exceeds the best sampled distance cannot contain the closest point.
+  double best = std::numeric_limits<double>::infinity();
+  for (const Vec3& q : SamplePoints)
+  {
+    best = std::min(best, (q - p).norm());
+  }
+  CandidateList candidates;
+  for (int i = 0; i < n; ++i)
+  {
+    const double d = (SamplePoints[i] - p).norm();
+    const double before = i > 0 ? (SamplePoints[i - 1] - p).norm() : d;
+    const double after = i + 1 < n ? (SamplePoints[i + 1] - p).norm() : d;
+    if (d > before || d > after)
+    {
+      continue;
+    }
+    double spacing = 0.0;
+    if (i > 0)
+    {
+      spacing = std::max(spacing, (SamplePoints[i] - SamplePoints[i - 1]).norm());
+    }
+    if (i + 1 < n)
+    {
+      spacing = std::max(spacing, (SamplePoints[i + 1] - SamplePoints[i]).norm());
+    }
+    if (d - spacing <= best || d == best)
+    {
+      candidates.offer({ d, i });
+    }
+  }
+
+  CurveProjection result;
+  result.distance = std::numeric_limits<double>::infinity();
+  auto consider = [&](double t) {
+    const Vec3 q = curve.point(t);
+    const double d = (q - p).norm();
+    if (d < result.distance)
+    {
+      result.t = t;
+      result.point = q;
+      result.distance = d;
+    }
+  };
+
+  CurveJet jet;
+  for (std::size_t c = 0; c < candidates.size(); ++c)
+  {
+    const int i = candidates[c].index;
+    const double lo = SampleT[std::max(i - 1, 0)];
+    const double mid = SampleT[i];
+    const double hi = SampleT[std::min(i + 1, n - 1)];
+    curve.evaluate(lo, jet);
+    const double gLo = gradient(jet, p);
+    curve.evaluate(mid, jet);
+    const double gMid = gradient(jet, p);
+    curve.evaluate(hi, jet);
+    const double gHi = gradient(jet, p);
+
+    consider(mid);
+    bool found = gMid == 0.0;
+    if (gLo < 0.0 && gMid > 0.0)
+    {
+      consider(solveBracketed(curve, p, lo, mid, gLo, gMid, tolerance));
+      found = true;
+    }
+    if (gMid < 0.0 && gHi > 0.0)
+    {
+      consider(solveBracketed(curve, p, mid, hi, gMid, gHi, tolerance));
+      found = true;
+    }
+    // Clamping: the distance still decreases towards an end of the curve.
+    if (lo == 0.0 && gLo >= 0.0)
+    {
+      consider(0.0);
+      found = true;
+    }
+    if (hi == 1.0 && gHi <= 0.0)
+    {
+      consider(1.0);
+      found = true;
+    }
+    if (!found)
+    {
+      // The distance wiggles within two sample intervals (very curved or noisy curve):
+      // look for a sign change of g on a finer grid.
+      constexpr int Sub = 32;
+      double tPrev = lo, gPrev = gLo;
+      for (int k = 1; k <= Sub; ++k)
+      {
+        const double tk = k == Sub ? hi : lo + (hi - lo) * k / Sub;
+        curve.evaluate(tk, jet);
+        const double gk = gradient(jet, p);
+        if (gPrev < 0.0 && gk > 0.0)
+        {
+          consider(solveBracketed(curve, p, tPrev, tk, gPrev, gk, tolerance));
+        }
+        tPrev = tk;
+        gPrev = gk;
+      }
+    }
+  }
+  return result;
+}
+
+// =======================================================================================
+SurfaceProjector::SurfaceProjector(SurfacePtr surface, int samplesS, int samplesT)
+  : TheSurface(std::move(surface))
+  , SamplesS(samplesS)
+  , SamplesT(samplesT)
+{
+  if (!TheSurface)
+  {
+    throw GeometryError("surface projection: no surface given");
+  }
+  if (samplesS < 2 || samplesT < 2)
+  {
+    throw GeometryError("surface projection needs at least 2 x 2 samples");
+  }
+  SamplePoints.resize(static_cast<std::size_t>(samplesS) * samplesT);
+  for (int j = 0; j < samplesT; ++j)
+  {
+    const double t = j == samplesT - 1 ? 1.0 : static_cast<double>(j) / (samplesT - 1);
+    for (int i = 0; i < samplesS; ++i)
+    {
+      const double s = i == samplesS - 1 ? 1.0 : static_cast<double>(i) / (samplesS - 1);
+      SamplePoints[i + static_cast<std::size_t>(j) * samplesS] = TheSurface->point(s, t);
+    }
+  }
+}
+
+SurfaceProjection SurfaceProjector::project(const Vec3& p, double tolerance) const
+{
+  const int ns = SamplesS, nt = SamplesT;
+  auto at = [&](int i, int j) -> const Vec3& {
+    return SamplePoints[i + static_cast<std::size_t>(j) * ns];
+  };
+
+  double best = std::numeric_limits<double>::infinity();
+  for (const Vec3& q : SamplePoints)
+  {
+    best = std::min(best, (q - p).norm());
+  }
+  CandidateList candidates;
+  for (int j = 0; j < nt; ++j)
+  {
+    for (int i = 0; i < ns; ++i)
+    {
+      const double d = (at(i, j) - p).norm();
+      bool localMinimum = true;
+      double spacing = 0.0;
+      for (int dj = -1; dj <= 1 && localMinimum; ++dj)
+      {
+        for (int di = -1; di <= 1; ++di)
+        {
+          const int ii = i + di, jj = j + dj;
+          if ((di == 0 && dj == 0) || ii < 0 || jj < 0 || ii >= ns || jj >= nt)
+          {
+            continue;
+          }
+          if ((at(ii, jj) - p).norm() < d)
+          {
+            localMinimum = false;
+            break;
+          }
+          spacing = std::max(spacing, (at(ii, jj) - at(i, j)).norm());
+        }
+      }
+      if (localMinimum && (d - spacing <= best || d == best))
+      {
+        candidates.offer({ d, i + j * ns });
+      }
+    }
+  }
+
+  // A step may cross at most two sample cells; beyond that the sample is a better guide.
+  const double maxStep = 2.0 / std::min(ns - 1, nt - 1);
+  SurfaceProjection result;
+  result.distance = std::numeric_limits<double>::infinity();
+  for (std::size_t c = 0; c < candidates.size(); ++c)
+  {
+    const int i = candidates[c].index % ns, j = candidates[c].index / ns;
+    const double s0 = i == ns - 1 ? 1.0 : static_cast<double>(i) / (ns - 1);
+    const double t0 = j == nt - 1 ? 1.0 : static_cast<double>(j) / (nt - 1);
+    const SurfaceState x = refineOnSurface(*TheSurface, p, s0, t0, maxStep, tolerance);
+    const double d = x.residual.norm();
+    if (d < result.distance)
+    {
+      result.s = x.s;
+      result.t = x.t;
+      result.point = x.d.P;
+      result.distance = d;
+    }
+  }
+  return result;
+}
+
+// =======================================================================================
+namespace
+{
+// 10-point Gauss-Legendre rule on [-1, 1] (exact for polynomials of degree 19).
+constexpr std::array<double, 5> GaussNodes = { 0.1488743389816312108848260,
+  0.4333953941292471907992659, 0.6794095682990244062343274, 0.8650633666889845107320967,
+  0.9739065285171717200779640 };
+constexpr std::array<double, 5> GaussWeights = { 0.2955242247147528701738930,
+  0.2692667193099963550912269, 0.2190863625159820439955349, 0.1494513318847011969813820,
+  0.0666713443086881375935688 };
+
+double gaussSpeed(const Curve& curve, double a, double b)
+{
+  const double half = 0.5 * (b - a), centre = 0.5 * (a + b);
+  double sum = 0.0;
+  for (std::size_t k = 0; k < GaussNodes.size(); ++k)
+  {
+    const double offset = half * GaussNodes[k];
+    sum += GaussWeights[k] *
+      (curve.derivative(centre - offset, 1).norm() + curve.derivative(centre + offset, 1).norm());
+  }
+  return sum * half;
+}
+
+/// Adaptive bisection until the halves agree with the whole to `tolerance`; speed
+/// discontinuities (knots of low continuity, corners) only cost local refinement.
+double adaptiveLength(const Curve& curve, double a, double b, double whole, double tolerance,
+  int depth)
+{
+  const double m = 0.5 * (a + b);
+  const double left = gaussSpeed(curve, a, m);
+  const double right = gaussSpeed(curve, m, b);
+  const double halves = left + right;
+  if (depth >= 30 || std::abs(halves - whole) <= tolerance || !(m > a && m < b))
+  {
+    return halves;
+  }
+  return adaptiveLength(curve, a, m, left, 0.5 * tolerance, depth + 1) +
+    adaptiveLength(curve, m, b, right, 0.5 * tolerance, depth + 1);
+}
+} // namespace
+
+ArcLength::ArcLength(CurvePtr curve, int segments)
+  : TheCurve(std::move(curve))
+{
+  if (!TheCurve)
+  {
+    throw GeometryError("arc length: no curve given");
+  }
+  if (segments < 1)
+  {
+    throw GeometryError("arc length needs at least 1 segment, got " +
+      std::to_string(segments));
+  }
+  Breaks.resize(segments + 1);
+  for (int k = 0; k <= segments; ++k)
+  {
+    Breaks[k] = static_cast<double>(k) / segments;
+  }
+  Breaks.back() = 1.0;
+  Cumulative.assign(segments + 1, 0.0);
+  for (int k = 0; k < segments; ++k)
+  {
+    Cumulative[k + 1] = Cumulative[k] + segmentLength(Breaks[k], Breaks[k + 1]);
+  }
+  Total = Cumulative.back();
+}
+
+double ArcLength::segmentLength(double a, double b) const
+{
+  if (!(b > a))
+  {
+    return 0.0;
+  }
+  const double whole = gaussSpeed(*TheCurve, a, b);
+  // Tolerance relative to the whole curve's length scale (segments are a fraction of it),
+  // with an absolute floor so that zero-speed pieces terminate at once.
+  const double scale = std::max(std::abs(whole), Total / std::max<std::size_t>(1, Breaks.size()));
+  return adaptiveLength(*TheCurve, a, b, whole, 1e-15 * scale + 1e-300, 0);
+}
+
+double ArcLength::lengthAt(double t) const
+{
+  if (!(t > 0.0))
+  {
+    return 0.0;
+  }
+  if (t >= 1.0)
+  {
+    return Total;
+  }
+  const int segments = static_cast<int>(Breaks.size()) - 1;
+  int k = std::min(static_cast<int>(t * segments), segments - 1);
+  while (k > 0 && Breaks[k] > t)
+  {
+    --k;
+  }
+  while (k + 1 < segments && Breaks[k + 1] <= t)
+  {
+    ++k;
+  }
+  return Cumulative[k] + segmentLength(Breaks[k], t);
+}
+
+double ArcLength::parameterAtFraction(double fraction) const
+{
+  if (!(Total > 0.0))
+  {
+    // A collapsed curve: every parameter is at length 0, keep the mapping monotone.
+    return clampUnit(fraction);
+  }
+  if (!(fraction > 0.0))
+  {
+    return 0.0;
+  }
+  if (fraction >= 1.0)
+  {
+    return 1.0;
+  }
+  const double target = fraction * Total;
+  const int segments = static_cast<int>(Breaks.size()) - 1;
+  int k = static_cast<int>(std::upper_bound(Cumulative.begin(), Cumulative.end(), target) -
+            Cumulative.begin()) - 1;
+  k = std::max(0, std::min(k, segments - 1));
+  double lo = Breaks[k], hi = Breaks[k + 1];
+  const double base = Cumulative[k];
+  const double segment = Cumulative[k + 1] - base;
+  double t = segment > 0.0 ? lo + (hi - lo) * std::min(1.0, (target - base) / segment)
+                           : 0.5 * (lo + hi);
+  const double accuracy = 1e-14 * Total;
+  for (int iteration = 0; iteration < 100; ++iteration)
+  {
+    const double error = base + segmentLength(Breaks[k], t) - target;
+    if (std::abs(error) <= accuracy)
+    {
+      break;
+    }
+    (error < 0.0 ? lo : hi) = t;
+    const double speed = TheCurve->derivative(t, 1).norm();
+    double next = speed > 0.0 ? t - error / speed : lo - 1.0;
+    if (!(next > lo && next < hi))
+    {
+      next = 0.5 * (lo + hi);
+    }
+    if (next == t || !(hi > lo))
+    {
+      break;
+    }
+    t = next;
+  }
+  return t;
+}
+} // namespace blockforge

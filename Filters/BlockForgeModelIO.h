@@ -1,0 +1,49 @@
+/**
+ * @file BlockForgeModelIO.h
+ * @brief Private glue between the VTK pipeline and the block model: the model travels as
+ * a versioned text document in a field-data string array, which survives saving to .vtm,
+ * client-server transfers and MPI.
+ */
+#pragma once
+
+#include "../Model/BlockModel.h"
+
+#include <string>
+
+class vtkDataObject;
+class vtkFieldData;
+
+namespace blockforge
+{
+namespace vtkglue
+{
+/// Stores the model document in `fieldData` (replacing an older one).
+void attachModel(vtkFieldData* fieldData, const std::string& document);
+/// The model document carried by `object`'s field data, or "" if none.
+std::string findModelDocument(vtkDataObject* object);
+} // namespace vtkglue
+} // namespace blockforge
+
+#include <functional>
+
+class vtkMultiBlockDataSet;
+
+namespace blockforge
+{
+namespace model
+{
+class MultiBlockMesher;
+}
+namespace vtkglue
+{
+/**
+ * Fills `output` with one named vtkStructuredGrid per model block (the points written
+ * by the mesher directly into the VTK array, no second copy) and a BlockId cell array.
+ * Blocks not assigned to this piece (block index modulo pieceCount != piece) are left
+ * empty so every MPI rank has the same structure. `progress` gets a fraction in [0, 1].
+ */
+void fillMultiBlock(const model::BlockModel& model, const model::MultiBlockMesher& mesher,
+  vtkMultiBlockDataSet* output, int piece, int pieceCount,
+  const std::function<void(double)>& progress);
+} // namespace vtkglue
+} // namespace blockforge

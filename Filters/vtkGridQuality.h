@@ -1,0 +1,51 @@
+/**
+ * @class   vtkGridQuality
+ * @brief   Cell quality of a block-structured hexahedral grid, with the paper's element
+ *          angle classes.
+ *
+ * Adds these cell arrays to every vtkStructuredGrid block of the input:
+ * - MinAngle, MaxAngle: smallest/largest corner angle of the cell's 6 faces [degrees]
+ *   (the paper's criterion; below 20 degrees harms accuracy and convergence);
+ * - NonOrthogonality: OpenFOAM's angle between a face normal and the line joining the
+ *   two cell centres, maximum over the cell's faces, block interfaces included [degrees];
+ * - Skewness: OpenFOAM's face skewness, maximum over the cell's faces [-];
+ * - AspectRatio: longest over shortest mean cell width [-];
+ * - ScaledJacobian: Verdict's hex scaled Jacobian (1 = cube, negative = inverted) [-];
+ * - BlockId: index of the block.
+ *
+ * Output port 0 is the input with these arrays; its field data holds
+ * MinAngleClassCounts (cells with MinAngle in [0,20), [20,40), [40,60), [60,80),
+ * [80,90] degrees) and, for every measure, "<Measure>Summary" (min, mean, max).
+ * Output port 1 is a table of the MinAngle classes for a bar chart (columns Class,
+ * Cells, Percent); output port 2 a table of the statistics (Measure, Min, Mean, Max).
+ * Under MPI the class counts and statistics are global.
+ *
+ * @sa vtkBlockMesher
+ */
+#ifndef vtkGridQuality_h
+#define vtkGridQuality_h
+
+#include "BlockForgeFiltersModule.h"
+#include "vtkMultiBlockDataSetAlgorithm.h"
+
+class BLOCKFORGEFILTERS_EXPORT vtkGridQuality : public vtkMultiBlockDataSetAlgorithm
+{
+public:
+  static vtkGridQuality* New();
+  vtkTypeMacro(vtkGridQuality, vtkMultiBlockDataSetAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+protected:
+  vtkGridQuality();
+  ~vtkGridQuality() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int FillOutputPortInformation(int port, vtkInformation* info) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+private:
+  vtkGridQuality(const vtkGridQuality&) = delete;
+  void operator=(const vtkGridQuality&) = delete;
+};
+
+#endif

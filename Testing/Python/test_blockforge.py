@@ -1,0 +1,264 @@
+"""Plain-Python tests of the BlockForge VTK classes through `import blockforge`.
+
+Run by CTest with /usr/bin/python3 and PYTHONPATH pointing at the build tree.
+"""
+import math
+import os
+import sys
+import unittest
+
+import blockforge
+from vtkmodules.numpy_interface import dataset_adapter as dsa
+from vtkmodules.vtkCommonCore import vtkCommand
+from vtkmodules.vtkFiltersVerdict import vtkMeshQuality
+from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataReader, vtkXMLMultiBlockDataWriter
+from vtkmodules.util.misc import calldata_type
+from vtkmodules.util.vtkConstants import VTK_STRING
+import numpy as np
+
+SOURCE = os.environ.get("BLOCKFORGE_SOURCE_DIR",
+                        os.path.join(os.path.dirname(__file__), "..", ".."))
+OUTPUT = os.environ.get("BLOCKFORGE_TEST_OUTPUT", "/tmp/blockforge-test-output")
+CYLINDER = os.path.join(SOURCE, "Templates", "cylinder_in_box.yaml")
+DATA = os.path.join(SOURCE, "Testing", "Data")
+
+
+def leaves(multiblock):
+    """(name, dataset) of every non-empty leaf, in order."""
+    result = []
+    iterator = multiblock.NewIterator()
+    iterator.InitTraversal()
+    while not iterator.IsDoneWithTraversal():
+        name = iterator.GetCurrentMetaData().Get(multiblock.NAME())
+        result.append((name, iterator.GetCurrentDataObject()))
+        iterator.GoToNextItem()
+    return result
+
+
+def points(dataset):
+    return np.array(dsa.WrapDataObject(dataset).Points)
+
+
+class ErrorCollector:
+    """Collects vtkErrorMacro messages of the observed algorithms."""
+
+    def __init__(self, *algorithms):
+        self.messages = []
+        for algorithm in algorithms:
+            algorithm.AddObserver(vtkCommand.ErrorEvent, self)
+
+    @calldata_type(VTK_STRING)
+    def __call__(self, _caller, _event, message):
+        self.messages.append(message)
+
+
+def pipeline(template, parameters=None, density=1.0):
+    source = blockforge.vtkBlockTemplateSource()
+    source.SetTemplateFile(template)
+    for name, value in (parameters or {}).items():
+        source.SetParameter(name, str(value))
+    mesher = blockforge.vtkBlockMesher()
+    mesher.SetInputConnection(source.GetOutputPort())
+    mesher.SetDensityMultiplier(density)
+    return source, mesher
+
+
+class ClassesTest(unittest.TestCase):
+    def test_classes_are_importable(self):
+        for name in ("vtkBlockTemplateSource", "vtkBlockMesher", "vtkGridQuality"):
+            self.assertTrue(hasattr(blockforge, name), name)
+            instance = getattr(blockforge, name)()
+            self.assertEqual(instance.GetClassName(), name)
+
+
+class CylinderInBoxTest(unittest.TestCase):
+    R, B, D = 0.5, 2.0, 1.0
+    AROUND, RADIAL, DEPTH = 16, 16, 8
+
+    def mesh(self, parameters=None, density=1.0):
+        source, mesher = pipeline(CYLINDER, parameters, density)
+        errors = ErrorCollector(source, mesher)
+        mesher.Update()
+        self.assertEqual(errors.messages, [])
+        return source, mesher, mesher.GetOutput()
+
+    def test_block_names_and_cell_count(self):
+        _, _, grid = self.mesh()
+        blocks = leaves(grid)
+        self.assertEqual(len(blocks), 4)
+        self.assertTrue(all(name for name, _ in blocks))
+        cells = sum(block.GetNumberOfCells() for _, block in blocks)
+        self.assertEqual(cells, 4 * self.AROUND * self.RADIAL * self.DEPTH)
+
+    def test_wall_nodes_on_exact_radius(self):
+        _, _, grid = self.mesh()
+        xyz = np.concatenate([points(block) for _, block in leaves(grid)])
+        radius = np.hypot(xyz[:, 0], xyz[:, 1])
+        wall = radius < self.R * (1 + 1e-6)
+        # 4 blocks, each with (AROUND+1) x (DEPTH+1) wall nodes
+        self.assertEqual(int(wall.sum()), 4 * (self.AROUND + 1) * (self.DEPTH + 1))
+        self.assertLess(np.max(np.abs(radius[wall] - self.R)) / self.R, 1e-9)
+        # box walls at |x| = B or |y| = B, depth between 0 and D
+        self.assertAlmostEqual(np.max(np.abs(xyz[:, :2])), self.B, places=12)
+        self.assertAlmostEqual(xyz[:, 2].min(), 0.0, places=12)
+        self.assertAlmostEqual(xyz[:, 2].max(), self.D, places=12)
+
+    def test_parameter_override_and_density(self):
+        _, _, grid = self.mesh({"R": 0.6, "n_around": "2*8"}, density=2.0)
+        xyz = np.concatenate([points(block) for _, block in leaves(grid)])
+        self.assertAlmostEqual(np.hypot(xyz[:, 0], xyz[:, 1]).min(), 0.6, places=12)
+        cells = sum(block.GetNumberOfCells() for _, block in leaves(grid))
+        self.assertEqual(cells, 4 * 32 * 32 * 16)
+
+    def test_deterministic_bit_for_bit(self):
+        _, _, first = self.mesh()
+        _, _, second = self.mesh()
+        for (_, a), (_, b) in zip(leaves(first), leaves(second)):
+            self.assertEqual(points(a).tobytes(), points(b).tobytes())
+
+    def test_model_survives_vtm_round_trip(self):
+        source, mesher, direct = self.mesh()
+        os.makedirs(OUTPUT, exist_ok=True)
+        path = os.path.join(OUTPUT, "cylinder_preview.vtm")
+        writer = vtkXMLMultiBlockDataWriter()
+        writer.SetInputConnection(source.GetOutputPort())
+        writer.SetFileName(path)
+        self.assertEqual(writer.Write(), 1)
+        reader = vtkXMLMultiBlockDataReader()
+        reader.SetFileName(path)
+        remesher = blockforge.vtkBlockMesher()
+        remesher.SetInputConnection(reader.GetOutputPort())
+        errors = ErrorCollector(remesher)
+        remesher.Update()
+        self.assertEqual(errors.messages, [])
+        reloaded = remesher.GetOutput()
+        self.assertEqual(len(leaves(reloaded)), len(leaves(direct)))
+        for (name_a, a), (name_b, b) in zip(leaves(direct), leaves(reloaded)):
+            self.assertEqual(name_a, name_b)
+            self.assertEqual(points(a).tobytes(), points(b).tobytes())
+
+    def test_preview_is_coarse(self):
+        source, _, _ = self.mesh()
+        source.SetPreviewCells(4)
+        source.Update()
+        for _, block in leaves(source.GetOutput()):
+            self.assertTrue(all(d - 1 <= 4 for d in block.GetDimensions()))
+
+
+class GridQualityTest(unittest.TestCase):
+    def test_arrays_classes_and_scaled_jacobian_against_vtk(self):
+        quality = blockforge.mesh_template(CYLINDER)
+        grid = quality.GetOutputDataObject(0)
+        total = 0
+        for name, block in leaves(grid):
+            cell_data = block.GetCellData()
+            for array in ("MinAngle", "MaxAngle", "NonOrthogonality", "Skewness",
+                          "AspectRatio", "ScaledJacobian", "BlockId"):
+                values = cell_data.GetArray(array)
+                self.assertIsNotNone(values, f"{array} missing on {name}")
+                self.assertEqual(values.GetNumberOfTuples(), block.GetNumberOfCells())
+            reference = vtkMeshQuality()
+            reference.SetInputData(block)
+            reference.SetHexQualityMeasureToScaledJacobian()
+            reference.Update()
+            expected = np.array(dsa.WrapDataObject(reference.GetOutput())
+                                .CellData["Quality"])
+            ours = np.array(dsa.WrapDataObject(block).CellData["ScaledJacobian"])
+            self.assertLess(np.max(np.abs(ours - expected)), 1e-9)
+            min_angle = np.array(dsa.WrapDataObject(block).CellData["MinAngle"])
+            max_angle = np.array(dsa.WrapDataObject(block).CellData["MaxAngle"])
+            self.assertTrue(np.all(min_angle > 0) and np.all(min_angle <= 90))
+            self.assertTrue(np.all(max_angle >= 90) and np.all(max_angle < 180))
+            total += block.GetNumberOfCells()
+        counts = grid.GetFieldData().GetArray("MinAngleClassCounts")
+        self.assertEqual(sum(counts.GetValue(i) for i in range(5)), total)
+        table = quality.GetOutputDataObject(1)
+        self.assertEqual(table.GetNumberOfRows(), 5)
+        self.assertEqual([table.GetValue(r, 0).ToString() for r in range(5)],
+                         list(blockforge.MIN_ANGLE_CLASSES))
+        self.assertAlmostEqual(sum(table.GetValue(r, 2).ToDouble() for r in range(5)), 100.0)
+        statistics = quality.GetOutputDataObject(2)
+        self.assertEqual(statistics.GetNumberOfRows(), 6)
+        summary = grid.GetFieldData().GetArray("ScaledJacobianSummary")
+        low, mean, high = summary.GetTuple3(0)
+        self.assertGreater(low, 0.0)
+        self.assertLessEqual(high, 1.0 + 1e-12)
+        self.assertTrue(low <= mean <= high)
+        # The model document travels on through the quality filter.
+        self.assertIsNotNone(grid.GetFieldData().GetAbstractArray("BlockForgeModel"))
+
+    def test_unit_cubes_are_perfect(self):
+        quality = blockforge.mesh_template(os.path.join(DATA, "two_blocks.yaml"))
+        grid = quality.GetOutputDataObject(0)
+        for _, block in leaves(grid):
+            data = dsa.WrapDataObject(block).CellData
+            np.testing.assert_allclose(data["MinAngle"], 90.0, atol=1e-9)
+            np.testing.assert_allclose(data["MaxAngle"], 90.0, atol=1e-9)
+            np.testing.assert_allclose(data["ScaledJacobian"], 1.0, atol=1e-12)
+            np.testing.assert_allclose(data["AspectRatio"], 1.0, atol=1e-12)
+            np.testing.assert_allclose(data["NonOrthogonality"], 0.0, atol=1e-6)
+            np.testing.assert_allclose(data["Skewness"], 0.0, atol=1e-9)
+        counts = grid.GetFieldData().GetArray("MinAngleClassCounts")
+        self.assertEqual([counts.GetValue(i) for i in range(5)], [0, 0, 0, 0, 2 * 64])
+
+
+class BadInputTest(unittest.TestCase):
+    """Every bad input gives a clear error naming file, line and entity; no crash."""
+
+    def run_bad(self, template, parameters=None):
+        source, mesher = pipeline(template, parameters)
+        errors = ErrorCollector(source, mesher)
+        mesher.Update()
+        self.assertTrue(errors.messages, "no error reported")
+        self.assertEqual(mesher.GetOutput().GetNumberOfBlocks(), 0)
+        return errors.messages[0]
+
+    def test_missing_file(self):
+        message = self.run_bad(os.path.join(DATA, "no_such_template.yaml"))
+        self.assertIn("no_such_template.yaml", message)
+
+    def test_syntax_error(self):
+        message = self.run_bad(os.path.join(DATA, "bad_syntax.yaml"))
+        self.assertIn("bad_syntax.yaml:2", message)  # line 21 or 22
+
+    def test_unknown_vertex(self):
+        message = self.run_bad(os.path.join(DATA, "bad_unknown_vertex.yaml"))
+        self.assertIn("bad_unknown_vertex.yaml:23", message)
+        self.assertIn("a8", message)
+        self.assertIn("left", message)
+
+    def test_bad_expression(self):
+        message = self.run_bad(os.path.join(DATA, "bad_expression.yaml"))
+        self.assertIn("bad_expression.yaml:6", message)
+        self.assertIn("'n'", message)
+
+    def test_mismatched_node_counts(self):
+        message = self.run_bad(os.path.join(DATA, "two_blocks.yaml"), {"n_right": 5})
+        self.assertIn("left", message)
+        self.assertIn("right", message)
+
+    def test_inside_out_block(self):
+        message = self.run_bad(os.path.join(DATA, "bad_inside_out.yaml"))
+        self.assertIn("right", message)
+        self.assertIn("inside-out", message)
+
+    def test_unknown_parameter_override(self):
+        message = self.run_bad(CYLINDER, {"no_such_parameter": 1})
+        self.assertIn("no_such_parameter", message)
+
+    def test_mesher_without_model(self):
+        from vtkmodules.vtkCommonDataModel import vtkMultiBlockDataSet
+        mesher = blockforge.vtkBlockMesher()
+        mesher.SetInputData(vtkMultiBlockDataSet())
+        errors = ErrorCollector(mesher)
+        mesher.Update()
+        self.assertTrue(any("BlockForge model" in m for m in errors.messages))
+
+    def test_mesh_template_raises(self):
+        with self.assertRaises(RuntimeError) as context:
+            blockforge.mesh_template(os.path.join(DATA, "bad_inside_out.yaml"))
+        self.assertIn("inside-out", str(context.exception))
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2, argv=[sys.argv[0]])
