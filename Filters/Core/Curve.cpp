@@ -1,5 +1,7 @@
 #include "Curve.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>

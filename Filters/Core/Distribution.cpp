@@ -1,1 +1,355 @@
-// placeholder
+#include "Distribution.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace blockforge
+{
+namespace
+{
+/// Relative slack for comparing lengths that the user computed by hand (h * cells == L).
+constexpr double LengthSlack = 1e-12;
+
+std::string toString(double value)
+{
+  std::ostringstream s;
+  s.precision(10);
+  s << value;
+  return s.str();
+}
+
+std::vector<double> uniform(int nodeCount)
+{
+  const int cells = nodeCount - 1;
+  std::vector<double> s(nodeCount);
+  for (int i = 0; i < nodeCount; ++i)
+  {
+    s[i] = static_cast<double>(i) / cells;
+  }
+  s.back() = 1.0;
+  return s;
+}
+
+/// Neumaier's compensated sum: node positions then carry rounding errors of the final
+/// division only, independent of the number of cells.
+class CompensatedSum
+{
+public:
+  void add(double x)
+  {
+    const double t = Sum + x;
+    Compensation += std::abs(Sum) >= std::abs(x) ? (Sum - t) + x : (x - t) + Sum;
+    Sum = t;
+  }
+  double value() const { return Sum + Compensation; }
+
+private:
+  double Sum = 0.0, Compensation = 0.0;
+};
+
+void requireStrictlyIncreasing(const std::vector<double>& s, const char* lawName)
+{
+  for (std::size_t i = 1; i < s.size(); ++i)
+  {
+    if (!(s[i] > s[i - 1]))
+    {
+      throw GeometryError(std::string(lawName) + " distribution: with " +
+        std::to_string(s.size()) +
+        " nodes the smallest cells become too small to represent; reduce the expansion "
+        "ratio or the number of nodes");
+    }
+  }
+}
+
+/// Node positions from relative cell sizes: cumulative sum divided by the total, with the
+/// ends forced to exactly 0 and 1.
+std::vector<double> fromCellSizes(const std::vector<double>& sizes, const char* lawName)
+{
+  std::vector<double> s(sizes.size() + 1);
+  CompensatedSum total;
+  for (double size : sizes)
+  {
+    total.add(size);
+  }
+  const double sum = total.value();
+  if (!(sum > 0.0) || !std::isfinite(sum))
+  {
+    throw GeometryError(std::string(lawName) +
+      " distribution: the cell sizes cannot be represented; reduce the expansion ratio or "
+      "the number of nodes");
+  }
+  CompensatedSum running;
+  s[0] = 0.0;
+  for (std::size_t i = 0; i + 1 < sizes.size(); ++i)
+  {
+    running.add(sizes[i]);
+    s[i + 1] = running.value() / sum;
+  }
+  s.back() = 1.0;
+  requireStrictlyIncreasing(s, lawName);
+  return s;
+}
+
+void requirePositiveRatio(double k, const char* lawName)
+{
+  if (!(k > 0.0) || !std::isfinite(k))
+  {
+    throw GeometryError(std::string(lawName) + " distribution: the expansion ratio must be a "
+      "positive number, got " + toString(k));
+  }
+}
+
+/// Cells k^i, i = 0..cells-1 (paper eq. 7), scaled so that the largest is 1: the ratio of
+/// successive cells is then exact to rounding and no power overflows. Summing the cells
+/// directly (instead of (k^n - 1)/(k - 1)) has no cancellation for k close to 1.
+std::vector<double> geometric(double k, int nodeCount)
+{
+  requirePositiveRatio(k, "geometric");
+  if (k == 1.0)
+  {
+    return uniform(nodeCount);
+  }
+  const int cells = nodeCount - 1;
+  const int largest = k > 1.0 ? cells - 1 : 0;
+  std::vector<double> sizes(cells);
+  for (int i = 0; i < cells; ++i)
+  {
+    sizes[i] = std::pow(k, i - largest);
+  }
+  return fromCellSizes(sizes, "geometric");
+}
+
+/// Cells proportional to k^min(i, cells-1-i), built from the first half and mirrored, so
+/// that s_i + s_(n-1-i) == 1 up to the rounding of one subtraction.
+std::vector<double> twoSided(double k, int nodeCount)
+{
+  requirePositiveRatio(k, "two-sided");
+  if (k == 1.0)
+  {
+    return uniform(nodeCount);
+  }
+  const int cells = nodeCount - 1;
+  const int halfCells = cells / 2;       // cells strictly in the lower half
+  const int largestExponent = (cells - 1) / 2;
+  const int scaleExponent = k > 1.0 ? largestExponent : 0;
+  CompensatedSum lowerHalf;
+  std::vector<double> cumulative(halfCells + 1, 0.0);
+  for (int i = 0; i < halfCells; ++i)
+  {
+    lowerHalf.add(std::pow(k, i - scaleExponent));
+    cumulative[i + 1] = lowerHalf.value();
+  }
+  const double half = lowerHalf.value();
+  const double middle = cells % 2 == 1 ? std::pow(k, largestExponent - scaleExponent) : 0.0;
+  const double total = 2.0 * half + middle;
+  if (!(total > 0.0) || !std::isfinite(total))
+  {
+    throw GeometryError("two-sided distribution: the cell sizes cannot be represented; "
+      "reduce the expansion ratio or the number of nodes");
+  }
+  std::vector<double> s(nodeCount);
+  for (int i = 0; i <= halfCells; ++i)
+  {
+    s[i] = cumulative[i] / total;
+    s[nodeCount - 1 - i] = 1.0 - s[i];
+  }
+  if (cells % 2 == 0)
+  {
+    s[halfCells] = 0.5;
+  }
+  s.front() = 0.0;
+  s.back() = 1.0;
+  requireStrictlyIncreasing(s, "two-sided");
+  return s;
+}
+
+/// First cell h, growing geometrically by k with k solved from h (1 + k + ... + k^(m-1)) = L.
+std::vector<double> firstCellSolvedRatio(double h, double length, int nodeCount)
+{
+  const int cells = nodeCount - 1;
+  const double q = length / h;
+  if (!(q > 1.0))
+  {
+    throw GeometryError("first-cell distribution: the first cell size " + toString(h) +
+      " must be smaller than the edge length " + toString(length));
+  }
+  if (std::abs(q - cells) <= LengthSlack * cells)
+  {
+    return uniform(nodeCount);
+  }
+  auto sumOfPowers = [cells](double k) {
+    double sum = 1.0;
+    for (int i = 1; i < cells; ++i)
+    {
+      sum = 1.0 + k * sum; // Horner: no cancellation near k = 1
+    }
+    return sum;
+  };
+  // sumOfPowers increases with k; it is below `cells` for k < 1 and at least k^(cells-1)
+  // for k > 1, which brackets the root. Bisection down to adjacent doubles is
+  // deterministic and as accurate as double allows.
+  double lo, hi;
+  if (q < cells)
+  {
+    lo = 0.0;
+    hi = 1.0;
+  }
+  else
+  {
+    lo = 1.0;
+    hi = std::max(1.0, std::pow(q, 1.0 / (cells - 1))) * (1.0 + 1e-12);
+  }
+  for (int iteration = 0; iteration < 2000; ++iteration)
+  {
+    const double mid = 0.5 * (lo + hi);
+    if (!(mid > lo && mid < hi))
+    {
+      break;
+    }
+    (sumOfPowers(mid) < q ? lo : hi) = mid;
+  }
+  const double k = std::abs(sumOfPowers(lo) - q) <= std::abs(sumOfPowers(hi) - q) ? lo : hi;
+  if (!(k > 0.0))
+  {
+    throw GeometryError("first-cell distribution: the first cell size " + toString(h) +
+      " is too large for " + std::to_string(cells) + " cells on an edge of length " +
+      toString(length));
+  }
+  std::vector<double> sizes(cells);
+  const int largest = k > 1.0 ? cells - 1 : 0;
+  for (int i = 0; i < cells; ++i)
+  {
+    sizes[i] = std::pow(k, i - largest);
+  }
+  return fromCellSizes(sizes, "first-cell");
+}
+
+/// First cell h, each cell at most r times the previous one: cells h r^i up to a cap c,
+/// then c, with c such that the cells fill the edge exactly.
+std::vector<double> firstCellCapped(double h, double r, double length, int nodeCount)
+{
+  const int cells = nodeCount - 1;
+  if (h * cells > length * (1.0 + LengthSlack))
+  {
+    throw GeometryError("first-cell distribution: " + std::to_string(cells) +
+      " cells of at least the first cell size " + toString(h) + " need a length of " +
+      toString(h * cells) + ", more than the edge length " + toString(length) +
+      "; reduce the first cell size or the number of nodes");
+  }
+  if (h * cells >= length * (1.0 - LengthSlack))
+  {
+    return uniform(nodeCount);
+  }
+  // The total F(c) = sum min(h r^i, c) is piecewise linear and increasing in c, so the cap
+  // is found exactly by locating the first cell j that is capped: with cells 0..j-1 free,
+  // c_j = (L - sum_{i<j} h r^i) / (cells - j), and j is the first index with c_j <= h r^j.
+  std::vector<double> sizes(cells);
+  double grown = 0.0; // sum of the free cells
+  int capped = cells;
+  double cap = 0.0;
+  for (int j = 1; j < cells; ++j)
+  {
+    const double previous = h * std::pow(r, j - 1);
+    grown += previous;
+    const double candidate = (length - grown) / (cells - j);
+    const double next = h * std::pow(r, j);
+    if (candidate <= next)
+    {
+      capped = j;
+      cap = std::max(candidate, previous);
+      break;
+    }
+  }
+  if (capped == cells)
+  {
+    const double reach = grown + h * std::pow(r, cells - 1);
+    if (reach < length * (1.0 - LengthSlack))
+    {
+      throw GeometryError("first-cell distribution: " + std::to_string(cells) +
+        " cells growing from the first cell size " + toString(h) + " by at most " +
+        toString(r) + " reach only a length of " + toString(reach) + " of the edge length " +
+        toString(length) + "; increase the expansion ratio, the first cell size or the "
+        "number of nodes");
+    }
+  }
+  for (int i = 0; i < cells; ++i)
+  {
+    sizes[i] = i < capped ? h * std::pow(r, i) : cap;
+  }
+  return fromCellSizes(sizes, "first-cell");
+}
+
+std::vector<double> firstCell(const DistributionLaw& law, int nodeCount, double length)
+{
+  const double h = law.firstCellSize;
+  const double r = law.expansionRatio;
+  if (!(length > 0.0) || !std::isfinite(length))
+  {
+    throw GeometryError("first-cell distribution: the edge length must be positive, got " +
+      toString(length));
+  }
+  if (!(h > 0.0) || !std::isfinite(h))
+  {
+    throw GeometryError("first-cell distribution: the first cell size must be positive, "
+      "got " + toString(h));
+  }
+  if (!std::isfinite(r) || (r != 0.0 && r < 1.0))
+  {
+    throw GeometryError("first-cell distribution: the maximum expansion ratio must be at "
+      "least 1 (or 0 to compute it from the first cell size), got " + toString(r));
+  }
+  if (nodeCount == 2)
+  {
+    if (std::abs(h - length) > 1e-9 * length)
+    {
+      throw GeometryError("first-cell distribution: with 2 nodes the only cell is the whole "
+        "edge (length " + toString(length) + "), so it cannot have the first cell size " +
+        toString(h) + "; use more nodes");
+    }
+    return uniform(nodeCount);
+  }
+  return r == 0.0 ? firstCellSolvedRatio(h, length, nodeCount)
+                  : firstCellCapped(h, r, length, nodeCount);
+}
+} // namespace
+
+std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
+  double edgeLength)
+{
+  if (nodeCount < 2)
+  {
+    throw GeometryError("an edge needs at least 2 nodes (1 cell), got " +
+      std::to_string(nodeCount));
+  }
+  switch (law.kind)
+  {
+    case DistributionLaw::Kind::Uniform:
+      return uniform(nodeCount);
+    case DistributionLaw::Kind::Geometric:
+      return geometric(law.expansionRatio, nodeCount);
+    case DistributionLaw::Kind::TwoSided:
+      return twoSided(law.expansionRatio, nodeCount);
+    case DistributionLaw::Kind::FirstCell:
+      return firstCell(law, nodeCount, edgeLength);
+  }
+  throw GeometryError("unknown distribution law");
+}
+
+DistributionLaw reversedLaw(const DistributionLaw& law)
+{
+  DistributionLaw reversed = law;
+  switch (law.kind)
+  {
+    case DistributionLaw::Kind::Geometric:
+      requirePositiveRatio(law.expansionRatio, "geometric");
+      reversed.expansionRatio = 1.0 / law.expansionRatio;
+      return reversed;
+    case DistributionLaw::Kind::FirstCell:
+      throw GeometryError("a first-cell distribution cannot be reversed into another "
+        "first-cell law; reverse its node parameters instead");
+    default:
+      return reversed; // Uniform and TwoSided are symmetric
+  }
+}
+} // namespace blockforge

@@ -58,6 +58,14 @@ private:
   const BSplineCurve* Spline;
 };
 
+void requireFinite(const Vec3& p)
+{
+  if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
+  {
+    throw GeometryError("projection: the point to project has a non-finite coordinate");
+  }
+}
+
 double clampUnit(double t)
 {
   return t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
@@ -330,6 +338,7 @@ CurveProjector::CurveProjector(CurvePtr curve, int samples)
 
 CurveProjection CurveProjector::project(const Vec3& p, double tolerance) const
 {
+  requireFinite(p);
   const int n = static_cast<int>(SamplePoints.size());
   const CurveEvaluator curve(*TheCurve);
 
@@ -392,8 +401,14 @@ CurveProjection CurveProjector::project(const Vec3& p, double tolerance) const
     curve.evaluate(hi, jet);
     const double gHi = gradient(jet, p);
 
-    consider(mid);
-    bool found = gMid == 0.0;
+    // Stationary points and clamped ends only: near the minimum the distance is flat to
+    // second order, so comparing it with the sample's distance cannot tell them apart.
+    bool found = false;
+    if (gMid == 0.0)
+    {
+      consider(mid);
+      found = true;
+    }
     if (gLo < 0.0 && gMid > 0.0)
     {
       consider(solveBracketed(curve, p, lo, mid, gLo, gMid, tolerance));
@@ -433,6 +448,7 @@ CurveProjection CurveProjector::project(const Vec3& p, double tolerance) const
         tPrev = tk;
         gPrev = gk;
       }
+      consider(mid);
     }
   }
   return result;
@@ -466,6 +482,7 @@ SurfaceProjector::SurfaceProjector(SurfacePtr surface, int samplesS, int samples
 
 SurfaceProjection SurfaceProjector::project(const Vec3& p, double tolerance) const
 {
+  requireFinite(p);
   const int ns = SamplesS, nt = SamplesT;
   auto at = [&](int i, int j) -> const Vec3& {
     return SamplePoints[i + static_cast<std::size_t>(j) * ns];
@@ -534,12 +551,11 @@ SurfaceProjection SurfaceProjector::project(const Vec3& p, double tolerance) con
 namespace
 {
 // 10-point Gauss-Legendre rule on [-1, 1] (exact for polynomials of degree 19).
-constexpr std::array<double, 5> GaussNodes = { 0.1488743389816312108848260,
-  0.4333953941292471907992659, 0.6794095682990244062343274, 0.8650633666889845107320967,
-  0.9739065285171717200779640 };
-constexpr std::array<double, 5> GaussWeights = { 0.2955242247147528701738930,
-  0.2692667193099963550912269, 0.2190863625159820439955349, 0.1494513318847011969813820,
-  0.0666713443086881375935688 };
+constexpr std::array<double, 5> GaussNodes = { 0.148874338981631210885, 0.433395394129247190799,
+  0.679409568299024406234, 0.865063366688984510732, 0.973906528517171720078 };
+constexpr std::array<double, 5> GaussWeights = { 0.295524224714752870174,
+  0.269266719309996355091, 0.219086362515982043996, 0.149451349150580593146,
+  0.066671344308688137594 };
 
 double gaussSpeed(const Curve& curve, double a, double b)
 {

@@ -49,6 +49,18 @@ double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre,
 double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea,
   const Vec3& faceCentre);
 
+/// Face skewness exactly as OpenFOAM's checkMesh reports it (meshCheck::faceSkewness):
+/// the same skewness vector sv, but divided by max(0.2 |d|, largest projection of the
+/// face corners, taken from the face centre, onto sv's direction). computeGridQuality
+/// uses this definition, so its Skewness compares with checkMesh's "Max skewness".
+double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre,
+  const Vec3& faceArea, const Vec3& faceCentre, const std::array<Vec3, 4>& faceCorners);
+
+/// OpenFOAM's meshCheck::boundaryFaceSkewness: d is the owner-to-face vector projected
+/// on the face normal and the distance term is 0.4 |d| (a mirrored cell).
+double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea,
+  const Vec3& faceCentre, const std::array<Vec3, 4>& faceCorners);
+
 /// Quality measures of every cell of a multiblock structured grid.
 struct StructuredBlock
 {
@@ -68,6 +80,17 @@ struct CellQualityArrays
  * face of another block (same four node coordinates, bit for bit) are treated as
  * internal faces, so interfaces are measured like the interior. `progress` (may be
  * empty) is called with a fraction in [0, 1].
+ *
+ * Conventions: face area vectors follow the block's index directions (a right-handed
+ * block has outward normals), so the faces of an inverted cell give NonOrthogonality
+ * above 90. Skewness is checkMesh's (the overload of faceSkewness with face corners);
+ * true boundary faces contribute boundaryFaceSkewness and no non-orthogonality. Faces
+ * with no area (collapsed edges of wedge/prism blocks) contribute nothing, and a block
+ * boundary face is paired only when exactly one other face has the same corners.
+ * Degenerate cells never give NaN: angles of collapsed faces are skipped (a cell with no
+ * valid face gets MinAngle 0, MaxAngle 180), AspectRatio and ScaledJacobian follow
+ * Verdict's convention of 1e30 (a collapsed edge makes the scaled Jacobian 1e30, as in
+ * vtkMeshQuality).
  */
 std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBlock>& blocks,
   const std::function<void(double)>& progress = {});

@@ -1,1 +1,101 @@
-// placeholder
+#include "BlockModel.h"
+
+namespace blockforge
+{
+namespace model
+{
+int BlockModel::findVertex(const std::string& vertexName) const
+{
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+  {
+    if (vertices[i].name == vertexName)
+    {
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+int BlockModel::findBlock(const std::string& blockName) const
+{
+  for (std::size_t i = 0; i < blocks.size(); ++i)
+  {
+    if (blocks[i].name == blockName)
+    {
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+int BlockModel::findEdge(int a, int b) const
+{
+  for (std::size_t i = 0; i < edges.size(); ++i)
+  {
+    const Edge& edge = edges[i];
+    if ((edge.from == a && edge.to == b) || (edge.from == b && edge.to == a))
+    {
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+namespace
+{
+const char* const FaceNames[6] = { "i0", "i1", "j0", "j1", "k0", "k1" };
+
+// Tables follow the local numbering of Transfinite.h (paper Fig. 7, 0-based).
+const std::array<int, 2> EdgeVertexTable[12] = { { 0, 1 }, { 1, 2 }, { 3, 2 }, { 0, 3 },
+  { 4, 5 }, { 5, 6 }, { 7, 6 }, { 4, 7 }, { 0, 4 }, { 1, 5 }, { 2, 6 }, { 3, 7 } };
+const std::array<int, 4> FaceCornerTable[6] = { { 0, 3, 7, 4 }, { 1, 2, 6, 5 },
+  { 0, 1, 5, 4 }, { 3, 2, 6, 7 }, { 0, 1, 2, 3 }, { 4, 5, 6, 7 } };
+const std::array<int, 4> FaceEdgeTable[6] = { { 3, 7, 8, 11 }, { 1, 5, 9, 10 },
+  { 0, 4, 8, 9 }, { 2, 6, 11, 10 }, { 0, 2, 3, 1 }, { 4, 6, 7, 5 } };
+const std::array<int, 2> FaceDirectionTable[6] = { { 1, 2 }, { 1, 2 }, { 0, 2 }, { 0, 2 },
+  { 0, 1 }, { 0, 1 } };
+}
+
+const char* faceName(int face)
+{
+  return face >= 0 && face < 6 ? FaceNames[face] : "?";
+}
+
+int faceFromName(const std::string& name)
+{
+  for (int f = 0; f < 6; ++f)
+  {
+    if (name == FaceNames[f])
+    {
+      return f;
+    }
+  }
+  return -1;
+}
+
+std::array<int, 4> faceCorners(int face)
+{
+  return FaceCornerTable[face];
+}
+
+std::array<int, 2> edgeVertices(int edge)
+{
+  return EdgeVertexTable[edge];
+}
+
+int edgeDirection(int edge)
+{
+  return edge < 8 ? (edge % 2 == 0 ? 0 : 1) : 2;
+}
+
+std::array<int, 4> faceEdges(int face)
+{
+  return FaceEdgeTable[face];
+}
+
+std::array<int, 2> faceDirections(int face)
+{
+  return FaceDirectionTable[face];
+}
+} // namespace model
+} // namespace blockforge

@@ -117,5 +117,12 @@ std::array<int, 4> faceCorners(int face);
 std::array<int, 2> edgeVertices(int edge);
 /// Direction (0 = i, 1 = j, 2 = k) of edge e.
 int edgeDirection(int edge);
+/// Face index (0..5) of "i0" .. "k1", -1 for anything else.
+int faceFromName(const std::string& name);
+/// Local edges (0..11) bounding face f, as the face grid sees them: bottom (b = 0),
+/// top (b = max), left (a = 0), right (a = max); each runs in increasing a or b.
+std::array<int, 4> faceEdges(int face);
+/// The two index directions (0 = i, 1 = j, 2 = k) of face f: a (fastest) and b.
+std::array<int, 2> faceDirections(int face);
 } // namespace model
 } // namespace blockforge

@@ -1,1 +1,561 @@
-// placeholder
+#include "ModelDocument.h"
+
+#include "ModelSyntax.h"
+#include "Template.h"
+
+#include <cmath>
+
+namespace blockforge
+{
+namespace model
+{
+namespace
+{
+using syntax::entity;
+using syntax::formatNumber;
+using syntax::MapEntry;
+
+const char* const DocumentFile = "<model document>";
+
+// ---------------------------------------------------------------------------- writing
+YAML::Emitter& emitVector(YAML::Emitter& out, const Vec3& value)
+{
+  out << YAML::Flow << YAML::BeginSeq;
+  for (int c = 0; c < 3; ++c)
+  {
+    out << formatNumber(value[c]);
+  }
+  return out << YAML::EndSeq;
+}
+
+/// Source of an entity: its template line, and its file when not the model's source.
+void emitWhere(YAML::Emitter& out, const SourceLocation& where, const BlockModel& model)
+{
+  if (where.file != model.sourceFile)
+  {
+    out << YAML::Key << "file" << YAML::Value << where.file;
+  }
+  out << YAML::Key << "line" << YAML::Value << where.line;
+}
+
+const std::string& vertexName(const BlockModel& model, int index, const std::string& user)
+{
+  if (index < 0 || index >= static_cast<int>(model.vertices.size()))
+  {
+    throw TemplateError(DocumentFile, 0, user,
+      "refers to vertex #" + std::to_string(index) + ", which does not exist");
+  }
+  return model.vertices[index].name;
+}
+
+// ---------------------------------------------------------------------------- reading
+class DocumentReader
+{
+public:
+  explicit DocumentReader(const std::string& text)
+    : Text(text)
+  {
+    Report.file = DocumentFile;
+  }
+
+  BlockModel read()
+  {
+    YAML::Node root;
+    try
+    {
+      root = YAML::Load(Text);
+    }
+    catch (const YAML::Exception& error)
+    {
+      fail(error.mark.line >= 0 ? error.mark.line + 1 : 0, "",
+        "not a BlockForge model document (YAML error: " + error.msg + ")");
+    }
+    if (!root.IsMap())
+    {
+      fail(1, "", "not a BlockForge model document (expected 'blockforge_model: 1')");
+    }
+    const auto sections = syntax::mapEntries(root, 1, "", "the model document", Report);
+    syntax::checkKeys(sections,
+      { "blockforge_model", "name", "source", "parameters", "vertices", "edges", "blocks",
+        "patches" },
+      "", Report);
+    const MapEntry* version = syntax::findEntry(sections, "blockforge_model");
+    if (!version)
+    {
+      fail(1, "", "not a BlockForge model document (missing 'blockforge_model')");
+    }
+    const double format = number(version->value, version->line, "", "blockforge_model");
+    if (format != std::floor(format) || format < 1)
+    {
+      fail(version->line, "", "'blockforge_model' must be a whole version number");
+    }
+    if (format > BlockModel::FormatVersion)
+    {
+      fail(version->line, "",
+        "the model document has format " + version->value.Scalar() +
+          ", newer than this BlockForge reads (" + std::to_string(BlockModel::FormatVersion) +
+          "); please update BlockForge");
+    }
+    if (const MapEntry* name = syntax::findEntry(sections, "name"))
+    {
+      Model.name = text(name->value, name->line, "", "name");
+    }
+    if (const MapEntry* source = syntax::findEntry(sections, "source"))
+    {
+      Model.sourceFile = text(source->value, source->line, "", "source");
+    }
+    if (const MapEntry* parameters = syntax::findEntry(sections, "parameters"))
+    {
+      for (const MapEntry& entry : syntax::mapEntries(
+             parameters->value, parameters->line, "", "parameters", Report))
+      {
+        Model.parameters.emplace_back(entry.key,
+          number(entry.value, entry.line, entity("parameter", entry.key), "value"));
+      }
+    }
+    for (const YAML::Node& node : list(sections, "vertices"))
+    {
+      readVertex(node);
+    }
+    for (const YAML::Node& node : list(sections, "edges"))
+    {
+      readEdge(node);
+    }
+    for (const YAML::Node& node : list(sections, "blocks"))
+    {
+      readBlock(node);
+    }
+    for (const YAML::Node& node : list(sections, "patches"))
+    {
+      readPatch(node);
+    }
+    return std::move(Model);
+  }
+
+private:
+  [[noreturn]] void fail(int line, const std::string& entityText, const std::string& what) const
+  {
+    Report.fail(line, entityText, what);
+  }
+
+  int here(const YAML::Node& node, int fallback) const
+  {
+    const int line = syntax::lineOf(node);
+    return line && !node.IsNull() ? line : fallback;
+  }
+
+  double number(const YAML::Node& node, int line, const std::string& entityText,
+    const std::string& what) const
+  {
+    double value = 0.0;
+    if (!node.IsScalar() || !syntax::parseNumber(node.Scalar(), value) || !std::isfinite(value))
+    {
+      fail(here(node, line), entityText, what + ": expected a finite number");
+    }
+    return value;
+  }
+
+  int integer(const YAML::Node& node, int line, const std::string& entityText,
+    const std::string& what) const
+  {
+    const double value = number(node, line, entityText, what);
+    if (value != std::floor(value) || std::abs(value) > 2.0e9)
+    {
+      fail(here(node, line), entityText, what + ": expected a whole number");
+    }
+    return static_cast<int>(value);
+  }
+
+  std::string text(const YAML::Node& node, int line, const std::string& entityText,
+    const std::string& what) const
+  {
+    if (!node.IsScalar())
+    {
+      fail(here(node, line), entityText, what + ": expected text");
+    }
+    return node.Scalar();
+  }
+
+  Vec3 vector3(const YAML::Node& node, int line, const std::string& entityText,
+    const std::string& what) const
+  {
+    if (!node.IsSequence() || node.size() != 3)
+    {
+      fail(here(node, line), entityText, what + ": expected [x, y, z]");
+    }
+    return Vec3(number(node[0], line, entityText, what), number(node[1], line, entityText, what),
+      number(node[2], line, entityText, what));
+  }
+
+  std::vector<YAML::Node> list(const std::vector<MapEntry>& sections, const std::string& key)
+  {
+    std::vector<YAML::Node> nodes;
+    const MapEntry* section = syntax::findEntry(sections, key);
+    if (!section || section->value.IsNull())
+    {
+      return nodes;
+    }
+    if (!section->value.IsSequence())
+    {
+      fail(section->line, "", "'" + key + "' must be a list");
+    }
+    for (const YAML::Node& node : section->value)
+    {
+      nodes.push_back(node);
+    }
+    return nodes;
+  }
+
+  /// The entity's keys; its name and source location are read here for every kind.
+  std::vector<MapEntry> entries(const YAML::Node& node, const std::string& kind,
+    const std::vector<std::string>& allowed, std::string& name, SourceLocation& where)
+  {
+    const int line = syntax::lineOf(node);
+    auto keys = syntax::mapEntries(node, line, kind, "a " + kind, Report);
+    if (!node.IsMap())
+    {
+      fail(line, "", "each " + kind + " must be a mapping");
+    }
+    std::vector<std::string> all = allowed;
+    all.insert(all.end(), { "name", "file", "line" });
+    const MapEntry* nameEntry = syntax::findEntry(keys, "name");
+    if (!nameEntry)
+    {
+      fail(line, "", "a " + kind + " without a name");
+    }
+    name = text(nameEntry->value, nameEntry->line, kind, "name");
+    syntax::checkKeys(keys, all, entity(kind, name), Report);
+    where.file = Model.sourceFile;
+    if (const MapEntry* file = syntax::findEntry(keys, "file"))
+    {
+      where.file = text(file->value, file->line, entity(kind, name), "file");
+    }
+    if (const MapEntry* sourceLine = syntax::findEntry(keys, "line"))
+    {
+      where.line = integer(sourceLine->value, sourceLine->line, entity(kind, name), "line");
+    }
+    return keys;
+  }
+
+  const MapEntry& required(const std::vector<MapEntry>& keys, const std::string& key,
+    const YAML::Node& node, const std::string& entityText) const
+  {
+    const MapEntry* found = syntax::findEntry(keys, key);
+    if (!found)
+    {
+      fail(syntax::lineOf(node), entityText, "missing '" + key + "'");
+    }
+    return *found;
+  }
+
+  int vertexRef(const YAML::Node& node, int line, const std::string& entityText) const
+  {
+    const std::string name = text(node, line, entityText, "vertex");
+    const int index = Model.findVertex(name);
+    if (index < 0)
+    {
+      fail(here(node, line), entityText, "unknown vertex '" + name + "'");
+    }
+    return index;
+  }
+
+  void readVertex(const YAML::Node& node)
+  {
+    Vertex vertex;
+    const auto keys = entries(node, "vertex", { "position" }, vertex.name, vertex.where);
+    const std::string entityText = entity("vertex", vertex.name);
+    if (Model.findVertex(vertex.name) >= 0)
+    {
+      fail(syntax::lineOf(node), entityText, "defined twice");
+    }
+    const MapEntry& position = required(keys, "position", node, entityText);
+    vertex.position = vector3(position.value, position.line, entityText, "position");
+    Model.vertices.push_back(vertex);
+  }
+
+  void readEdge(const YAML::Node& node)
+  {
+    Edge edge;
+    const auto keys = entries(
+      node, "edge", { "kind", "from", "to", "centre", "through", "points" }, edge.name, edge.where);
+    const std::string entityText = entity("edge", edge.name);
+    const MapEntry& kind = required(keys, "kind", node, entityText);
+    const std::string kindName = text(kind.value, kind.line, entityText, "kind");
+    const MapEntry& from = required(keys, "from", node, entityText);
+    const MapEntry& to = required(keys, "to", node, entityText);
+    edge.from = vertexRef(from.value, from.line, entityText);
+    edge.to = vertexRef(to.value, to.line, entityText);
+    if (kindName == "line")
+    {
+      edge.kind = Edge::Kind::Line;
+    }
+    else if (kindName == "arc")
+    {
+      edge.kind = Edge::Kind::Arc;
+      const MapEntry* centre = syntax::findEntry(keys, "centre");
+      const MapEntry* through = syntax::findEntry(keys, "through");
+      if ((centre != nullptr) == (through != nullptr))
+      {
+        fail(kind.line, entityText, "an arc needs exactly one of 'centre' or 'through'");
+      }
+      edge.arcHasCentre = centre != nullptr;
+      if (centre)
+      {
+        edge.arcCentre = vector3(centre->value, centre->line, entityText, "centre");
+      }
+      else
+      {
+        edge.arcThrough = vector3(through->value, through->line, entityText, "through");
+      }
+    }
+    else if (kindName == "spline")
+    {
+      edge.kind = Edge::Kind::Spline;
+      const MapEntry& points = required(keys, "points", node, entityText);
+      if (!points.value.IsSequence())
+      {
+        fail(points.line, entityText, "'points' must be a list of [x, y, z]");
+      }
+      for (const YAML::Node& point : points.value)
+      {
+        edge.splinePoints.push_back(vector3(point, points.line, entityText, "point"));
+      }
+    }
+    else
+    {
+      fail(kind.line, entityText, "unknown edge kind '" + kindName + "' (line, arc, spline)");
+    }
+    Model.edges.push_back(edge);
+  }
+
+  void readBlock(const YAML::Node& node)
+  {
+    Block block;
+    const auto keys =
+      entries(node, "block", { "vertices", "cells", "laws" }, block.name, block.where);
+    const std::string entityText = entity("block", block.name);
+    const MapEntry& vertices = required(keys, "vertices", node, entityText);
+    if (!vertices.value.IsSequence() || vertices.value.size() != 8)
+    {
+      fail(vertices.line, entityText, "needs 8 vertices");
+    }
+    for (int v = 0; v < 8; ++v)
+    {
+      block.vertices[v] = vertexRef(vertices.value[v], vertices.line, entityText);
+    }
+    const MapEntry& cells = required(keys, "cells", node, entityText);
+    if (!cells.value.IsSequence() || cells.value.size() != 3)
+    {
+      fail(cells.line, entityText, "'cells' needs three counts");
+    }
+    for (int d = 0; d < 3; ++d)
+    {
+      block.cells[d] = integer(cells.value[d], cells.line, entityText, "cells");
+      if (block.cells[d] < 1)
+      {
+        fail(cells.line, entityText, "cells must be at least 1");
+      }
+    }
+    const MapEntry& laws = required(keys, "laws", node, entityText);
+    if (!laws.value.IsSequence() || laws.value.size() != 12)
+    {
+      fail(laws.line, entityText, "'laws' needs one law per edge, E1 to E12");
+    }
+    const syntax::NumberReader reader = [this, &entityText](const YAML::Node& value, int line,
+                                          const std::string& what) {
+      return number(value, line, entityText, what);
+    };
+    for (int e = 0; e < 12; ++e)
+    {
+      block.laws[e] = syntax::parseLaw(
+        laws.value[e], laws.line, entityText, "law " + syntax::edgeLabel(e), reader, Report);
+    }
+    Model.blocks.push_back(block);
+  }
+
+  void readPatch(const YAML::Node& node)
+  {
+    Patch patch;
+    const auto keys = entries(node, "patch",
+      { "type", "faces", "partner", "axis", "origin", "angle" }, patch.name, patch.where);
+    const std::string entityText = entity("patch", patch.name);
+    const MapEntry& type = required(keys, "type", node, entityText);
+    patch.type = text(type.value, type.line, entityText, "type");
+    const MapEntry& faces = required(keys, "faces", node, entityText);
+    if (!faces.value.IsSequence())
+    {
+      fail(faces.line, entityText, "'faces' must be a list of block.face");
+    }
+    for (const YAML::Node& face : faces.value)
+    {
+      const std::string name = text(face, faces.line, entityText, "face");
+      const std::size_t dot = name.rfind('.');
+      BlockFace blockFace;
+      if (dot != std::string::npos)
+      {
+        blockFace.block = Model.findBlock(name.substr(0, dot));
+        blockFace.face = faceFromName(name.substr(dot + 1));
+      }
+      if (blockFace.block < 0 || blockFace.face < 0)
+      {
+        fail(here(face, faces.line), entityText, "unknown face '" + name + "'");
+      }
+      patch.faces.push_back(blockFace);
+    }
+    if (const MapEntry* partner = syntax::findEntry(keys, "partner"))
+    {
+      patch.periodicPartner = text(partner->value, partner->line, entityText, "partner");
+    }
+    if (const MapEntry* axis = syntax::findEntry(keys, "axis"))
+    {
+      patch.periodicAxis = vector3(axis->value, axis->line, entityText, "axis");
+    }
+    if (const MapEntry* origin = syntax::findEntry(keys, "origin"))
+    {
+      patch.periodicAxisPoint = vector3(origin->value, origin->line, entityText, "origin");
+    }
+    if (const MapEntry* angle = syntax::findEntry(keys, "angle"))
+    {
+      patch.periodicAngle = number(angle->value, angle->line, entityText, "angle");
+    }
+    Model.patches.push_back(patch);
+  }
+
+  const std::string& Text;
+  syntax::Reporter Report;
+  BlockModel Model;
+};
+} // namespace
+
+std::string writeModelDocument(const BlockModel& model)
+{
+  YAML::Emitter out;
+  out << YAML::Comment("BlockForge block model: resolved numbers, written by BlockForge");
+  out << YAML::BeginMap;
+  out << YAML::Key << "blockforge_model" << YAML::Value << BlockModel::FormatVersion;
+  out << YAML::Key << "name" << YAML::Value << model.name;
+  out << YAML::Key << "source" << YAML::Value << model.sourceFile;
+
+  out << YAML::Key << "parameters" << YAML::Value << YAML::BeginMap;
+  for (const auto& parameter : model.parameters)
+  {
+    out << YAML::Key << parameter.first << YAML::Value << formatNumber(parameter.second);
+  }
+  out << YAML::EndMap;
+
+  out << YAML::Key << "vertices" << YAML::Value << YAML::BeginSeq;
+  for (const Vertex& vertex : model.vertices)
+  {
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << vertex.name;
+    out << YAML::Key << "position" << YAML::Value;
+    emitVector(out, vertex.position);
+    emitWhere(out, vertex.where, model);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+
+  out << YAML::Key << "edges" << YAML::Value << YAML::BeginSeq;
+  for (const Edge& edge : model.edges)
+  {
+    const std::string user = entity("edge", edge.name);
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << edge.name;
+    out << YAML::Key << "kind" << YAML::Value
+        << (edge.kind == Edge::Kind::Line ? "line"
+                                          : edge.kind == Edge::Kind::Arc ? "arc" : "spline");
+    out << YAML::Key << "from" << YAML::Value << vertexName(model, edge.from, user);
+    out << YAML::Key << "to" << YAML::Value << vertexName(model, edge.to, user);
+    if (edge.kind == Edge::Kind::Arc)
+    {
+      out << YAML::Key << (edge.arcHasCentre ? "centre" : "through") << YAML::Value;
+      emitVector(out, edge.arcHasCentre ? edge.arcCentre : edge.arcThrough);
+    }
+    if (edge.kind == Edge::Kind::Spline)
+    {
+      out << YAML::Key << "points" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      for (const Vec3& point : edge.splinePoints)
+      {
+        emitVector(out, point);
+      }
+      out << YAML::EndSeq;
+    }
+    emitWhere(out, edge.where, model);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+
+  out << YAML::Key << "blocks" << YAML::Value << YAML::BeginSeq;
+  for (const Block& block : model.blocks)
+  {
+    const std::string user = entity("block", block.name);
+    out << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << block.name;
+    out << YAML::Key << "vertices" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (int vertex : block.vertices)
+    {
+      out << vertexName(model, vertex, user);
+    }
+    out << YAML::EndSeq;
+    out << YAML::Key << "cells" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (int cells : block.cells)
+    {
+      out << cells;
+    }
+    out << YAML::EndSeq;
+    out << YAML::Key << "laws" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (const DistributionLaw& law : block.laws)
+    {
+      syntax::emitLaw(out, law);
+    }
+    out << YAML::EndSeq;
+    emitWhere(out, block.where, model);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+
+  out << YAML::Key << "patches" << YAML::Value << YAML::BeginSeq;
+  for (const Patch& patch : model.patches)
+  {
+    out << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << patch.name;
+    out << YAML::Key << "type" << YAML::Value << patch.type;
+    out << YAML::Key << "faces" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (const BlockFace& face : patch.faces)
+    {
+      if (face.block < 0 || face.block >= static_cast<int>(model.blocks.size()))
+      {
+        throw TemplateError(DocumentFile, 0, entity("patch", patch.name),
+          "refers to block #" + std::to_string(face.block) + ", which does not exist");
+      }
+      out << model.blocks[face.block].name + "." + faceName(face.face);
+    }
+    out << YAML::EndSeq;
+    if (patch.type == "periodic")
+    {
+      out << YAML::Key << "partner" << YAML::Value << patch.periodicPartner;
+      out << YAML::Key << "axis" << YAML::Value;
+      emitVector(out, patch.periodicAxis);
+      out << YAML::Key << "origin" << YAML::Value;
+      emitVector(out, patch.periodicAxisPoint);
+      out << YAML::Key << "angle" << YAML::Value << formatNumber(patch.periodicAngle);
+    }
+    emitWhere(out, patch.where, model);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+  if (!out.good())
+  {
+    throw TemplateError(DocumentFile, 0, entity("model", model.name),
+      "cannot write the model document: " + out.GetLastError());
+  }
+  return std::string(out.c_str()) + "\n";
+}
+
+BlockModel readModelDocument(const std::string& document)
+{
+  return DocumentReader(document).read();
+}
+} // namespace model
+} // namespace blockforge

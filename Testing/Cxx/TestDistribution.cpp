@@ -1,1 +1,296 @@
+// Node distribution laws along an edge (paper eq. 7 and friends).
+#include "Distribution.h"
+
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+using namespace blockforge;
+
+namespace
+{
+DistributionLaw law(DistributionLaw::Kind kind, double ratio, double firstCell = 0.0)
+{
+  DistributionLaw l;
+  l.kind = kind;
+  l.expansionRatio = ratio;
+  l.firstCellSize = firstCell;
+  return l;
+}
+
+/// Exactly n values, exact ends, strictly increasing.
+void expectValidNodes(const std::vector<double>& s, int n)
+{
+  ASSERT_EQ(static_cast<int>(s.size()), n);
+  EXPECT_EQ(s.front(), 0.0);
+  EXPECT_EQ(s.back(), 1.0);
+  for (int i = 1; i < n; ++i)
+  {
+    EXPECT_GT(s[i], s[i - 1]) << "node " << i;
+  }
+}
+
+double cell(const std::vector<double>& s, int i)
+{
+  return s[i + 1] - s[i];
+}
+} // namespace
+
+TEST(Distribution, UniformIsEquallySpaced)
+{
+  for (int n : { 2, 3, 10, 101 })
+  {
+    const auto s = distributeNodes(DistributionLaw{}, n);
+    expectValidNodes(s, n);
+    for (int i = 0; i < n; ++i)
+    {
+      EXPECT_NEAR(s[i], static_cast<double>(i) / (n - 1), 1e-16);
+    }
+  }
+}
+
+TEST(Distribution, GeometricPaperEquation7)
+{
+  for (double k : { 0.5, 0.8, 0.95, 1.0 - 1e-9, 1.0 + 1e-12, 1.05, 1.2, 2.0 })
+  {
+    for (int n : { 2, 3, 5, 11, 21 })
+    {
+      const auto s = distributeNodes(law(DistributionLaw::Kind::Geometric, k), n);
+      expectValidNodes(s, n);
+      // Eq. 7 literally (small n keeps the literal sums accurate enough to compare).
+      double denominator = 0.0;
+      for (int j = 0; j <= n - 2; ++j)
+      {
+        denominator += std::pow(k, j);
+      }
+      const double a = 1.0 / denominator;
+      double partial = 0.0;
+      for (int i = 1; i < n - 1; ++i)
+      {
+        partial += std::pow(k, i - 1);
+        EXPECT_NEAR(s[i], a * partial, 4e-16) << "k " << k << " n " << n << " i " << i;
+      }
+      for (int i = 1; i + 1 < n; ++i)
+      {
+        // Positions near 1 carry an absolute rounding of ~1e-16, which limits the relative
+        // accuracy of tiny cells there (k < 1); elsewhere the ratio is exact to 1e-12.
+        const double smaller = std::min(cell(s, i), cell(s, i - 1));
+        const double tolerance = std::max(1e-12, 4.5e-16 / smaller);
+        EXPECT_NEAR(cell(s, i) / cell(s, i - 1), k, tolerance * k)
+          << "k " << k << " n " << n << " i " << i;
+        if (smaller > 1e-3)
+        {
+          EXPECT_NEAR(cell(s, i) / cell(s, i - 1), k, 1e-12 * k);
+        }
+      }
+    }
+  }
+}
+
+TEST(Distribution, GeometricKEqualOneIsUniform)
+{
+  const auto s = distributeNodes(law(DistributionLaw::Kind::Geometric, 1.0), 17);
+  const auto u = distributeNodes(DistributionLaw{}, 17);
+  EXPECT_EQ(s, u);
+  // Close to 1 there is no cancellation: compare with the closed form
+  // s_i = (k^i - 1) / (k^m - 1) written with expm1/log1p.
+  for (double epsilon : { 1e-14, -1e-12, 1e-9, -3e-7 })
+  {
+    const double k = 1.0 + epsilon;
+    const double logK = std::log1p(k - 1.0);
+    const int m = 16;
+    const auto near = distributeNodes(law(DistributionLaw::Kind::Geometric, k), m + 1);
+    expectValidNodes(near, m + 1);
+    for (int i = 0; i <= m; ++i)
+    {
+      EXPECT_NEAR(near[i], std::expm1(i * logK) / std::expm1(m * logK), 4.5e-16) << epsilon;
+      EXPECT_NEAR(near[i], u[i], 20 * std::abs(epsilon) + 1e-16) << epsilon;
+    }
+  }
+}
+
+TEST(Distribution, GeometricReversedLaw)
+{
+  const auto forward = distributeNodes(law(DistributionLaw::Kind::Geometric, 1.3), 12);
+  const DistributionLaw reversed = reversedLaw(law(DistributionLaw::Kind::Geometric, 1.3));
+  EXPECT_EQ(reversed.kind, DistributionLaw::Kind::Geometric);
+  EXPECT_DOUBLE_EQ(reversed.expansionRatio, 1.0 / 1.3);
+  const auto backward = distributeNodes(reversed, 12);
+  for (int i = 0; i < 12; ++i)
+  {
+    EXPECT_NEAR(backward[i], 1.0 - forward[11 - i], 1e-15);
+  }
+  EXPECT_EQ(reversedLaw(law(DistributionLaw::Kind::TwoSided, 1.2)),
+    law(DistributionLaw::Kind::TwoSided, 1.2));
+  EXPECT_THROW(reversedLaw(law(DistributionLaw::Kind::FirstCell, 1.2, 0.01)), GeometryError);
+}
+
+TEST(Distribution, TwoSidedSymmetricWithRatioK)
+{
+  for (double k : { 0.7, 1.1, 1.5 })
+  {
+    for (int n : { 2, 3, 4, 9, 10, 24 })
+    {
+      const auto s = distributeNodes(law(DistributionLaw::Kind::TwoSided, k), n);
+      expectValidNodes(s, n);
+      const int m = n - 1;
+      for (int i = 0; i < n; ++i)
+      {
+        EXPECT_NEAR(s[i] + s[n - 1 - i], 1.0, 2e-16) << "k " << k << " n " << n;
+      }
+      // Cell i is proportional to k^min(i, m-1-i).
+      for (int i = 1; i < m; ++i)
+      {
+        const int e0 = std::min(i - 1, m - i), e1 = std::min(i, m - 1 - i);
+        EXPECT_NEAR(cell(s, i) / cell(s, i - 1), std::pow(k, e1 - e0), 1e-12)
+          << "k " << k << " n " << n << " i " << i;
+      }
+      if (m % 2 == 0)
+      {
+        EXPECT_EQ(s[m / 2], 0.5);
+      }
+    }
+  }
+}
+
+TEST(Distribution, FirstCellCappedGrowth)
+{
+  const double length = 2.5;
+  int feasible = 0, infeasible = 0;
+  for (double h : { 1e-4, 0.01, 0.05 })
+  {
+    for (double r : { 1.05, 1.2, 1.5 })
+    {
+      for (int n : { 20, 41, 80 })
+      {
+        const int m = n - 1;
+        double uncapped = 0.0;
+        for (int i = 0; i < m; ++i)
+        {
+          uncapped += h * std::pow(r, i);
+        }
+        if (h * m > length || uncapped < length)
+        {
+          EXPECT_THROW(distributeNodes(law(DistributionLaw::Kind::FirstCell, r, h), n, length),
+            GeometryError)
+            << h << " " << r << " " << n;
+          ++infeasible;
+          continue;
+        }
+        ++feasible;
+        const auto s = distributeNodes(law(DistributionLaw::Kind::FirstCell, r, h), n, length);
+        expectValidNodes(s, n);
+        EXPECT_NEAR(s[1] * length, h, 1e-12 * h) << h << " " << r << " " << n;
+        bool capped = false;
+        for (int i = 1; i < m; ++i)
+        {
+          const double ratio = cell(s, i) / cell(s, i - 1);
+          EXPECT_LE(ratio, r * (1 + 1e-12)) << h << " " << r << " " << n << " i " << i;
+          EXPECT_GE(ratio, 1.0 - 1e-9);
+          if (!capped && std::abs(ratio - r) > 1e-9 * r)
+          {
+            capped = true; // from here on all cells are the cap
+          }
+          else if (capped)
+          {
+            EXPECT_NEAR(ratio, 1.0, 1e-9) << h << " " << r << " " << n << " i " << i;
+          }
+          else
+          {
+            EXPECT_NEAR(ratio, r, 1e-12 * r);
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GE(feasible, 10);
+  EXPECT_GE(infeasible, 5);
+}
+
+TEST(Distribution, FirstCellKnownCap)
+{
+  // h = 0.1, r = 2, 6 cells on L = 3.1: 0.1, 0.2, 0.4, 0.8, then two caps of 0.8.
+  const auto s = distributeNodes(law(DistributionLaw::Kind::FirstCell, 2.0, 0.1), 7, 3.1);
+  const double expected[] = { 0.0, 0.1, 0.3, 0.7, 1.5, 2.3, 3.1 };
+  for (int i = 0; i < 7; ++i)
+  {
+    EXPECT_NEAR(s[i] * 3.1, expected[i], 1e-14);
+  }
+  // Cap between two growth steps: h = 1, r = 2, 4 cells on L = 10: 1, 2, c, c, c = 3.5.
+  const auto t = distributeNodes(law(DistributionLaw::Kind::FirstCell, 2.0, 1.0), 5, 10.0);
+  const double cells[] = { 1.0, 2.0, 3.5, 3.5 };
+  for (int i = 0; i < 4; ++i)
+  {
+    EXPECT_NEAR(cell(t, i) * 10.0, cells[i], 1e-14);
+  }
+}
+
+TEST(Distribution, FirstCellSolvedRatio)
+{
+  const double length = 1.7;
+  for (double h : { 1e-5, 1e-3, 0.05, 0.3 })
+  {
+    for (int n : { 3, 10, 50 })
+    {
+      const int m = n - 1;
+      if (h >= length)
+      {
+        continue;
+      }
+      const auto s = distributeNodes(law(DistributionLaw::Kind::FirstCell, 0.0, h), n, length);
+      expectValidNodes(s, n);
+      EXPECT_NEAR(s[1] * length, h, 1e-12 * h) << h << " " << n;
+      // All cells grow (or shrink) by one constant ratio.
+      const double k = cell(s, 1) / cell(s, 0);
+      EXPECT_EQ(k > 1.0, h * m < length);
+      for (int i = 2; i < m; ++i)
+      {
+        EXPECT_NEAR(cell(s, i) / cell(s, i - 1), k, 1e-9 * k) << h << " " << n << " " << i;
+      }
+    }
+  }
+  // h * cells == L: uniform.
+  const auto u = distributeNodes(law(DistributionLaw::Kind::FirstCell, 0.0, 0.25), 5, 1.0);
+  for (int i = 0; i < 5; ++i)
+  {
+    EXPECT_NEAR(u[i], 0.25 * i, 1e-15);
+  }
+}
+
+TEST(Distribution, ImpossibleLawsThrow)
+{
+  using Kind = DistributionLaw::Kind;
+  EXPECT_THROW(distributeNodes(DistributionLaw{}, 1), GeometryError);
+  EXPECT_THROW(distributeNodes(DistributionLaw{}, 0), GeometryError);
+  EXPECT_THROW(distributeNodes(law(Kind::Geometric, 0.0), 5), GeometryError);
+  EXPECT_THROW(distributeNodes(law(Kind::Geometric, -1.2), 5), GeometryError);
+  EXPECT_THROW(distributeNodes(law(Kind::Geometric, std::numeric_limits<double>::quiet_NaN()), 5),
+    GeometryError);
+  EXPECT_THROW(distributeNodes(law(Kind::TwoSided, -1.0), 5), GeometryError);
+  // Cells too small to represent.
+  EXPECT_THROW(distributeNodes(law(Kind::Geometric, 1e-30), 50), GeometryError);
+  // First cell: larger than the edge allows, too small to reach the end, bad arguments.
+  EXPECT_THROW(distributeNodes(law(Kind::FirstCell, 1.2, 0.2), 11, 1.0), GeometryError);
+  EXPECT_THROW(distributeNodes(law(Kind::FirstCell, 1.1, 1e-4), 11, 1.0), GeometryError);
+  EXPECT_THROW(distributeNodes(law(Kind::FirstCell, 1.0, 0.05), 11, 1.0), GeometryError);
+  EXPECT_THROW(distributeNodes(law(Kind::FirstCell, 0.9, 0.05), 11, 1.0), GeometryError);
+  EXPECT_THROW(distributeNodes(law(Kind::FirstCell, 1.2, 0.0), 11, 1.0), GeometryError);
+  EXPECT_THROW(distributeNodes(law(Kind::FirstCell, 1.2, 0.05), 11, 0.0), GeometryError);
+  EXPECT_THROW(distributeNodes(law(Kind::FirstCell, 0.0, 1.5), 11, 1.0), GeometryError);
+  EXPECT_THROW(distributeNodes(law(Kind::FirstCell, 1.2, 0.3), 2, 1.0), GeometryError);
+  EXPECT_NO_THROW(distributeNodes(law(Kind::FirstCell, 1.2, 1.0), 2, 1.0));
+  EXPECT_NO_THROW(distributeNodes(law(Kind::FirstCell, 1.0, 0.1), 11, 1.0)); // exactly uniform
+
+  try
+  {
+    distributeNodes(law(Kind::FirstCell, 1.2, 0.2), 11, 1.0);
+  }
+  catch (const GeometryError& e)
+  {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("first cell size"), std::string::npos) << message;
+    EXPECT_NE(message.find("edge length"), std::string::npos) << message;
+  }
+}

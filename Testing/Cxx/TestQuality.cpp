@@ -1,1 +1,448 @@
+// Cell quality measures (Filters/Core/Quality.h).
+#include "Quality.h"
+
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <map>
+#include <random>
+#include <vector>
+
+using namespace blockforge;
+
+namespace
+{
+const double degrees = 180.0 / M_PI;
+
+using Corners = std::array<Vec3, 8>;
+
+Corners unitCube()
+{
+  return { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0), Vec3(0, 0, 1),
+    Vec3(1, 0, 1), Vec3(1, 1, 1), Vec3(0, 1, 1) };
+}
+
+/// Unit cube whose top face is shifted by tan(angle) along x.
+Corners shearedCube(double angle)
+{
+  Corners c = unitCube();
+  for (int v = 4; v < 8; ++v)
+  {
+    c[v].x() += std::tan(angle);
+  }
+  return c;
+}
+
+/// Nodes of a structured block from a function of the node indices.
+struct Grid
+{
+  int ni, nj, nk;
+  std::vector<double> xyz;
+  StructuredBlock block() const { return { xyz.data(), ni, nj, nk }; }
+  Vec3 node(int i, int j, int k) const
+  {
+    const long n = i + static_cast<long>(ni) * (j + static_cast<long>(nj) * k);
+    return Vec3(xyz[3 * n], xyz[3 * n + 1], xyz[3 * n + 2]);
+  }
+};
+
+Grid makeGrid(int ni, int nj, int nk, const std::function<Vec3(int, int, int)>& at)
+{
+  Grid g{ ni, nj, nk, {} };
+  for (int k = 0; k < nk; ++k)
+  {
+    for (int j = 0; j < nj; ++j)
+    {
+      for (int i = 0; i < ni; ++i)
+      {
+        const Vec3 p = at(i, j, k);
+        g.xyz.insert(g.xyz.end(), { p.x(), p.y(), p.z() });
+      }
+    }
+  }
+  return g;
+}
+
+Corners cellCorners(const Grid& g, int i, int j, int k)
+{
+  return { g.node(i, j, k), g.node(i + 1, j, k), g.node(i + 1, j + 1, k), g.node(i, j + 1, k),
+    g.node(i, j, k + 1), g.node(i + 1, j, k + 1), g.node(i + 1, j + 1, k + 1),
+    g.node(i, j + 1, k + 1) };
+}
+
+/// Two cells side by side along x: a unit cube and a cell whose far face (x = 2) is
+/// shifted by `shift` along y. Analytic values of the shared face x = 1:
+/// non-orthogonality atan(shift / 2), checkMesh skewness shift / 2 (|sv| = shift / 4,
+/// normalised by the half-width 0.5 of the face).
+Vec3 twoCellNode(int i, int j, int k, double shift)
+{
+  return Vec3(i, j + (i == 2 ? shift : 0.0), k);
+}
+} // namespace
+
+TEST(Quality, UnitCube)
+{
+  const Corners cube = unitCube();
+  double minAngle, maxAngle;
+  hexFaceAngles(cube, minAngle, maxAngle);
+  EXPECT_DOUBLE_EQ(minAngle, 90.0);
+  EXPECT_DOUBLE_EQ(maxAngle, 90.0);
+  EXPECT_DOUBLE_EQ(hexScaledJacobian(cube), 1.0);
+  EXPECT_DOUBLE_EQ(hexAspectRatio(cube), 1.0);
+  EXPECT_TRUE(hexCentre(cube).isApprox(Vec3(0.5, 0.5, 0.5)));
+
+  const Grid g = makeGrid(2, 2, 2, [](int i, int j, int k) { return Vec3(i, j, k); });
+  const auto q = computeGridQuality({ g.block() });
+  ASSERT_EQ(q.size(), 1u);
+  ASSERT_EQ(q[0].minAngle.size(), 1u);
+  EXPECT_DOUBLE_EQ(q[0].minAngle[0], 90.0);
+  EXPECT_DOUBLE_EQ(q[0].maxAngle[0], 90.0);
+  EXPECT_DOUBLE_EQ(q[0].nonOrthogonality[0], 0.0);
+  EXPECT_DOUBLE_EQ(q[0].skewness[0], 0.0);
+  EXPECT_DOUBLE_EQ(q[0].aspectRatio[0], 1.0);
+  EXPECT_DOUBLE_EQ(q[0].scaledJacobian[0], 1.0);
+}
+
+TEST(Quality, CartesianGridIsPerfect)
+{
+  const Grid g = makeGrid(5, 4, 3, [](int i, int j, int k) { return Vec3(0.5 * i, 0.25 * j, 2.0 * k); });
+  const auto q = computeGridQuality({ g.block() });
+  ASSERT_EQ(q[0].nonOrthogonality.size(), 4u * 3u * 2u);
+  for (std::size_t c = 0; c < q[0].nonOrthogonality.size(); ++c)
+  {
+    EXPECT_NEAR(q[0].nonOrthogonality[c], 0.0, 1e-6);
+    EXPECT_NEAR(q[0].skewness[c], 0.0, 1e-14);
+    EXPECT_NEAR(q[0].minAngle[c], 90.0, 1e-12);
+    EXPECT_NEAR(q[0].aspectRatio[c], 8.0, 1e-14);
+    EXPECT_NEAR(q[0].scaledJacobian[c], 1.0, 1e-15);
+  }
+}
+
+TEST(Quality, ShearedCell)
+{
+  const double shear = 30.0 / degrees;
+  const Corners cell = shearedCube(shear);
+  double minAngle, maxAngle;
+  hexFaceAngles(cell, minAngle, maxAngle);
+  EXPECT_NEAR(minAngle, 60.0, 1e-12);
+  EXPECT_NEAR(maxAngle, 120.0, 1e-12);
+  EXPECT_NEAR(hexScaledJacobian(cell), std::cos(shear), 1e-15);
+  EXPECT_NEAR(hexAspectRatio(cell), 1.0 / std::cos(shear), 1e-15);
+}
+
+TEST(Quality, ShearedCellsNonOrthogonalityInBothDirections)
+{
+  // Cells sheared by 30 deg (x grows with k). Neighbours along x share a face whose
+  // normal is tilted by 30 deg from the centre line; neighbours along z share a
+  // horizontal face while the centre line is tilted by 30 deg.
+  const double a = std::tan(30.0 / degrees);
+  const Grid alongX = makeGrid(3, 2, 2, [a](int i, int j, int k) { return Vec3(i + a * k, j, k); });
+  const Grid alongZ = makeGrid(2, 2, 3, [a](int i, int j, int k) { return Vec3(i + a * k, j, k); });
+  for (const Grid* g : { &alongX, &alongZ })
+  {
+    const auto q = computeGridQuality({ g->block() });
+    ASSERT_EQ(q[0].nonOrthogonality.size(), 2u);
+    for (int c = 0; c < 2; ++c)
+    {
+      EXPECT_NEAR(q[0].nonOrthogonality[c], 30.0, 1e-12);
+      EXPECT_NEAR(q[0].minAngle[c], 60.0, 1e-12);
+      EXPECT_NEAR(q[0].maxAngle[c], 120.0, 1e-12);
+      EXPECT_NEAR(q[0].scaledJacobian[c], std::cos(30.0 / degrees), 1e-15);
+    }
+  }
+}
+
+TEST(Quality, NonOrthogonalityAndSkewnessAcrossBlockInterface)
+{
+  const double shift = 0.4;
+  const double expectedAngle = std::atan(shift / 2) * degrees;
+  const Grid single = makeGrid(3, 2, 2, [=](int i, int j, int k) { return twoCellNode(i, j, k, shift); });
+  const Grid left = makeGrid(2, 2, 2, [=](int i, int j, int k) { return twoCellNode(i, j, k, shift); });
+  const Grid right = makeGrid(2, 2, 2, [=](int i, int j, int k) { return twoCellNode(i + 1, j, k, shift); });
+
+  const auto one = computeGridQuality({ single.block() });
+  const auto two = computeGridQuality({ left.block(), right.block() });
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_NEAR(one[0].nonOrthogonality[0], expectedAngle, 1e-12);
+  EXPECT_NEAR(one[0].nonOrthogonality[1], expectedAngle, 1e-12);
+  EXPECT_NEAR(two[0].nonOrthogonality[0], expectedAngle, 1e-12);
+  EXPECT_NEAR(two[1].nonOrthogonality[0], expectedAngle, 1e-12);
+  // The cube's only skewed face is the shared one.
+  EXPECT_NEAR(one[0].skewness[0], shift / 2, 1e-14);
+  EXPECT_NEAR(two[0].skewness[0], shift / 2, 1e-14);
+  // The interface is measured exactly like the interior.
+  EXPECT_NEAR(two[1].skewness[0], one[0].skewness[1], 1e-14);
+  // The far face of the second cell is a boundary face: |sv| = shift / 2 over 0.5.
+  EXPECT_NEAR(one[0].skewness[1], std::max(shift / 2 / 0.5, shift / 2), 1e-14);
+
+  // Interfaces match bit for bit only: a face one ulp away is a boundary.
+  Grid moved = right;
+  moved.xyz[0] = std::nextafter(moved.xyz[0], 10.0);
+  const auto apart = computeGridQuality({ left.block(), moved.block() });
+  EXPECT_EQ(apart[0].nonOrthogonality[0], 0.0);
+  EXPECT_NEAR(apart[0].skewness[0], 0.0, 1e-14);
+}
+
+TEST(Quality, FaceFunctions)
+{
+  Vec3 area, centre;
+  quadAreaAndCentre(Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(3, 2, 0), Vec3(1, 2, 0), area, centre);
+  EXPECT_TRUE(area.isApprox(Vec3(0, 0, 6)));
+  // Trapezoid centroid: y = h (a + 2b) / (3 (a + b)) with a = 4, b = 2, h = 2.
+  EXPECT_NEAR(centre.x(), 2.0, 1e-15);
+  EXPECT_NEAR(centre.y(), 16.0 / 18.0, 1e-15);
+  EXPECT_NEAR(centre.z(), 0.0, 1e-15);
+
+  EXPECT_NEAR(faceNonOrthogonality(Vec3(0, 0, 0), Vec3(1, 1, 0), Vec3(2, 0, 0)), 45.0, 1e-12);
+  EXPECT_NEAR(faceNonOrthogonality(Vec3(0, 0, 0), Vec3(-1, 0, 0), Vec3(2, 0, 0)), 180.0, 1e-12);
+  EXPECT_NEAR(faceNonOrthogonality(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0)), 0.0, 1e-12);
+
+  // The shared face of the two-cell configuration, shift 0.4.
+  const Vec3 owner(0.5, 0.5, 0.5), neighbour(1.5, 0.7, 0.5);
+  const Vec3 faceArea(1, 0, 0), faceCentre(1, 0.5, 0.5);
+  const std::array<Vec3, 4> face = { Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(1, 1, 1), Vec3(1, 0, 1) };
+  EXPECT_NEAR(faceSkewness(owner, neighbour, faceArea, faceCentre), 0.1 / std::hypot(1.0, 0.2), 1e-15);
+  EXPECT_NEAR(faceSkewness(owner, neighbour, faceArea, faceCentre, face), 0.2, 1e-15);
+
+  // Boundary face x = 2 of the shifted cell: tangential offset 0.2, normal distance 0.5.
+  const Vec3 shiftedOwner(1.5, 0.7, 0.5), boundaryCentre(2, 0.9, 0.5);
+  const std::array<Vec3, 4> boundary = { Vec3(2, 0.4, 0), Vec3(2, 1.4, 0), Vec3(2, 1.4, 1),
+    Vec3(2, 0.4, 1) };
+  EXPECT_NEAR(boundaryFaceSkewness(shiftedOwner, faceArea, boundaryCentre), 0.2 / 1.0, 1e-15);
+  EXPECT_NEAR(boundaryFaceSkewness(shiftedOwner, faceArea, boundaryCentre, boundary), 0.4, 1e-15);
+}
+
+TEST(Quality, InvertedCellsHaveNegativeScaledJacobian)
+{
+  Corners mirrored = unitCube();
+  for (Vec3& p : mirrored)
+  {
+    p.z() = -p.z();
+  }
+  EXPECT_DOUBLE_EQ(hexScaledJacobian(mirrored), -1.0);
+
+  Corners tangled = unitCube();
+  tangled[4] = Vec3(0, 0, -0.5); // corner pushed through the opposite face
+  EXPECT_LT(hexScaledJacobian(tangled), 0.0);
+
+  // In a grid, the inverted cell's faces point backwards: non-orthogonality > 90.
+  const Grid folded = makeGrid(3, 2, 2, [](int i, int j, int k) {
+    return Vec3(i == 2 ? -0.5 : i, j, k);
+  });
+  const auto q = computeGridQuality({ folded.block() });
+  EXPECT_LT(q[0].scaledJacobian[1], 0.0);
+  EXPECT_GT(q[0].nonOrthogonality[1], 90.0);
+}
+
+TEST(Quality, CollapsedCells)
+{
+  // Prism: edges V0-V3 and V4-V7 collapsed. Bottom/top are right isosceles triangles
+  // (45, 90, 45), the other faces rectangles; the face s = 0 is a segment (skipped).
+  Corners prism = unitCube();
+  prism[3] = prism[0];
+  prism[7] = prism[4];
+  double minAngle, maxAngle;
+  hexFaceAngles(prism, minAngle, maxAngle);
+  EXPECT_NEAR(minAngle, 45.0, 1e-12);
+  EXPECT_NEAR(maxAngle, 90.0, 1e-12);
+  EXPECT_EQ(hexScaledJacobian(prism), 1e30); // vtkMeshQuality's value
+  // Mean widths: (1 + sqrt 2) / 2 along s, 0.5 along t (two collapsed edges), 1 along u.
+  EXPECT_NEAR(hexAspectRatio(prism), 1.0 + std::sqrt(2.0), 1e-14);
+
+  // Nearly collapsed (1e-15 of the cell size) counts as collapsed for angles too.
+  Corners almost = prism;
+  almost[3] += Vec3(1e-15, 0, 0);
+  hexFaceAngles(almost, minAngle, maxAngle);
+  EXPECT_NEAR(minAngle, 45.0, 1e-9);
+
+  Corners point;
+  point.fill(Vec3(1, 2, 3));
+  hexFaceAngles(point, minAngle, maxAngle);
+  EXPECT_EQ(minAngle, 0.0);
+  EXPECT_EQ(maxAngle, 180.0);
+  EXPECT_EQ(hexAspectRatio(point), 1e30);
+  EXPECT_EQ(hexScaledJacobian(point), 1e30);
+
+  // A grid whose i = 0 face is collapsed onto a line gives no NaN anywhere.
+  const Grid wedge = makeGrid(4, 3, 3, [](int i, int j, int k) { return Vec3(i, i * (j - 1.0), k); });
+  const auto q = computeGridQuality({ wedge.block() });
+  for (const auto* values : { &q[0].minAngle, &q[0].maxAngle, &q[0].nonOrthogonality,
+         &q[0].skewness, &q[0].aspectRatio, &q[0].scaledJacobian })
+  {
+    for (double v : *values)
+    {
+      EXPECT_FALSE(std::isnan(v));
+    }
+  }
+}
+
+TEST(Quality, GridPassMatchesCellAndFaceFunctions)
+{
+  // Randomly perturbed two-block grid: every cell value from computeGridQuality must equal
+  // a plain evaluation with the public per-cell and per-face functions.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> jitter(-0.2, 0.2);
+  const int ni = 6, nj = 5, nk = 4;
+  std::vector<Vec3> offsets(2 * ni * nj * nk);
+  for (Vec3& o : offsets)
+  {
+    o = Vec3(jitter(random), jitter(random), jitter(random));
+  }
+  auto at = [&](int i, int j, int k) {
+    // Global i in [0, 2 ni - 2]; node i = ni - 1 is shared by both blocks.
+    const bool boundaryNode = i == 0 || i == 2 * ni - 2 || j == 0 || j == nj - 1 || k == 0 ||
+      k == nk - 1;
+    const Vec3 o = boundaryNode ? Vec3::Zero() : offsets[i + 2 * ni * (j + nj * k)];
+    return Vec3(i * 0.7, j * 1.1 + 0.1 * i * i, k * 0.9 + 0.05 * j * i) + o;
+  };
+  const Grid a = makeGrid(ni, nj, nk, at);
+  const Grid b = makeGrid(ni, nj, nk, [&](int i, int j, int k) { return at(i + ni - 1, j, k); });
+  const Grid whole = makeGrid(2 * ni - 1, nj, nk, at);
+  const auto split = computeGridQuality({ a.block(), b.block() });
+  const auto joined = computeGridQuality({ whole.block() });
+
+  const int ci = 2 * ni - 2, cj = nj - 1, ck = nk - 1;
+  auto centre = [&](int i, int j, int k) { return hexCentre(cellCorners(whole, i, j, k)); };
+  for (int k = 0; k < ck; ++k)
+  {
+    for (int j = 0; j < cj; ++j)
+    {
+      for (int i = 0; i < ci; ++i)
+      {
+        const Corners c = cellCorners(whole, i, j, k);
+        double minAngle, maxAngle;
+        hexFaceAngles(c, minAngle, maxAngle);
+        double nonOrth = 0.0, skew = 0.0;
+        // Faces with area vectors along +i, +j, +k; owner is the lower cell.
+        const int step[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+        for (int d = 0; d < 3; ++d)
+        {
+          for (int upper = 0; upper < 2; ++upper)
+          {
+            const int fi = i + upper * step[d][0], fj = j + upper * step[d][1],
+                      fk = k + upper * step[d][2];
+            std::array<Vec3, 4> q;
+            if (d == 0)
+              q = { whole.node(fi, fj, fk), whole.node(fi, fj + 1, fk),
+                whole.node(fi, fj + 1, fk + 1), whole.node(fi, fj, fk + 1) };
+            else if (d == 1)
+              q = { whole.node(fi, fj, fk), whole.node(fi, fj, fk + 1),
+                whole.node(fi + 1, fj, fk + 1), whole.node(fi + 1, fj, fk) };
+            else
+              q = { whole.node(fi, fj, fk), whole.node(fi + 1, fj, fk),
+                whole.node(fi + 1, fj + 1, fk), whole.node(fi, fj + 1, fk) };
+            Vec3 area, faceCentre;
+            quadAreaAndCentre(q[0], q[1], q[2], q[3], area, faceCentre);
+            const int other[3] = { i + (upper ? 1 : -1) * step[d][0],
+              j + (upper ? 1 : -1) * step[d][1], k + (upper ? 1 : -1) * step[d][2] };
+            const int extent[3] = { ci, cj, ck };
+            const bool internal = other[d] >= 0 && other[d] < extent[d];
+            const Vec3 own = centre(i, j, k);
+            const Vec3 outward = upper ? area : Vec3(-area);
+            if (internal)
+            {
+              const Vec3 nei = centre(other[0], other[1], other[2]);
+              nonOrth = std::max(nonOrth, faceNonOrthogonality(own, nei, outward));
+              skew = std::max(skew, faceSkewness(own, nei, outward, faceCentre, q));
+            }
+            else
+            {
+              skew = std::max(skew, boundaryFaceSkewness(own, outward, faceCentre, q));
+            }
+          }
+        }
+        const long wholeCell = i + ci * (j + cj * k);
+        const int block = i < ni - 1 ? 0 : 1;
+        const long splitCell = (i - block * (ni - 1)) + (ni - 1) * (j + cj * k);
+        for (const auto* q : { &joined[0], &split[block] })
+        {
+          const long cell = q == &joined[0] ? wholeCell : splitCell;
+          EXPECT_NEAR(q->minAngle[cell], minAngle, 1e-12);
+          EXPECT_NEAR(q->maxAngle[cell], maxAngle, 1e-12);
+          EXPECT_NEAR(q->scaledJacobian[cell], hexScaledJacobian(c), 1e-14);
+          EXPECT_NEAR(q->aspectRatio[cell], hexAspectRatio(c), 1e-14);
+          EXPECT_NEAR(q->nonOrthogonality[cell], nonOrth, 1e-9) << i << " " << j << " " << k;
+          EXPECT_NEAR(q->skewness[cell], skew, 1e-12) << i << " " << j << " " << k;
+        }
+      }
+    }
+  }
+}
+
+TEST(Quality, OGridSeamIsAnInternalFace)
+{
+  // Full ring with uneven angular spacing; node i = n repeats node i = 0 bit for bit.
+  // Moving the seam by m cells must not change any cell's values.
+  const int n = 24, nr = 4;
+  std::vector<double> angles(n);
+  for (int i = 0; i < n; ++i)
+  {
+    angles[i] = 2 * M_PI * (i + 0.3 * std::sin(2 * M_PI * i / n)) / n;
+  }
+  auto ringNode = [&](int i, int j, int k) {
+    const double r = 1.0 + 0.4 * j + 0.05 * j * j;
+    const double theta = angles[((i % n) + n) % n];
+    return Vec3(r * std::cos(theta), r * std::sin(theta), 0.3 * k);
+  };
+  const int m = 7;
+  const Grid original = makeGrid(n + 1, nr, 2, ringNode);
+  const Grid rotated = makeGrid(n + 1, nr, 2, [&](int i, int j, int k) { return ringNode(i + m, j, k); });
+  const auto q0 = computeGridQuality({ original.block() });
+  const auto q1 = computeGridQuality({ rotated.block() });
+  bool anySkew = false;
+  for (int j = 0; j < nr - 1; ++j)
+  {
+    for (int i = 0; i < n; ++i)
+    {
+      const long c0 = (i + m) % n + n * j;
+      const long c1 = i + n * j;
+      EXPECT_NEAR(q0[0].nonOrthogonality[c0], q1[0].nonOrthogonality[c1], 1e-9) << i << " " << j;
+      EXPECT_NEAR(q0[0].skewness[c0], q1[0].skewness[c1], 1e-12) << i << " " << j;
+      EXPECT_NEAR(q0[0].minAngle[c0], q1[0].minAngle[c1], 1e-12);
+      anySkew |= q0[0].nonOrthogonality[c0] > 0.1;
+    }
+  }
+  EXPECT_TRUE(anySkew); // the test would be vacuous on a perfectly orthogonal ring
+}
+
+TEST(Quality, MinAngleClasses)
+{
+  CellQualityArrays a, b;
+  a.minAngle = { 5.0, 19.999, 20.0, 45.0 };
+  b.minAngle = { 60.0, 79.9, 80.0, 90.0, 0.0 };
+  const auto classes = minAngleClasses({ a, b });
+  EXPECT_EQ(classes, (std::array<long long, 5>{ 3, 1, 1, 2, 2 }));
+
+  // Sheared grid: 2 cells with MinAngle 60 and a cube: 90.
+  const double t = std::tan(30.0 / degrees);
+  const Grid sheared = makeGrid(3, 2, 2, [t](int i, int j, int k) { return Vec3(i + t * k, j, k); });
+  const Grid cube = makeGrid(2, 2, 2, [](int i, int j, int k) { return Vec3(i + 5, j, k); });
+  const auto gridClasses = minAngleClasses(computeGridQuality({ sheared.block(), cube.block() }));
+  EXPECT_EQ(gridClasses, (std::array<long long, 5>{ 0, 0, 0, 2, 1 }));
+}
+
+TEST(Quality, ProgressIsReportedAFewTimes)
+{
+  const Grid g = makeGrid(40, 30, 50, [](int i, int j, int k) { return Vec3(i, j, k); });
+  const Grid h = makeGrid(40, 30, 50, [](int i, int j, int k) { return Vec3(i + 39, j, k); });
+  std::vector<double> reports;
+  computeGridQuality({ g.block(), h.block() }, [&](double f) { reports.push_back(f); });
+  ASSERT_GE(reports.size(), 3u);
+  EXPECT_LE(reports.size(), 40u);
+  EXPECT_EQ(reports.front(), 0.0);
+  EXPECT_EQ(reports.back(), 1.0);
+  for (std::size_t n = 1; n < reports.size(); ++n)
+  {
+    EXPECT_GE(reports[n], reports[n - 1]);
+  }
+}
+
+TEST(Quality, EmptyAndFlatBlocks)
+{
+  const Grid flat = makeGrid(3, 3, 1, [](int i, int j, int) { return Vec3(i, j, 0); });
+  const auto q = computeGridQuality({ flat.block() });
+  ASSERT_EQ(q.size(), 1u);
+  EXPECT_TRUE(q[0].minAngle.empty());
+  EXPECT_TRUE(computeGridQuality({}).empty());
+}

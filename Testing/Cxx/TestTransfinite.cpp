@@ -1,1 +1,429 @@
+// Transfinite interpolation of faces and blocks (Filters/Core/Transfinite.h).
+#include "Quality.h"
+#include "Transfinite.h"
+
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <vector>
+
+using namespace blockforge;
+
+namespace
+{
+using PointMap = std::function<Vec3(double, double, double)>;
+
+struct Edge
+{
+  std::vector<double> xyz;
+  std::vector<double> params;
+  EdgeNodes nodes() const { return { xyz.data(), params.data(), static_cast<int>(params.size()) }; }
+};
+
+/// Geometric distribution with ratio r between successive cells (paper eq. 7).
+std::vector<double> graded(int count, double ratio)
+{
+  std::vector<double> p(count);
+  double total = 0.0, cell = 1.0;
+  for (int n = 1; n < count; ++n)
+  {
+    total += cell;
+    cell *= ratio;
+  }
+  double position = 0.0;
+  cell = 1.0;
+  for (int n = 0; n < count; ++n)
+  {
+    p[n] = position / total;
+    position += cell;
+    cell *= ratio;
+  }
+  p[count - 1] = 1.0;
+  return p;
+}
+
+Vec3 node(const std::vector<double>& xyz, long index)
+{
+  return Vec3(xyz[3 * index], xyz[3 * index + 1], xyz[3 * index + 2]);
+}
+
+/// Edge of the unit parameter cube from `from` to `to` (one coordinate varying), mapped.
+Edge makeEdge(const PointMap& map, const Vec3& from, const Vec3& to, const std::vector<double>& params)
+{
+  Edge e;
+  e.params = params;
+  for (double p : params)
+  {
+    const Vec3 q = from + p * (to - from);
+    const Vec3 x = map(q.x(), q.y(), q.z());
+    e.xyz.insert(e.xyz.end(), { x.x(), x.y(), x.z() });
+  }
+  return e;
+}
+
+/// Block boundary built like the mesher does: 12 edges, 6 faces by transfiniteFace.
+struct TestBlock
+{
+  int ni, nj, nk;
+  std::array<Edge, 12> edges;
+  std::array<std::vector<double>, 6> faces;
+  std::vector<double> nodes;
+
+  BlockBoundary boundary() const
+  {
+    BlockBoundary b;
+    for (int f = 0; f < 6; ++f)
+    {
+      b.faces[f] = faces[f].data();
+    }
+    for (int e = 0; e < 12; ++e)
+    {
+      b.edgeParams[e] = edges[e].params.data();
+    }
+    return b;
+  }
+};
+
+/// Edge parameters per edge (block notation of Transfinite.h) and the map of the unit
+/// parameter cube; edges are the images of the cube's edges.
+TestBlock buildBlock(const PointMap& map, const std::array<std::vector<double>, 12>& params)
+{
+  TestBlock b;
+  b.ni = static_cast<int>(params[0].size());
+  b.nj = static_cast<int>(params[3].size());
+  b.nk = static_cast<int>(params[8].size());
+  const Vec3 V[8] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { 0, 0, 1 },
+    { 1, 0, 1 }, { 1, 1, 1 }, { 0, 1, 1 } };
+  const int ends[12][2] = { { 0, 1 }, { 1, 2 }, { 3, 2 }, { 0, 3 }, { 4, 5 }, { 5, 6 },
+    { 7, 6 }, { 4, 7 }, { 0, 4 }, { 1, 5 }, { 2, 6 }, { 3, 7 } };
+  for (int e = 0; e < 12; ++e)
+  {
+    b.edges[e] = makeEdge(map, V[ends[e][0]], V[ends[e][1]], params[e]);
+  }
+  // (bottom, top, left, right) per face.
+  const int faceEdges[6][4] = { { 3, 7, 8, 11 }, { 1, 5, 9, 10 }, { 0, 4, 8, 9 },
+    { 2, 6, 11, 10 }, { 0, 2, 3, 1 }, { 4, 6, 7, 5 } };
+  for (int f = 0; f < 6; ++f)
+  {
+    const auto& fe = faceEdges[f];
+    b.faces[f].resize(3 * params[fe[0]].size() * params[fe[2]].size());
+    transfiniteFace(b.edges[fe[0]].nodes(), b.edges[fe[1]].nodes(), b.edges[fe[2]].nodes(),
+      b.edges[fe[3]].nodes(), b.faces[f].data());
+  }
+  b.nodes.resize(3L * b.ni * b.nj * b.nk);
+  transfiniteBlock(b.boundary(), b.ni, b.nj, b.nk, b.nodes.data());
+  return b;
+}
+
+std::array<std::vector<double>, 12> separableParams(
+  const std::vector<double>& s, const std::vector<double>& t, const std::vector<double>& u)
+{
+  return { s, t, s, t, s, t, s, t, u, u, u, u };
+}
+
+PointMap affineMap()
+{
+  Eigen::Matrix3d A;
+  A << 2.0, 0.3, -0.4, 0.1, 1.5, 0.25, -0.2, 0.35, 3.0;
+  const Vec3 offset(1.25, -0.5, 2.0);
+  return [A, offset](double s, double t, double u) { return Vec3(A * Vec3(s, t, u) + offset); };
+}
+
+long index3(const TestBlock& b, int i, int j, int k)
+{
+  return i + static_cast<long>(b.ni) * (j + static_cast<long>(b.nj) * k);
+}
+
+/// Every node of the block equals the face node it comes from, bit for bit.
+void expectBoundaryCopied(const TestBlock& b)
+{
+  auto same = [&](long blockIndex, const std::vector<double>& face, long faceIndex) {
+    return std::memcmp(&b.nodes[3 * blockIndex], &face[3 * faceIndex], 3 * sizeof(double)) == 0;
+  };
+  for (int k = 0; k < b.nk; ++k)
+  {
+    for (int j = 0; j < b.nj; ++j)
+    {
+      EXPECT_TRUE(same(index3(b, 0, j, k), b.faces[0], j + b.nj * k)) << j << " " << k;
+      EXPECT_TRUE(same(index3(b, b.ni - 1, j, k), b.faces[1], j + b.nj * k)) << j << " " << k;
+    }
+    for (int i = 0; i < b.ni; ++i)
+    {
+      EXPECT_TRUE(same(index3(b, i, 0, k), b.faces[2], i + b.ni * k)) << i << " " << k;
+      EXPECT_TRUE(same(index3(b, i, b.nj - 1, k), b.faces[3], i + b.ni * k)) << i << " " << k;
+    }
+  }
+  for (int j = 0; j < b.nj; ++j)
+  {
+    for (int i = 0; i < b.ni; ++i)
+    {
+      EXPECT_TRUE(same(index3(b, i, j, 0), b.faces[4], i + b.ni * j)) << i << " " << j;
+      EXPECT_TRUE(same(index3(b, i, j, b.nk - 1), b.faces[5], i + b.ni * j)) << i << " " << j;
+    }
+  }
+}
+
+std::vector<StructuredBlock> asGrid(const TestBlock& b)
+{
+  return { StructuredBlock{ b.nodes.data(), b.ni, b.nj, b.nk } };
+}
+} // namespace
+
+TEST(TransfiniteFace, ReproducesAffineMapWithDifferentParametersOnOppositeEdges)
+{
+  const PointMap map = affineMap();
+  const std::vector<double> sBottom = graded(9, 1.3), sTop = graded(9, 0.8);
+  const std::vector<double> tLeft = graded(6, 1.5), tRight = graded(6, 1.0);
+  const Edge bottom = makeEdge(map, { 0, 0, 0 }, { 1, 0, 0 }, sBottom);
+  const Edge top = makeEdge(map, { 0, 1, 0 }, { 1, 1, 0 }, sTop);
+  const Edge left = makeEdge(map, { 0, 0, 0 }, { 0, 1, 0 }, tLeft);
+  const Edge right = makeEdge(map, { 1, 0, 0 }, { 1, 1, 0 }, tRight);
+  std::vector<double> face(3 * 9 * 6);
+  transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), face.data());
+
+  // Edges are copied bit for bit.
+  for (int i = 0; i < 9; ++i)
+  {
+    EXPECT_EQ(0, std::memcmp(&face[3 * i], &bottom.xyz[3 * i], 3 * sizeof(double)));
+    EXPECT_EQ(0, std::memcmp(&face[3 * (i + 9 * 5)], &top.xyz[3 * i], 3 * sizeof(double)));
+  }
+  for (int j = 0; j < 6; ++j)
+  {
+    EXPECT_EQ(0, std::memcmp(&face[3 * (9 * j)], &left.xyz[3 * j], 3 * sizeof(double)));
+    EXPECT_EQ(0, std::memcmp(&face[3 * (8 + 9 * j)], &right.xyz[3 * j], 3 * sizeof(double)));
+  }
+  // Interior: the intersection of the lines joining matching edge parameters, so for an
+  // affine map each node is the image of that (s, t) and lies on both lines.
+  for (int j = 1; j < 5; ++j)
+  {
+    for (int i = 1; i < 8; ++i)
+    {
+      const double ds = sTop[i] - sBottom[i], dt = tRight[j] - tLeft[j];
+      const double s = (sBottom[i] + tLeft[j] * ds) / (1 - ds * dt);
+      const double t = (tLeft[j] + sBottom[i] * dt) / (1 - dt * ds);
+      const Vec3 x = node(face, i + 9 * j);
+      EXPECT_LT((x - map(s, t, 0)).norm(), 1e-12) << i << " " << j;
+      const Vec3 B = node(bottom.xyz, i), T = node(top.xyz, i);
+      const Vec3 L = node(left.xyz, j), R = node(right.xyz, j);
+      EXPECT_LT((x - B).cross(T - B).norm(), 1e-12);
+      EXPECT_LT((x - L).cross(R - L).norm(), 1e-12);
+    }
+  }
+}
+
+TEST(TransfiniteFace, RejectsMismatchedEdges)
+{
+  const PointMap map = affineMap();
+  const Edge bottom = makeEdge(map, { 0, 0, 0 }, { 1, 0, 0 }, graded(5, 1.0));
+  const Edge top = makeEdge(map, { 0, 1, 0 }, { 1, 1, 0 }, graded(6, 1.0));
+  const Edge side = makeEdge(map, { 0, 0, 0 }, { 0, 1, 0 }, graded(4, 1.0));
+  std::vector<double> face(3 * 6 * 4);
+  EXPECT_THROW(transfiniteFace(bottom.nodes(), top.nodes(), side.nodes(), side.nodes(), face.data()),
+    GeometryError);
+}
+
+TEST(TransfiniteBlock, ReproducesAffineMapWithGradedSeparableParameters)
+{
+  const PointMap map = affineMap();
+  const std::vector<double> s = graded(11, 1.2), t = graded(8, 0.85), u = graded(7, 1.5);
+  const TestBlock b = buildBlock(map, separableParams(s, t, u));
+  for (int k = 0; k < b.nk; ++k)
+  {
+    for (int j = 0; j < b.nj; ++j)
+    {
+      for (int i = 0; i < b.ni; ++i)
+      {
+        EXPECT_LT((node(b.nodes, index3(b, i, j, k)) - map(s[i], t[j], u[k])).norm(), 1e-12)
+          << i << " " << j << " " << k;
+      }
+    }
+  }
+  expectBoundaryCopied(b);
+}
+
+TEST(TransfiniteBlock, CoupledParametersReproduceAffineMapWhenOneDirectionVaries)
+{
+  // Parallel s-edges with four different distributions (the coupled path), t- and
+  // u-edges shared: TFI is then still exact for an affine map, each node being the
+  // image of the bilinear blend of the s-edge parameters.
+  const PointMap map = affineMap();
+  const std::vector<double> t = graded(7, 1.1), u = graded(6, 0.9);
+  std::array<std::vector<double>, 12> p = separableParams(graded(9, 1.0), t, u);
+  p[2] = graded(9, 1.3);
+  p[4] = graded(9, 0.7);
+  p[6] = graded(9, 1.6);
+  const TestBlock b = buildBlock(map, p);
+  for (int k = 0; k < b.nk; ++k)
+  {
+    for (int j = 0; j < b.nj; ++j)
+    {
+      for (int i = 0; i < b.ni; ++i)
+      {
+        const double s = (1 - t[j]) * (1 - u[k]) * p[0][i] + t[j] * (1 - u[k]) * p[2][i] +
+          (1 - t[j]) * u[k] * p[4][i] + t[j] * u[k] * p[6][i];
+        EXPECT_LT((node(b.nodes, index3(b, i, j, k)) - map(s, t[j], u[k])).norm(), 1e-12)
+          << i << " " << j << " " << k;
+      }
+    }
+  }
+  expectBoundaryCopied(b);
+}
+
+TEST(TransfiniteBlock, CoupledPathAgreesWithSeparablePathInTheLimit)
+{
+  const PointMap map = [](double s, double t, double u) {
+    return Vec3(s + 0.2 * std::sin(3 * t), t + 0.1 * s * u, u + 0.3 * s * s);
+  };
+  const std::vector<double> s = graded(8, 1.2), t = graded(9, 0.9), u = graded(6, 1.1);
+  const TestBlock separable = buildBlock(map, separableParams(s, t, u));
+  std::array<std::vector<double>, 12> p = separableParams(s, t, u);
+  for (int n = 1; n < 5; ++n)
+  {
+    p[6][n] += 1e-10; // different arrays: forces the coupled path
+  }
+  const TestBlock coupled = buildBlock(map, p);
+  double largest = 0.0;
+  for (std::size_t n = 0; n < separable.nodes.size(); ++n)
+  {
+    largest = std::max(largest, std::abs(separable.nodes[n] - coupled.nodes[n]));
+  }
+  EXPECT_LT(largest, 1e-9);
+}
+
+TEST(TransfiniteBlock, FullyCoupledParametersGiveValidGrid)
+{
+  const PointMap map = affineMap();
+  std::array<std::vector<double>, 12> p;
+  const double ratios[12] = { 1.0, 1.2, 1.4, 0.8, 0.6, 1.0, 1.3, 1.1, 1.5, 0.7, 1.0, 1.25 };
+  const int counts[12] = { 10, 8, 10, 8, 10, 8, 10, 8, 7, 7, 7, 7 };
+  for (int e = 0; e < 12; ++e)
+  {
+    p[e] = graded(counts[e], ratios[e]);
+  }
+  const TestBlock b = buildBlock(map, p);
+  expectBoundaryCopied(b);
+  const auto quality = computeGridQuality(asGrid(b));
+  for (double sj : quality[0].scaledJacobian)
+  {
+    EXPECT_GT(sj, 0.2);
+  }
+}
+
+TEST(TransfiniteBlock, CylinderSectorKeepsWallNodesOnTheWall)
+{
+  // s: angle 0..60 deg, t: radius 1..2, u: height 0..0.5. Arc edges are exact.
+  const double innerRadius = 1.0, outerRadius = 2.0, height = 0.5, sector = M_PI / 3;
+  const PointMap map = [=](double s, double t, double u) {
+    const double r = innerRadius + t * (outerRadius - innerRadius);
+    return Vec3(r * std::cos(s * sector), r * std::sin(s * sector), u * height);
+  };
+  const std::vector<double> s = graded(13, 1.0), t = graded(9, 1.25), u = graded(5, 1.0);
+  const TestBlock b = buildBlock(map, separableParams(s, t, u));
+  expectBoundaryCopied(b);
+  for (int k = 0; k < b.nk; ++k)
+  {
+    for (int i = 0; i < b.ni; ++i)
+    {
+      for (int j : { 0, b.nj - 1 })
+      {
+        const Vec3 x = node(b.nodes, index3(b, i, j, k));
+        const double radius = j == 0 ? innerRadius : outerRadius;
+        EXPECT_NEAR(std::hypot(x.x(), x.y()), radius, 1e-14) << i << " " << j << " " << k;
+      }
+      for (int j = 1; j < b.nj - 1; ++j)
+      {
+        const Vec3 x = node(b.nodes, index3(b, i, j, k));
+        const double r = std::hypot(x.x(), x.y());
+        EXPECT_GT(r, innerRadius);
+        EXPECT_LT(r, outerRadius);
+      }
+    }
+  }
+}
+
+TEST(TransfiniteBlock, WedgeWithCollapsedFaceGivesValidCells)
+{
+  // Prism: the s = 0 face collapses onto the axis (V0 = V3, V4 = V7).
+  const PointMap map = [](double s, double t, double u) {
+    return Vec3(s, s * (t - 0.5), u + 0.1 * s * t);
+  };
+  const TestBlock b = buildBlock(map, separableParams(graded(9, 1.2), graded(7, 1.0), graded(5, 1.0)));
+  expectBoundaryCopied(b);
+  for (double x : b.nodes)
+  {
+    EXPECT_TRUE(std::isfinite(x));
+  }
+  const auto quality = computeGridQuality(asGrid(b));
+  ASSERT_EQ(quality[0].scaledJacobian.size(), 8u * 6u * 4u);
+  for (const auto* values :
+    { &quality[0].minAngle, &quality[0].maxAngle, &quality[0].nonOrthogonality,
+      &quality[0].skewness, &quality[0].aspectRatio, &quality[0].scaledJacobian })
+  {
+    for (double v : *values)
+    {
+      EXPECT_FALSE(std::isnan(v));
+    }
+  }
+  for (int k = 0; k < b.nk - 1; ++k)
+  {
+    for (int j = 0; j < b.nj - 1; ++j)
+    {
+      for (int i = 0; i < b.ni - 1; ++i)
+      {
+        const double sj = quality[0].scaledJacobian[i + (b.ni - 1) * (j + (b.nj - 1) * k)];
+        EXPECT_GE(sj, 0.0);
+        if (i == 0)
+        {
+          EXPECT_EQ(sj, 1e30); // collapsed edge: Verdict's value
+        }
+        else
+        {
+          EXPECT_GT(sj, 0.5);
+          EXPECT_LE(sj, 1.0);
+        }
+      }
+    }
+  }
+}
+
+TEST(TransfiniteBlock, WedgeWithOneCollapsedEdgeGivesFiniteNonInvertedCells)
+{
+  // Only V0 = V3 (edge 3 collapsed): faces s = 0 and u = 0 are triangles.
+  const PointMap map = [](double s, double t, double u) {
+    const double w = s + u - s * u; // 0 only on the edge s = u = 0
+    return Vec3(s, w * (t - 0.5), u);
+  };
+  const TestBlock b = buildBlock(map, separableParams(graded(8, 1.0), graded(6, 1.0), graded(7, 1.0)));
+  for (double x : b.nodes)
+  {
+    EXPECT_TRUE(std::isfinite(x));
+  }
+  const auto quality = computeGridQuality(asGrid(b));
+  for (double sj : quality[0].scaledJacobian)
+  {
+    EXPECT_GE(sj, 0.0);
+  }
+  for (double angle : quality[0].minAngle)
+  {
+    EXPECT_TRUE(std::isfinite(angle));
+    EXPECT_GT(angle, 0.0);
+  }
+}
+
+TEST(TransfiniteBlock, RejectsTooFewNodes)
+{
+  BlockBoundary boundary;
+  std::vector<double> dummy(3 * 4, 0.0);
+  for (auto& f : boundary.faces)
+  {
+    f = dummy.data();
+  }
+  for (auto& e : boundary.edgeParams)
+  {
+    e = dummy.data();
+  }
+  std::vector<double> out(3 * 8);
+  EXPECT_THROW(transfiniteBlock(boundary, 1, 2, 2, out.data()), GeometryError);
+}

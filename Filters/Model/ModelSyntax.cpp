@@ -1,0 +1,307 @@
+#include "ModelSyntax.h"
+
+#include "Template.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+
+namespace blockforge
+{
+namespace model
+{
+namespace syntax
+{
+std::string formatNumber(double value)
+{
+  // std::to_chars ignores the C locale (ParaView's GUI may set a decimal comma) and 17
+  // significant digits always round-trip an IEEE double.
+  char buffer[64];
+  const auto result =
+    std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::general, 17);
+  return std::string(buffer, result.ptr);
+}
+
+bool parseNumber(const std::string& text, double& value)
+{
+  const char* first = text.data();
+  const char* last = text.data() + text.size();
+  if (first != last && *first == '+')
+  {
+    ++first;
+  }
+  if (first == last)
+  {
+    return false;
+  }
+  const auto result = std::from_chars(first, last, value);
+  return result.ec == std::errc() && result.ptr == last;
+}
+
+int lineOf(const YAML::Node& node)
+{
+  if (!node.IsDefined())
+  {
+    return 0;
+  }
+  const YAML::Mark mark = node.Mark();
+  return mark.line >= 0 ? mark.line + 1 : 0;
+}
+
+namespace
+{
+bool isNameStart(char c)
+{
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
+}
+bool isNameChar(char c)
+{
+  return isNameStart(c) || (c >= '0' && c <= '9');
+}
+}
+
+bool isIdentifier(const std::string& name)
+{
+  return !name.empty() && isNameStart(name[0]) &&
+    std::all_of(name.begin(), name.end(), isNameChar);
+}
+
+bool isEntityName(const std::string& name)
+{
+  return !name.empty() && isNameStart(name[0]) &&
+    std::all_of(name.begin(), name.end(), [](char c) { return isNameChar(c) || c == '-'; });
+}
+
+std::string joinNames(const std::vector<std::string>& names, std::size_t maxCount)
+{
+  std::string text;
+  for (std::size_t i = 0; i < names.size() && i < maxCount; ++i)
+  {
+    text += (i ? ", " : "") + names[i];
+  }
+  if (names.size() > maxCount)
+  {
+    text += ", ...";
+  }
+  return text.empty() ? "(none)" : text;
+}
+
+namespace
+{
+std::size_t editDistance(const std::string& a, const std::string& b)
+{
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j)
+  {
+    row[j] = j;
+  }
+  for (std::size_t i = 1; i <= a.size(); ++i)
+  {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j)
+    {
+      const std::size_t above = row[j];
+      row[j] = std::min({ row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1]) });
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+}
+
+std::string closestName(const std::string& name, const std::vector<std::string>& candidates)
+{
+  std::string best;
+  std::size_t bestDistance = 3;
+  for (const std::string& candidate : candidates)
+  {
+    const std::size_t distance = editDistance(name, candidate);
+    if (distance < bestDistance)
+    {
+      bestDistance = distance;
+      best = candidate;
+    }
+  }
+  return best;
+}
+
+std::string entity(const std::string& kind, const std::string& name)
+{
+  return kind + " '" + name + "'";
+}
+
+std::string edgeLabel(int edge)
+{
+  return "E" + std::to_string(edge + 1);
+}
+
+void Reporter::fail(int line, const std::string& entityText, const std::string& what) const
+{
+  throw TemplateError(file, line, entityText, what);
+}
+
+std::vector<MapEntry> mapEntries(const YAML::Node& node, int line,
+  const std::string& entityText, const std::string& what, const Reporter& reporter)
+{
+  std::vector<MapEntry> entries;
+  if (!node.IsDefined() || node.IsNull())
+  {
+    return entries;
+  }
+  if (!node.IsMap())
+  {
+    reporter.fail(lineOf(node) ? lineOf(node) : line, entityText,
+      what + " must be a mapping (name: value lines or {key: value, ...})");
+  }
+  for (auto it = node.begin(); it != node.end(); ++it)
+  {
+    MapEntry entry;
+    entry.line = lineOf(it->first);
+    if (!it->first.IsScalar())
+    {
+      reporter.fail(entry.line ? entry.line : line, entityText,
+        what + " has a key that is not a plain name");
+    }
+    entry.key = it->first.Scalar();
+    entry.value = it->second;
+    for (const MapEntry& earlier : entries)
+    {
+      if (earlier.key == entry.key)
+      {
+        reporter.fail(entry.line, entityText,
+          "'" + entry.key + "' appears twice in " + what + " (first on line " +
+            std::to_string(earlier.line) + ")");
+      }
+    }
+    entries.push_back(std::move(entry));
+  }
+  return entries;
+}
+
+void checkKeys(const std::vector<MapEntry>& entries, const std::vector<std::string>& allowed,
+  const std::string& entityText, const Reporter& reporter)
+{
+  for (const MapEntry& entry : entries)
+  {
+    if (std::find(allowed.begin(), allowed.end(), entry.key) == allowed.end())
+    {
+      std::string what = "unknown key '" + entry.key + "'";
+      const std::string suggestion = closestName(entry.key, allowed);
+      if (!suggestion.empty())
+      {
+        what += " (did you mean '" + suggestion + "'?)";
+      }
+      reporter.fail(entry.line, entityText, what + "; expected one of: " + joinNames(allowed));
+    }
+  }
+}
+
+const MapEntry* findEntry(const std::vector<MapEntry>& entries, const std::string& key)
+{
+  for (const MapEntry& entry : entries)
+  {
+    if (entry.key == key)
+    {
+      return &entry;
+    }
+  }
+  return nullptr;
+}
+
+namespace
+{
+const char* const LawSyntax =
+  "uniform, {geometric: k}, {two_sided: k} or {first_cell: h, ratio: r}";
+}
+
+DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entityText,
+  const std::string& what, const NumberReader& number, const Reporter& reporter)
+{
+  const int here = lineOf(node) ? lineOf(node) : line;
+  DistributionLaw law;
+  if (node.IsScalar())
+  {
+    if (node.Scalar() == "uniform")
+    {
+      return law;
+    }
+    reporter.fail(here, entityText,
+      what + ": unknown law '" + node.Scalar() + "'; expected " + LawSyntax);
+  }
+  if (!node.IsMap())
+  {
+    reporter.fail(here, entityText, what + ": expected " + LawSyntax);
+  }
+  const std::vector<MapEntry> entries = mapEntries(node, here, entityText, what, reporter);
+  checkKeys(entries, { "geometric", "two_sided", "first_cell", "ratio" }, entityText, reporter);
+  const MapEntry* geometric = findEntry(entries, "geometric");
+  const MapEntry* twoSided = findEntry(entries, "two_sided");
+  const MapEntry* firstCell = findEntry(entries, "first_cell");
+  const MapEntry* ratio = findEntry(entries, "ratio");
+  if ((geometric != nullptr) + (twoSided != nullptr) + (firstCell != nullptr) != 1 ||
+    (ratio && !firstCell))
+  {
+    reporter.fail(here, entityText, what + ": expected exactly one of " + LawSyntax);
+  }
+  if (geometric || twoSided)
+  {
+    const MapEntry& entry = geometric ? *geometric : *twoSided;
+    law.kind = geometric ? DistributionLaw::Kind::Geometric : DistributionLaw::Kind::TwoSided;
+    law.expansionRatio = number(entry.value, entry.line, what + " " + entry.key);
+    if (!(law.expansionRatio > 0.0))
+    {
+      reporter.fail(entry.line, entityText,
+        what + ": the expansion ratio must be positive, got " +
+          formatNumber(law.expansionRatio));
+    }
+    return law;
+  }
+  law.kind = DistributionLaw::Kind::FirstCell;
+  law.firstCellSize = number(firstCell->value, firstCell->line, what + " first_cell");
+  if (!(law.firstCellSize > 0.0))
+  {
+    reporter.fail(firstCell->line, entityText,
+      what + ": the first cell size must be positive, got " + formatNumber(law.firstCellSize));
+  }
+  law.expansionRatio = 0.0; // solved by distributeNodes
+  if (ratio)
+  {
+    law.expansionRatio = number(ratio->value, ratio->line, what + " ratio");
+    if (!(law.expansionRatio > 1.0))
+    {
+      reporter.fail(ratio->line, entityText,
+        what + ": the largest growth ratio must be above 1, got " +
+          formatNumber(law.expansionRatio));
+    }
+  }
+  return law;
+}
+
+void emitLaw(YAML::Emitter& out, const DistributionLaw& law)
+{
+  switch (law.kind)
+  {
+    case DistributionLaw::Kind::Uniform:
+      out << "uniform";
+      return;
+    case DistributionLaw::Kind::Geometric:
+    case DistributionLaw::Kind::TwoSided:
+      out << YAML::Flow << YAML::BeginMap << YAML::Key
+          << (law.kind == DistributionLaw::Kind::Geometric ? "geometric" : "two_sided")
+          << YAML::Value << formatNumber(law.expansionRatio) << YAML::EndMap;
+      return;
+    case DistributionLaw::Kind::FirstCell:
+      out << YAML::Flow << YAML::BeginMap << YAML::Key << "first_cell" << YAML::Value
+          << formatNumber(law.firstCellSize);
+      if (law.expansionRatio != 0.0)
+      {
+        out << YAML::Key << "ratio" << YAML::Value << formatNumber(law.expansionRatio);
+      }
+      out << YAML::EndMap;
+      return;
+  }
+}
+} // namespace syntax
+} // namespace model
+} // namespace blockforge

@@ -1,0 +1,86 @@
+/**
+ * @file ModelSyntax.h
+ * @brief Private helpers shared by the template reader and the model document: exact
+ * number formatting, located errors, YAML mapping walks and the grading-law syntax.
+ * Not installed; includes yaml-cpp, which stays a private dependency of the model.
+ */
+#pragma once
+
+#include "BlockModel.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace blockforge
+{
+namespace model
+{
+namespace syntax
+{
+/// 17 significant digits, independent of the C locale: parseNumber gives back the same double.
+std::string formatNumber(double value);
+/// Parses the whole of `text` as a double, independent of the C locale.
+bool parseNumber(const std::string& text, double& value);
+
+/// 1-based line of a node, 0 when yaml-cpp has no position for it.
+int lineOf(const YAML::Node& node);
+
+/// `[A-Za-z_][A-Za-z0-9_]*`: parameter names (they appear in expressions).
+bool isIdentifier(const std::string& name);
+/// `[A-Za-z_][A-Za-z0-9_-]*`: names of vertices, edges, blocks and patches.
+bool isEntityName(const std::string& name);
+/// "a, b, c" (at most `maxCount` names, then ", ...").
+std::string joinNames(const std::vector<std::string>& names, std::size_t maxCount = 40);
+/// The name of `candidates` closest to `name` (edit distance <= 2), "" if none.
+std::string closestName(const std::string& name, const std::vector<std::string>& candidates);
+/// "kind 'name'", the entity part of every message.
+std::string entity(const std::string& kind, const std::string& name);
+/// Paper edge label of local edge e: "E1" .. "E12".
+std::string edgeLabel(int edge);
+
+/// Throws TemplateError for one source (a template file or a model document).
+struct Reporter
+{
+  std::string file;
+  [[noreturn]] void fail(int line, const std::string& entity, const std::string& what) const;
+};
+
+/// One key/value pair of a YAML mapping, with the key's line.
+struct MapEntry
+{
+  std::string key;
+  YAML::Node value;
+  int line = 0;
+};
+
+/**
+ * The entries of mapping `node` in document order. Fails (at `line`, on `entity`) when
+ * `node` is not a mapping, a key is not a plain name or a key is repeated; `what`
+ * describes the mapping in messages ("the blocks section").
+ */
+std::vector<MapEntry> mapEntries(const YAML::Node& node, int line, const std::string& entity,
+  const std::string& what, const Reporter& reporter);
+/// Fails on the first key not in `allowed`, listing the allowed keys.
+void checkKeys(const std::vector<MapEntry>& entries, const std::vector<std::string>& allowed,
+  const std::string& entity, const Reporter& reporter);
+/// The entry with `key`, or nullptr.
+const MapEntry* findEntry(const std::vector<MapEntry>& entries, const std::string& key);
+
+/// Converts a scalar node to a number (a literal or an expression) or fails itself.
+using NumberReader = std::function<double(const YAML::Node& node, int line, const std::string& what)>;
+
+/**
+ * A grading law: `uniform`, `{geometric: k}`, `{two_sided: k}` or
+ * `{first_cell: h, ratio: r}` (ratio optional). `what` names the law in messages
+ * ("grading j", "grading E9").
+ */
+DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entity,
+  const std::string& what, const NumberReader& number, const Reporter& reporter);
+/// Writes a law in the syntax parseLaw reads, numbers with formatNumber.
+void emitLaw(YAML::Emitter& out, const DistributionLaw& law);
+} // namespace syntax
+} // namespace model
+} // namespace blockforge
