@@ -87,19 +87,22 @@ class CandidateList
 public:
   void offer(const Candidate& c)
   {
-    if (Count < MaxCandidates)
+    std::size_t position = Count < MaxCandidates ? Count++ : MaxCandidates;
+    if (position == MaxCandidates)
     {
-      Items[Count++] = c;
+      if (!(c < Items[MaxCandidates - 1]))
+      {
+        return;
+      }
+      position = MaxCandidates - 1;
     }
-    else if (c < Items[Count - 1])
+    // Insertion into the sorted list.
+    while (position > 0 && c < Items[position - 1])
     {
-      Items[Count - 1] = c;
+      Items[position] = Items[position - 1];
+      --position;
     }
-    else
-    {
-      return;
-    }
-    std::sort(Items.begin(), Items.begin() + Count);
+    Items[position] = c;
   }
   std::size_t size() const { return Count; }
   const Candidate& operator[](std::size_t i) const { return Items[i]; }
@@ -287,10 +290,13 @@ SurfaceState refineOnSurface(const Surface& surface, const Vec3& p, double s0, d
         accepted = true;
         break;
       }
-      // Near the minimum f changes below its rounding; progress shows in the gradient.
+      // Near the minimum f changes below its rounding, which comes from the coordinates
+      // (|r| * |P| * eps), not from f itself; progress then shows in the gradient.
       double tgs, tgt;
       projectedGradient(trial, tgs, tgt);
-      if (trial.f <= x.f * (1.0 + 8.0 * Epsilon) && std::hypot(tgs, tgt) < gradientNorm)
+      const double noise = 8.0 * Epsilon *
+        (x.f + std::sqrt(2.0 * x.f) * (x.d.P.cwiseAbs().maxCoeff() + p.cwiseAbs().maxCoeff()));
+      if (trial.f <= x.f + noise && std::hypot(tgs, tgt) < gradientNorm)
       {
         accepted = true;
         break;
@@ -344,18 +350,19 @@ CurveProjection CurveProjector::project(const Vec3& p, double tolerance) const
 
   // Local minima of the sampled distance; one whose distance minus its sample spacing
   // exceeds the best sampled distance cannot contain the closest point.
+  thread_local std::vector<double> distances;
+  distances.resize(n);
   double best = std::numeric_limits<double>::infinity();
-  for (const Vec3& q : SamplePoints)
+  for (int i = 0; i < n; ++i)
   {
-    best = std::min(best, (q - p).norm());
+    distances[i] = (SamplePoints[i] - p).norm();
+    best = std::min(best, distances[i]);
   }
   CandidateList candidates;
   for (int i = 0; i < n; ++i)
   {
-    const double d = (SamplePoints[i] - p).norm();
-    const double before = i > 0 ? (SamplePoints[i - 1] - p).norm() : d;
-    const double after = i + 1 < n ? (SamplePoints[i + 1] - p).norm() : d;
-    if (d > before || d > after)
+    const double d = distances[i];
+    if ((i > 0 && distances[i - 1] < d) || (i + 1 < n && distances[i + 1] < d))
     {
       continue;
     }
@@ -368,7 +375,7 @@ CurveProjection CurveProjector::project(const Vec3& p, double tolerance) const
     {
       spacing = std::max(spacing, (SamplePoints[i + 1] - SamplePoints[i]).norm());
     }
-    if (d - spacing <= best || d == best)
+    if (d - spacing <= best)
     {
       candidates.offer({ d, i });
     }
@@ -400,6 +407,11 @@ CurveProjection CurveProjector::project(const Vec3& p, double tolerance) const
     const double gMid = gradient(jet, p);
     curve.evaluate(hi, jet);
     const double gHi = gradient(jet, p);
+    auto halfDistanceSquared = [&](int k) {
+      return 0.5 * (SamplePoints[std::min(std::max(k, 0), n - 1)] - p).squaredNorm();
+    };
+    const double fLo = halfDistanceSquared(i - 1), fMid = halfDistanceSquared(i),
+                 fHi = halfDistanceSquared(i + 1);
 
     // Stationary points and clamped ends only: near the minimum the distance is flat to
     // second order, so comparing it with the sample's distance cannot tell them apart.
@@ -409,16 +421,63 @@ CurveProjection CurveProjector::project(const Vec3& p, double tolerance) const
       consider(mid);
       found = true;
     }
-    if (gLo < 0.0 && gMid > 0.0)
-    {
-      consider(solveBracketed(curve, p, lo, mid, gLo, gMid, tolerance));
-      found = true;
-    }
-    if (gMid < 0.0 && gHi > 0.0)
-    {
-      consider(solveBracketed(curve, p, mid, hi, gMid, gHi, tolerance));
-      found = true;
-    }
+    auto searchInterval = [&](double a, double b, double fa, double fb, double ga, double gb) {
+      if (!(b > a))
+      {
+        return;
+      }
+      if (ga < 0.0 && gb > 0.0)
+      {
+        consider(solveBracketed(curve, p, a, b, ga, gb, tolerance));
+        found = true;
+        return;
+      }
+      // Same sign at both ends: a minimum and a maximum may hide inside. The cubic
+      // Hermite model of f from the known values and slopes locates them at no cost;
+      // g at the model's critical points then brackets the minimum.
+      if (!((ga < 0.0 && gb < 0.0) || (ga > 0.0 && gb > 0.0)))
+      {
+        return;
+      }
+      const double h = b - a;
+      const double m0 = ga * h, m1 = gb * h, delta = fb - fa;
+      const double c0 = m0, c1 = 2.0 * (3.0 * delta - 2.0 * m0 - m1),
+                   c2 = 3.0 * (m0 + m1 - 2.0 * delta);
+      const double discriminant = c1 * c1 - 4.0 * c2 * c0;
+      if (c2 == 0.0 || !(discriminant > 0.0))
+      {
+        return;
+      }
+      // Numerically stable roots of c2 x^2 + c1 x + c0.
+      const double q = -0.5 * (c1 + std::copysign(std::sqrt(discriminant), c1));
+      double r1 = q / c2, r2 = q != 0.0 ? c0 / q : r1;
+      if (r1 > r2)
+      {
+        std::swap(r1, r2);
+      }
+      double points[4] = { a, a + h * r1, a + h * r2, b };
+      double slopes[4] = { ga, 0.0, 0.0, gb };
+      if (!(r1 > 0.0 && r2 < 1.0))
+      {
+        return;
+      }
+      for (int k = 1; k <= 2; ++k)
+      {
+        curve.evaluate(points[k], jet);
+        slopes[k] = gradient(jet, p);
+      }
+      for (int k = 0; k < 3; ++k)
+      {
+        if (slopes[k] < 0.0 && slopes[k + 1] > 0.0 && points[k + 1] > points[k])
+        {
+          consider(solveBracketed(
+            curve, p, points[k], points[k + 1], slopes[k], slopes[k + 1], tolerance));
+          found = true;
+        }
+      }
+    };
+    searchInterval(lo, mid, fLo, fMid, gLo, gMid);
+    searchInterval(mid, hi, fMid, fHi, gMid, gHi);
     // Clamping: the distance still decreases towards an end of the curve.
     if (lo == 0.0 && gLo >= 0.0)
     {
@@ -488,39 +547,57 @@ SurfaceProjection SurfaceProjector::project(const Vec3& p, double tolerance) con
     return SamplePoints[i + static_cast<std::size_t>(j) * ns];
   };
 
+  // Per-thread scratch: projection runs in inner loops and must not allocate each call.
+  thread_local std::vector<double> distances;
+  distances.resize(SamplePoints.size());
   double best = std::numeric_limits<double>::infinity();
-  for (const Vec3& q : SamplePoints)
+  for (std::size_t k = 0; k < SamplePoints.size(); ++k)
   {
-    best = std::min(best, (q - p).norm());
+    distances[k] = (SamplePoints[k] - p).norm();
+    best = std::min(best, distances[k]);
   }
   CandidateList candidates;
   for (int j = 0; j < nt; ++j)
   {
     for (int i = 0; i < ns; ++i)
     {
-      const double d = (at(i, j) - p).norm();
+      const std::size_t index = i + static_cast<std::size_t>(j) * ns;
+      const double d = distances[index];
       bool localMinimum = true;
-      double spacing = 0.0;
       for (int dj = -1; dj <= 1 && localMinimum; ++dj)
       {
         for (int di = -1; di <= 1; ++di)
         {
           const int ii = i + di, jj = j + dj;
-          if ((di == 0 && dj == 0) || ii < 0 || jj < 0 || ii >= ns || jj >= nt)
-          {
-            continue;
-          }
-          if ((at(ii, jj) - p).norm() < d)
+          if (ii >= 0 && jj >= 0 && ii < ns && jj < nt &&
+            distances[ii + static_cast<std::size_t>(jj) * ns] < d)
           {
             localMinimum = false;
             break;
           }
-          spacing = std::max(spacing, (at(ii, jj) - at(i, j)).norm());
         }
       }
-      if (localMinimum && (d - spacing <= best || d == best))
+      if (!localMinimum)
       {
-        candidates.offer({ d, i + j * ns });
+        continue;
+      }
+      // A local minimum farther than the best sample by more than its cell size cannot
+      // hold the closest point.
+      double spacing = 0.0;
+      for (int dj = -1; dj <= 1; ++dj)
+      {
+        for (int di = -1; di <= 1; ++di)
+        {
+          const int ii = i + di, jj = j + dj;
+          if (ii >= 0 && jj >= 0 && ii < ns && jj < nt)
+          {
+            spacing = std::max(spacing, (at(ii, jj) - at(i, j)).norm());
+          }
+        }
+      }
+      if (d - spacing <= best)
+      {
+        candidates.offer({ d, static_cast<int>(index) });
       }
     }
   }
@@ -623,7 +700,7 @@ double ArcLength::segmentLength(double a, double b) const
   const double whole = gaussSpeed(*TheCurve, a, b);
   // Tolerance relative to the whole curve's length scale (segments are a fraction of it),
   // with an absolute floor so that zero-speed pieces terminate at once.
-  const double scale = std::max(std::abs(whole), Total / std::max<std::size_t>(1, Breaks.size()));
+  const double scale = std::max(std::abs(whole), Total / static_cast<double>(Breaks.size()));
   return adaptiveLength(*TheCurve, a, b, whole, 1e-15 * scale + 1e-300, 0);
 }
 
@@ -676,9 +753,11 @@ double ArcLength::parameterAtFraction(double fraction) const
   double t = segment > 0.0 ? lo + (hi - lo) * std::min(1.0, (target - base) / segment)
                            : 0.5 * (lo + hi);
   const double accuracy = 1e-14 * Total;
+  // The length at the current iterate is updated by the integral over each Newton step;
+  // those intervals shrink quadratically, so their quadrature is cheap and exact.
+  double error = base + segmentLength(Breaks[k], t) - target;
   for (int iteration = 0; iteration < 100; ++iteration)
   {
-    const double error = base + segmentLength(Breaks[k], t) - target;
     if (std::abs(error) <= accuracy)
     {
       break;
@@ -694,6 +773,7 @@ double ArcLength::parameterAtFraction(double fraction) const
     {
       break;
     }
+    error += next > t ? segmentLength(t, next) : -segmentLength(next, t);
     t = next;
   }
   return t;

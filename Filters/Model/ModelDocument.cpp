@@ -75,10 +75,6 @@ public:
       fail(1, "", "not a BlockForge model document (expected 'blockforge_model: 1')");
     }
     const auto sections = syntax::mapEntries(root, 1, "", "the model document", Report);
-    syntax::checkKeys(sections,
-      { "blockforge_model", "name", "source", "parameters", "vertices", "edges", "blocks",
-        "patches" },
-      "", Report);
     const MapEntry* version = syntax::findEntry(sections, "blockforge_model");
     if (!version)
     {
@@ -96,6 +92,11 @@ public:
           ", newer than this BlockForge reads (" + std::to_string(BlockModel::FormatVersion) +
           "); please update BlockForge");
     }
+    // Checked after the version: a newer document may well have keys this build lacks.
+    syntax::checkKeys(sections,
+      { "blockforge_model", "name", "source", "parameters", "vertices", "edges", "blocks",
+        "patches" },
+      "", Report);
     if (const MapEntry* name = syntax::findEntry(sections, "name"))
     {
       Model.name = text(name->value, name->line, "", "name");

@@ -112,6 +112,19 @@ std::size_t editDistance(const std::string& a, const std::string& b)
 
 std::string closestName(const std::string& name, const std::vector<std::string>& candidates)
 {
+  auto lower = [](std::string text) {
+    std::transform(text.begin(), text.end(), text.begin(),
+      [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; });
+    return text;
+  };
+  // A difference of case only is the likeliest slip.
+  for (const std::string& candidate : candidates)
+  {
+    if (lower(candidate) == lower(name))
+    {
+      return candidate;
+    }
+  }
   std::string best;
   std::size_t bestDistance = 3;
   for (const std::string& candidate : candidates)
@@ -142,7 +155,8 @@ void Reporter::fail(int line, const std::string& entityText, const std::string& 
 }
 
 std::vector<MapEntry> mapEntries(const YAML::Node& node, int line,
-  const std::string& entityText, const std::string& what, const Reporter& reporter)
+  const std::string& entityText, const std::string& what, const Reporter& reporter,
+  const std::string& itemKind)
 {
   std::vector<MapEntry> entries;
   if (!node.IsDefined() || node.IsNull())
@@ -167,6 +181,11 @@ std::vector<MapEntry> mapEntries(const YAML::Node& node, int line,
     entry.value = it->second;
     for (const MapEntry& earlier : entries)
     {
+      if (earlier.key == entry.key && !itemKind.empty())
+      {
+        reporter.fail(entry.line, entity(itemKind, entry.key),
+          "defined twice (first on line " + std::to_string(earlier.line) + ")");
+      }
       if (earlier.key == entry.key)
       {
         reporter.fail(entry.line, entityText,

@@ -59,10 +59,11 @@ struct MapEntry
 /**
  * The entries of mapping `node` in document order. Fails (at `line`, on `entity`) when
  * `node` is not a mapping, a key is not a plain name or a key is repeated; `what`
- * describes the mapping in messages ("the blocks section").
+ * describes the mapping in messages ("the blocks section"). When the keys are names of
+ * entities, `itemKind` ("block") names a repeated one as the entity of the message.
  */
 std::vector<MapEntry> mapEntries(const YAML::Node& node, int line, const std::string& entity,
-  const std::string& what, const Reporter& reporter);
+  const std::string& what, const Reporter& reporter, const std::string& itemKind = "");
 /// Fails on the first key not in `allowed`, listing the allowed keys.
 void checkKeys(const std::vector<MapEntry>& entries, const std::vector<std::string>& allowed,
   const std::string& entity, const Reporter& reporter);

@@ -136,8 +136,11 @@ public:
       {
         throw ExpressionError{ "empty expression" };
       }
+      const std::string hint = token == "deg"
+        ? " (write degrees without a space: 45deg, or multiply: 45*deg)"
+        : std::string();
       throw ExpressionError{ "cannot evaluate '" + expression + "'" + readAs + ": " +
-        error.GetMsg() };
+        error.GetMsg() + hint };
     }
     if (!std::isfinite(value))
     {
@@ -333,11 +336,12 @@ private:
     const int here = lineOrFallback(node, line);
     if (!node.IsDefined() || node.IsNull())
     {
-      fail(here, entityText, what + ": value missing");
+      fail(here, entityText, (what.empty() ? "" : what + ": ") + "value missing");
     }
     if (!node.IsScalar())
     {
-      fail(here, entityText, what + ": expected a number or an expression");
+      fail(here, entityText,
+        (what.empty() ? "" : what + ": ") + "expected a number or an expression");
     }
     try
     {
@@ -345,7 +349,7 @@ private:
     }
     catch (const ExpressionError& error)
     {
-      fail(here, entityText, what + ": " + error.message);
+      fail(here, entityText, what.empty() ? error.message : what + ": " + error.message);
     }
   }
 
@@ -495,7 +499,7 @@ private:
     if (parameters)
     {
       entries = syntax::mapEntries(
-        parameters->value, parameters->line, "", "the parameters section", Report);
+        parameters->value, parameters->line, "", "the parameters section", Report, "parameter");
     }
     // Unknown overrides are reported first: a typo in a GUI field should not look like a
     // problem of the template.
@@ -562,7 +566,7 @@ private:
       }
       else
       {
-        value = number(entry.value, entry.line, entityText, "value");
+        value = number(entry.value, entry.line, entityText, "");
       }
       info.value = value;
       if (entry.line >= 1 && entry.line <= static_cast<int>(lines.size()))
@@ -583,7 +587,7 @@ private:
       fail(vertices ? vertices->line : 1, "", "the template has no 'vertices' section");
     }
     for (const MapEntry& entry :
-      syntax::mapEntries(vertices->value, vertices->line, "", "the vertices section", Report))
+      syntax::mapEntries(vertices->value, vertices->line, "", "the vertices section", Report, "vertex"))
     {
       checkEntityName(entry, "vertex");
       const std::string entityText = entity("vertex", entry.key);
@@ -662,7 +666,7 @@ private:
       return;
     }
     for (const MapEntry& entry :
-      syntax::mapEntries(edges->value, edges->line, "", "the edges section", Report))
+      syntax::mapEntries(edges->value, edges->line, "", "the edges section", Report, "edge"))
     {
       checkEntityName(entry, "edge");
       const std::string entityText = entity("edge", entry.key);
@@ -764,7 +768,7 @@ private:
       fail(blocks ? blocks->line : 1, "", "the template has no 'blocks' section");
     }
     for (const MapEntry& entry :
-      syntax::mapEntries(blocks->value, blocks->line, "", "the blocks section", Report))
+      syntax::mapEntries(blocks->value, blocks->line, "", "the blocks section", Report, "block"))
     {
       checkEntityName(entry, "block");
       const std::string entityText = entity("block", entry.key);
@@ -883,7 +887,7 @@ private:
     std::vector<int> patchLines;
     std::vector<bool> hasRotation;
     for (const MapEntry& entry :
-      syntax::mapEntries(patches->value, patches->line, "", "the patches section", Report))
+      syntax::mapEntries(patches->value, patches->line, "", "the patches section", Report, "patch"))
     {
       checkEntityName(entry, "patch");
       const std::string entityText = entity("patch", entry.key);

@@ -1,1 +1,504 @@
+// Multiblock mesher (Filters/Model/Mesher.h) on the example templates: geometry of the
+// boundary nodes, bit-identical shared faces, density multiplier and preview cap,
+// determinism, periodicity, degenerate wedges and total volume.
+#include "Mesher.h"
+#include "Quality.h"
+#include "Template.h"
+
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <future>
+#include <map>
+#include <set>
+
+using namespace blockforge;
+using namespace blockforge::model;
+
+namespace
+{
+const double Pi = 3.14159265358979323846;
+
+std::string templatePath(const std::string& name)
+{
+  return std::string(BLOCKFORGE_SOURCE_DIR) + "/Templates/" + name;
+}
+
+const std::vector<std::string> ExampleTemplates = { "cylinder_in_box.yaml",
+  "annular_sector.yaml", "wedge_sector.yaml" };
+
+struct BlockGrid
+{
+  int ni = 0, nj = 0, nk = 0;
+  std::vector<double> xyz;
+  Vec3 node(int i, int j, int k) const
+  {
+    const std::size_t n = static_cast<std::size_t>(i) + ni * (j + static_cast<std::size_t>(nj) * k);
+    return Vec3(xyz[3 * n], xyz[3 * n + 1], xyz[3 * n + 2]);
+  }
+  const double* raw(int i, int j, int k) const
+  {
+    return &xyz[3 * (static_cast<std::size_t>(i) + ni * (j + static_cast<std::size_t>(nj) * k))];
+  }
+  std::size_t cellCount() const
+  {
+    return static_cast<std::size_t>(ni - 1) * (nj - 1) * (nk - 1);
+  }
+  std::array<Vec3, 8> cell(int i, int j, int k) const
+  {
+    return { node(i, j, k), node(i + 1, j, k), node(i + 1, j + 1, k), node(i, j + 1, k),
+      node(i, j, k + 1), node(i + 1, j, k + 1), node(i + 1, j + 1, k + 1),
+      node(i, j + 1, k + 1) };
+  }
+};
+
+std::vector<BlockGrid> meshAll(const BlockModel& model, double multiplier = 1.0, int cap = 0)
+{
+  MultiBlockMesher mesher(model, multiplier);
+  mesher.setCellCap(cap);
+  mesher.computeBoundaries();
+  std::vector<BlockGrid> grids(mesher.blockCount());
+  for (int b = 0; b < mesher.blockCount(); ++b)
+  {
+    const std::array<int, 3> n = mesher.nodeCounts(b);
+    grids[b].ni = n[0];
+    grids[b].nj = n[1];
+    grids[b].nk = n[2];
+    grids[b].xyz.resize(3 * static_cast<std::size_t>(n[0]) * n[1] * n[2]);
+    mesher.meshBlock(b, grids[b].xyz.data());
+  }
+  return grids;
+}
+
+/// Pointers to the nodes of one block face, in the face's (a, b) order.
+std::vector<const double*> faceNodes(const BlockGrid& g, int face)
+{
+  std::vector<const double*> nodes;
+  const int fixedI = face == 0 ? 0 : g.ni - 1, fixedJ = face == 2 ? 0 : g.nj - 1,
+            fixedK = face == 4 ? 0 : g.nk - 1;
+  for (int k = 0; k < g.nk; ++k)
+    for (int j = 0; j < g.nj; ++j)
+      for (int i = 0; i < g.ni; ++i)
+      {
+        const bool on = (face < 2 && i == fixedI) || (face >= 2 && face < 4 && j == fixedJ) ||
+          (face >= 4 && k == fixedK);
+        if (on)
+        {
+          nodes.push_back(g.raw(i, j, k));
+        }
+      }
+  return nodes;
+}
+
+/// Node coordinates of a face, sorted lexicographically: compares faces whatever their
+/// orientation in the two blocks.
+std::vector<std::array<double, 3>> sortedFaceNodes(const BlockGrid& g, int face)
+{
+  std::vector<std::array<double, 3>> nodes;
+  for (const double* p : faceNodes(g, face))
+  {
+    nodes.push_back({ p[0], p[1], p[2] });
+  }
+  std::sort(nodes.begin(), nodes.end());
+  return nodes;
+}
+
+std::vector<Vec3> patchNodes(
+  const BlockModel& model, const std::vector<BlockGrid>& grids, const std::string& name)
+{
+  std::vector<Vec3> nodes;
+  for (const Patch& patch : model.patches)
+  {
+    if (patch.name != name)
+    {
+      continue;
+    }
+    for (const BlockFace& face : patch.faces)
+    {
+      for (const double* p : faceNodes(grids[face.block], face.face))
+      {
+        nodes.emplace_back(p[0], p[1], p[2]);
+      }
+    }
+    return nodes;
+  }
+  ADD_FAILURE() << "no patch " << name;
+  return nodes;
+}
+
+double parameter(const BlockModel& model, const std::string& name)
+{
+  for (const auto& p : model.parameters)
+  {
+    if (p.first == name)
+    {
+      return p.second;
+    }
+  }
+  ADD_FAILURE() << "no parameter " << name;
+  return NAN;
+}
+
+/// Hexahedron volume by 6 tetrahedra about the diagonal V0-V6.
+double hexVolume(const std::array<Vec3, 8>& p)
+{
+  static const int tets[6][4] = { { 0, 1, 2, 6 }, { 0, 2, 3, 6 }, { 0, 3, 7, 6 },
+    { 0, 7, 4, 6 }, { 0, 4, 5, 6 }, { 0, 5, 1, 6 } };
+  double volume = 0.0;
+  for (const auto& t : tets)
+  {
+    volume += (p[t[1]] - p[t[0]]).dot((p[t[2]] - p[t[0]]).cross(p[t[3]] - p[t[0]])) / 6.0;
+  }
+  return volume;
+}
+
+double gridVolume(const std::vector<BlockGrid>& grids)
+{
+  double volume = 0.0;
+  for (const BlockGrid& g : grids)
+    for (int k = 0; k + 1 < g.nk; ++k)
+      for (int j = 0; j + 1 < g.nj; ++j)
+        for (int i = 0; i + 1 < g.ni; ++i)
+        {
+          volume += hexVolume(g.cell(i, j, k));
+        }
+  return volume;
+}
+
+/// Pairs of (block, face) whose four corners are the same vertices (>= 3 distinct).
+std::vector<std::pair<BlockFace, BlockFace>> sharedFaces(const BlockModel& model)
+{
+  std::map<std::vector<int>, std::vector<BlockFace>> byVertices;
+  for (int b = 0; b < static_cast<int>(model.blocks.size()); ++b)
+  {
+    for (int f = 0; f < 6; ++f)
+    {
+      std::vector<int> ids;
+      for (int corner : faceCorners(f))
+      {
+        ids.push_back(model.blocks[b].vertices[corner]);
+      }
+      std::sort(ids.begin(), ids.end());
+      if (std::set<int>(ids.begin(), ids.end()).size() >= 3)
+      {
+        byVertices[ids].push_back(BlockFace{ b, f });
+      }
+    }
+  }
+  std::vector<std::pair<BlockFace, BlockFace>> pairs;
+  for (const auto& entry : byVertices)
+  {
+    if (entry.second.size() == 2)
+    {
+      pairs.emplace_back(entry.second[0], entry.second[1]);
+    }
+  }
+  return pairs;
+}
+
+bool identical(const std::vector<BlockGrid>& a, const std::vector<BlockGrid>& b)
+{
+  if (a.size() != b.size())
+  {
+    return false;
+  }
+  for (std::size_t i = 0; i < a.size(); ++i)
+  {
+    if (a[i].xyz.size() != b[i].xyz.size() ||
+      std::memcmp(a[i].xyz.data(), b[i].xyz.data(), a[i].xyz.size() * sizeof(double)) != 0)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+} // namespace
+
+TEST(Mesher, CylinderWallNodesAtRadius)
+{
+  const BlockModel model = loadTemplate(templatePath("cylinder_in_box.yaml"));
+  const auto grids = meshAll(model);
+  const double R = parameter(model, "R");
+  const std::vector<Vec3> wall = patchNodes(model, grids, "cylinder");
+  ASSERT_EQ(wall.size(), 4u * 17 * 9);
+  for (const Vec3& p : wall)
+  {
+    EXPECT_LT(std::abs(std::hypot(p.x(), p.y()) - R) / R, 1e-9) << p.transpose();
+  }
+}
+
+TEST(Mesher, CylinderBoxNodesOnTheBox)
+{
+  const BlockModel model = loadTemplate(templatePath("cylinder_in_box.yaml"));
+  const auto grids = meshAll(model);
+  const double B = parameter(model, "B"), D = parameter(model, "D");
+  for (const auto& side : std::vector<std::pair<std::string, int>>{
+         { "inlet", 0 }, { "outlet", 0 }, { "top", 1 }, { "bottom", 1 } })
+  {
+    const std::vector<Vec3> nodes = patchNodes(model, grids, side.first);
+    ASSERT_EQ(nodes.size(), 17u * 9) << side.first;
+    for (const Vec3& p : nodes)
+    {
+      EXPECT_LT(std::abs(std::abs(p[side.second]) - B), 1e-12) << side.first << p.transpose();
+      EXPECT_LE(std::max(std::abs(p.x()), std::abs(p.y())), B + 1e-12);
+    }
+  }
+  for (const Vec3& p : patchNodes(model, grids, "front"))
+  {
+    EXPECT_LT(std::abs(p.z()), 1e-12);
+  }
+  for (const Vec3& p : patchNodes(model, grids, "back"))
+  {
+    EXPECT_LT(std::abs(p.z() - D), 1e-12);
+  }
+}
+
+TEST(Mesher, EdgeNodesFollowTheLaws)
+{
+  const BlockModel model = loadTemplate(templatePath("cylinder_in_box.yaml"));
+  const auto grids = meshAll(model);
+  const BlockGrid& north = grids[model.findBlock("north")];
+  const double kWall = parameter(model, "k_wall");
+  // The radial edge w_ne0 -> b_ne0 (north's E2): geometric, each cell k_wall times the last.
+  for (int j = 1; j + 1 < north.nj; ++j)
+  {
+    const double before = (north.node(north.ni - 1, j, 0) - north.node(north.ni - 1, j - 1, 0)).norm();
+    const double after = (north.node(north.ni - 1, j + 1, 0) - north.node(north.ni - 1, j, 0)).norm();
+    EXPECT_NEAR(after / before, kWall, 1e-9);
+  }
+  // The wall arc: uniform in arc length, so in angle.
+  const double step = (Pi / 2) / (north.ni - 1);
+  for (int i = 0; i + 1 < north.ni; ++i)
+  {
+    const Vec3 a = north.node(i, 0, 0), b = north.node(i + 1, 0, 0);
+    const double angle = std::atan2(a.y(), a.x()) - std::atan2(b.y(), b.x());
+    EXPECT_NEAR(angle, step, 1e-12);
+  }
+}
+
+TEST(Mesher, CornerNodesAreTheVertices)
+{
+  for (const std::string& name : ExampleTemplates)
+  {
+    const BlockModel model = loadTemplate(templatePath(name));
+    const auto grids = meshAll(model);
+    for (std::size_t b = 0; b < grids.size(); ++b)
+    {
+      const BlockGrid& g = grids[b];
+      const int is[8] = { 0, g.ni - 1, g.ni - 1, 0, 0, g.ni - 1, g.ni - 1, 0 };
+      const int js[8] = { 0, 0, g.nj - 1, g.nj - 1, 0, 0, g.nj - 1, g.nj - 1 };
+      const int ks[8] = { 0, 0, 0, 0, g.nk - 1, g.nk - 1, g.nk - 1, g.nk - 1 };
+      for (int v = 0; v < 8; ++v)
+      {
+        const Vec3& vertex = model.vertices[model.blocks[b].vertices[v]].position;
+        EXPECT_EQ(0, std::memcmp(g.raw(is[v], js[v], ks[v]), vertex.data(), 3 * sizeof(double)))
+          << name << " block " << model.blocks[b].name << " V" << v;
+      }
+    }
+  }
+}
+
+TEST(Mesher, SharedFacesAreBitIdentical)
+{
+  for (const std::string& name : ExampleTemplates)
+  {
+    const BlockModel model = loadTemplate(templatePath(name));
+    for (double multiplier : { 1.0, 2.0 })
+    {
+      const auto grids = meshAll(model, multiplier);
+      const auto pairs = sharedFaces(model);
+      EXPECT_FALSE(pairs.empty()) << name;
+      for (const auto& pair : pairs)
+      {
+        const auto a = sortedFaceNodes(grids[pair.first.block], pair.first.face);
+        const auto b = sortedFaceNodes(grids[pair.second.block], pair.second.face);
+        ASSERT_EQ(a.size(), b.size());
+        EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])))
+          << name << ": " << model.blocks[pair.first.block].name << "."
+          << faceName(pair.first.face) << " vs " << model.blocks[pair.second.block].name << "."
+          << faceName(pair.second.face);
+      }
+    }
+  }
+}
+
+TEST(Mesher, DensityMultiplierAndCap)
+{
+  const BlockModel model = loadTemplate(templatePath("cylinder_in_box.yaml"));
+  {
+    MultiBlockMesher mesher(model, 2.0);
+    for (int b = 0; b < mesher.blockCount(); ++b)
+    {
+      const std::array<int, 3> n = mesher.nodeCounts(b);
+      for (int d = 0; d < 3; ++d)
+      {
+        EXPECT_EQ(n[d], 2 * model.blocks[b].cells[d] + 1);
+      }
+    }
+  }
+  {
+    MultiBlockMesher mesher(model, 0.3); // 16 -> 5 (4.8), 8 -> 2 (2.4)
+    EXPECT_EQ(mesher.nodeCounts(0), (std::array<int, 3>{ 6, 6, 3 }));
+  }
+  {
+    MultiBlockMesher mesher(model, 0.001); // never fewer than one cell
+    EXPECT_EQ(mesher.nodeCounts(0), (std::array<int, 3>{ 2, 2, 2 }));
+  }
+  {
+    MultiBlockMesher mesher(model, 1.0);
+    mesher.setCellCap(4);
+    EXPECT_EQ(mesher.nodeCounts(0), (std::array<int, 3>{ 5, 5, 5 }));
+    mesher.computeBoundaries();
+    std::vector<double> xyz(3 * 5 * 5 * 5);
+    mesher.meshBlock(0, xyz.data());
+    for (double v : xyz)
+    {
+      EXPECT_TRUE(std::isfinite(v));
+    }
+  }
+  // A preview cap where the first-cell law cannot fit any more falls back, not fails.
+  const BlockModel annulus = loadTemplate(templatePath("annular_sector.yaml"));
+  EXPECT_NO_THROW(meshAll(annulus, 1.0, 3));
+  EXPECT_NO_THROW(meshAll(annulus, 0.2));
+}
+
+TEST(Mesher, Deterministic)
+{
+  for (const std::string& name : ExampleTemplates)
+  {
+    const BlockModel model = loadTemplate(templatePath(name));
+    const auto first = meshAll(model);
+    const auto second = meshAll(model);
+    EXPECT_TRUE(identical(first, second)) << name;
+
+    // Blocks meshed concurrently, in reverse order, from one mesher: the same doubles.
+    MultiBlockMesher mesher(model);
+    mesher.computeBoundaries();
+    std::vector<BlockGrid> parallel(mesher.blockCount());
+    std::vector<std::future<void>> jobs;
+    for (int b = mesher.blockCount() - 1; b >= 0; --b)
+    {
+      const std::array<int, 3> n = mesher.nodeCounts(b);
+      parallel[b].ni = n[0];
+      parallel[b].nj = n[1];
+      parallel[b].nk = n[2];
+      parallel[b].xyz.resize(3 * static_cast<std::size_t>(n[0]) * n[1] * n[2]);
+      jobs.push_back(std::async(std::launch::async,
+        [&mesher, &parallel, b] { mesher.meshBlock(b, parallel[b].xyz.data()); }));
+    }
+    for (auto& job : jobs)
+    {
+      job.get();
+    }
+    EXPECT_TRUE(identical(first, parallel)) << name;
+  }
+}
+
+TEST(Mesher, AnnularSectorIsPeriodic)
+{
+  const BlockModel model = loadTemplate(templatePath("annular_sector.yaml"));
+  const auto grids = meshAll(model);
+  const double theta = parameter(model, "theta");
+  const double size = parameter(model, "r_out");
+  const std::vector<Vec3> low = patchNodes(model, grids, "periodic_low");
+  const std::vector<Vec3> high = patchNodes(model, grids, "periodic_high");
+  ASSERT_EQ(low.size(), high.size());
+  ASSERT_FALSE(low.empty());
+  const Eigen::Matrix3d rotation = Eigen::AngleAxisd(theta, Vec3::UnitZ()).toRotationMatrix();
+  for (const Vec3& p : low)
+  {
+    const Vec3 image = rotation * p;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Vec3& q : high)
+    {
+      nearest = std::min(nearest, (image - q).norm());
+    }
+    EXPECT_LT(nearest / size, 1e-9) << p.transpose();
+  }
+  // Inner and outer walls are on their radii.
+  for (const Vec3& p : patchNodes(model, grids, "inner"))
+  {
+    EXPECT_NEAR(std::hypot(p.x(), p.y()), parameter(model, "r_in"), 1e-12);
+  }
+  for (const Vec3& p : patchNodes(model, grids, "outer"))
+  {
+    EXPECT_NEAR(std::hypot(p.x(), p.y()), parameter(model, "r_out"), 1e-12);
+  }
+  // The first cell at the inner wall has the requested height.
+  const BlockGrid& in1 = grids[model.findBlock("in_1")];
+  EXPECT_NEAR((in1.node(1, 0, 0) - in1.node(0, 0, 0)).norm(), parameter(model, "h_wall"), 1e-12);
+  const double expected = theta / 2 *
+    (std::pow(parameter(model, "r_out"), 2) - std::pow(parameter(model, "r_in"), 2)) *
+    parameter(model, "H");
+  EXPECT_NEAR(gridVolume(grids) / expected, 1.0, 0.01);
+}
+
+TEST(Mesher, WedgeMeshesWithoutInvertedCells)
+{
+  const BlockModel model = loadTemplate(templatePath("wedge_sector.yaml"));
+  for (double multiplier : { 1.0, 2.0 })
+  {
+    const auto grids = meshAll(model, multiplier);
+    std::size_t cells = 0;
+    for (const BlockGrid& g : grids)
+    {
+      for (double v : g.xyz)
+      {
+        ASSERT_TRUE(std::isfinite(v));
+      }
+      for (int k = 0; k + 1 < g.nk; ++k)
+        for (int j = 0; j + 1 < g.nj; ++j)
+          for (int i = 0; i + 1 < g.ni; ++i)
+          {
+            const double jacobian = hexScaledJacobian(g.cell(i, j, k));
+            EXPECT_FALSE(std::isnan(jacobian));
+            EXPECT_GE(jacobian, 0.0) << "cell " << i << " " << j << " " << k;
+            EXPECT_GT(hexVolume(g.cell(i, j, k)), 0.0);
+            ++cells;
+          }
+    }
+    EXPECT_GT(cells, 0u);
+    // The collapsed edge of the core wedge lies on the axis.
+    const BlockGrid& core = grids[model.findBlock("core")];
+    for (int k = 0; k < core.nk; ++k)
+      for (int j = 0; j < core.nj; ++j)
+      {
+        EXPECT_EQ(core.node(0, j, k).head<2>().norm(), 0.0);
+      }
+    const double phi = parameter(model, "phi"), R = parameter(model, "R");
+    EXPECT_NEAR(gridVolume(grids) / (phi / 2 * R * R * parameter(model, "H")), 1.0, 0.01);
+  }
+}
+
+TEST(Mesher, CylinderInBoxVolume)
+{
+  const BlockModel model = loadTemplate(templatePath("cylinder_in_box.yaml"));
+  const auto grids = meshAll(model);
+  const double R = parameter(model, "R"), B = parameter(model, "B"), D = parameter(model, "D");
+  const double exact = (4 * B * B - Pi * R * R) * D;
+  const double volume = gridVolume(grids);
+  EXPECT_NEAR(volume / exact, 1.0, 0.01);
+  for (const BlockGrid& g : grids)
+    for (int k = 0; k + 1 < g.nk; ++k)
+      for (int j = 0; j + 1 < g.nj; ++j)
+        for (int i = 0; i + 1 < g.ni; ++i)
+        {
+          ASSERT_GT(hexScaledJacobian(g.cell(i, j, k)), 0.0);
+        }
+}
+
+TEST(Mesher, Misuse)
+{
+  const BlockModel model = loadTemplate(templatePath("cylinder_in_box.yaml"));
+  EXPECT_THROW(MultiBlockMesher(model, 0.0), TemplateError);
+  EXPECT_THROW(MultiBlockMesher(model, NAN), TemplateError);
+  MultiBlockMesher mesher(model);
+  std::vector<double> xyz(3 * 17 * 17 * 9);
+  EXPECT_THROW(mesher.meshBlock(0, xyz.data()), std::logic_error);
+  mesher.computeBoundaries();
+  EXPECT_THROW(mesher.meshBlock(4, xyz.data()), std::out_of_range);
+  EXPECT_NO_THROW(mesher.meshBlock(3, xyz.data()));
+}

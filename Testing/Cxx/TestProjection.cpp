@@ -206,8 +206,110 @@ TEST(CurveProjection, InterpolatedCircleBSpline)
   }
 }
 
+TEST(CurveProjection, WigglyCurveGlobalMinimum)
+{
+  // Several local minima per sample interval in places: the result must never be farther
+  // than the best of a dense sample of the curve.
+  std::vector<Vec3> points;
+  for (int i = 0; i < 40; ++i)
+  {
+    const double u = i / 39.0 * 6.0;
+    points.emplace_back(u, std::sin(3 * u), 0.3 * std::cos(5 * u));
+  }
+  auto curve = std::make_shared<BSplineCurve>(BSplineCurve::interpolate(points, 3));
+  const CurveProjector projector(curve);
+  std::vector<Vec3> dense;
+  for (int i = 0; i <= 50000; ++i)
+  {
+    dense.push_back(curve->point(i / 50000.0));
+  }
+  std::vector<Vec3> queries = {
+    // Closest point just inside the end, with a second local minimum at the end itself.
+    Vec3(6.5722023778056009, -0.63193537034704317, -0.54732655616416293)
+  };
+  unsigned long long state = 12345;
+  auto next = [&state] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  for (int k = 0; k < 60; ++k)
+  {
+    queries.emplace_back(next() * 8 - 1, next() * 4 - 2, next() * 2 - 1);
+  }
+  for (const Vec3& p : queries)
+  {
+    const CurveProjection r = projector.project(p);
+    double sampled = std::numeric_limits<double>::infinity();
+    for (const Vec3& q : dense)
+    {
+      sampled = std::min(sampled, (q - p).norm());
+    }
+    EXPECT_LE(r.distance, sampled + 1e-13) << p.transpose();
+    EXPECT_NEAR(r.distance, (curve->point(r.t) - p).norm(), 1e-15);
+    if (r.t > 0.0 && r.t < 1.0)
+    {
+      // g = (C - p) . C' vanishes; its size relative to |C'|^2 is the parameter error.
+      const Vec3 tangent = curve->derivative(r.t);
+      EXPECT_LT(std::abs((r.point - p).dot(tangent)) / tangent.squaredNorm(), 1e-13);
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------
 // Surfaces
+
+TEST(SurfaceProjection, WavySurfaceGlobalMinimum)
+{
+  const int ns = 20, nt = 15;
+  std::vector<Vec3> grid;
+  for (int j = 0; j < nt; ++j)
+  {
+    for (int i = 0; i < ns; ++i)
+    {
+      const double u = i / (ns - 1.0) * 3, v = j / (nt - 1.0) * 2;
+      grid.emplace_back(u, v, 0.4 * std::sin(2 * u) * std::cos(3 * v));
+    }
+  }
+  auto surface = std::make_shared<BSplineSurface>(BSplineSurface::interpolate(grid, ns, nt));
+  const SurfaceProjector projector(surface);
+  const int N = 300;
+  std::vector<Vec3> dense;
+  for (int j = 0; j <= N; ++j)
+  {
+    for (int i = 0; i <= N; ++i)
+    {
+      dense.push_back(surface->point(static_cast<double>(i) / N, static_cast<double>(j) / N));
+    }
+  }
+  unsigned long long state = 777;
+  auto next = [&state] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  for (int k = 0; k < 25; ++k)
+  {
+    const Vec3 p(next() * 4 - 0.5, next() * 3 - 0.5, next() * 2 - 1);
+    const SurfaceProjection r = projector.project(p);
+    double sampled = std::numeric_limits<double>::infinity();
+    for (const Vec3& q : dense)
+    {
+      sampled = std::min(sampled, (q - p).norm());
+    }
+    EXPECT_LE(r.distance, sampled + 1e-13) << p.transpose();
+    // Stationarity in every free direction.
+    SurfaceDerivatives d;
+    surface->derivatives(r.s, r.t, d);
+    EXPECT_LT(maxError(d.P, r.point), 1e-15);
+    if (r.s > 0.0 && r.s < 1.0)
+    {
+      EXPECT_LT(std::abs((d.P - p).dot(d.Ps)), 1e-13);
+    }
+    if (r.t > 0.0 && r.t < 1.0)
+    {
+      EXPECT_LT(std::abs((d.P - p).dot(d.Pt)), 1e-13);
+    }
+  }
+}
 
 TEST(SurfaceProjection, PlaneRectangleWithClamping)
 {

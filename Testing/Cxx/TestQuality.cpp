@@ -289,7 +289,7 @@ TEST(Quality, GridPassMatchesCellAndFaceFunctions)
   {
     o = Vec3(jitter(random), jitter(random), jitter(random));
   }
-  auto at = [&](int i, int j, int k) {
+  auto at = [&](int i, int j, int k) -> Vec3 {
     // Global i in [0, 2 ni - 2]; node i = ni - 1 is shared by both blocks.
     const bool boundaryNode = i == 0 || i == 2 * ni - 2 || j == 0 || j == nj - 1 || k == 0 ||
       k == nk - 1;

@@ -2,6 +2,7 @@
 #include "Quality.h"
 #include "Transfinite.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <cmath>
