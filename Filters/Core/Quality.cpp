@@ -2,10 +2,14 @@
  * @file Quality.cpp
  * @brief Cell quality of structured hexahedral blocks.
  *
- * The grid pass is written for throughput: every cell evaluates its shape measures from
- * one set of edge vectors, each internal face is evaluated once (by the cell on its
- * upper side) and updates both neighbours, and non-orthogonality is accumulated as the
- * smallest cosine so that only one acos per cell is needed.
+ * The grid pass is written for throughput. Per block it keeps rolling buffers of two
+ * node planes in structure-of-arrays form, the squared and inverse lengths of the edges
+ * leaving each node (shared by 4 cells) and the centres of two cell layers. Cells are
+ * evaluated two at a time in SIMD lanes (Eigen::Array2d: SSE2 on x86-64, scalar code
+ * elsewhere); each internal face is evaluated once, by the cell above it, and updates both
+ * cells; non-orthogonality is accumulated as a signed squared cosine so that only one
+ * root and one acos per cell remain. Rare special cases (collapsed edges or faces,
+ * Verdict's degenerate cells) fall back to the literal formulas for that lane only.
  */
 #include "Quality.h"
 
@@ -14,6 +18,10 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace blockforge
 {
@@ -32,33 +40,154 @@ constexpr double collapsedFaceFraction = 1.0e-12;
 /// Aspect ratio reported for a cell with a zero mean width (Verdict's "infinite").
 constexpr double degenerateAspectRatio = verdictMax;
 
-struct P3
+// ---------------------------------------------------------------------------------------
+// Lane arithmetic: the kernels are templates on T = double (one cell) or Pair (two cells).
+
+using Pair = Eigen::Array2d;
+
+inline double vmin(double a, double b)
 {
-  double x, y, z;
-};
-inline P3 load(const double* p)
-{
-  return { p[0], p[1], p[2] };
+  return std::min(a, b);
 }
-inline P3 operator-(const P3& a, const P3& b)
+inline double vmax(double a, double b)
+{
+  return std::max(a, b);
+}
+inline double vabs(double a)
+{
+  return std::abs(a);
+}
+inline double vsqrt(double a)
+{
+  return std::sqrt(a);
+}
+inline Pair vmin(const Pair& a, const Pair& b)
+{
+  return a.min(b);
+}
+inline Pair vmax(const Pair& a, const Pair& b)
+{
+  return a.max(b);
+}
+inline Pair vabs(const Pair& a)
+{
+  return a.abs();
+}
+inline Pair vsqrt(const Pair& a)
+{
+  return a.sqrt();
+}
+
+template <typename T>
+constexpr int laneCount = 1;
+template <>
+constexpr int laneCount<Pair> = 2;
+
+template <typename T>
+T splat(double value);
+template <>
+inline double splat<double>(double value)
+{
+  return value;
+}
+template <>
+inline Pair splat<Pair>(double value)
+{
+  return Pair::Constant(value);
+}
+
+template <typename T>
+T loadLanes(const double* p);
+template <>
+inline double loadLanes<double>(const double* p)
+{
+  return *p;
+}
+template <>
+inline Pair loadLanes<Pair>(const double* p)
+{
+  return Eigen::Map<const Pair>(p);
+}
+inline void storeLanes(double* p, double v)
+{
+  *p = v;
+}
+inline void storeLanes(double* p, const Pair& v)
+{
+  Eigen::Map<Pair> target(p);
+  target = v;
+}
+inline double& lane(double& v, int)
+{
+  return v;
+}
+inline double lane(const double& v, int)
+{
+  return v;
+}
+inline double& lane(Pair& v, int l)
+{
+  return v[l];
+}
+inline double lane(const Pair& v, int l)
+{
+  return v[l];
+}
+
+template <typename T>
+struct V3
+{
+  T x, y, z;
+};
+using P3 = V3<double>;
+
+template <typename T>
+inline V3<T> operator-(const V3<T>& a, const V3<T>& b)
 {
   return { a.x - b.x, a.y - b.y, a.z - b.z };
 }
-inline P3 operator+(const P3& a, const P3& b)
+template <typename T>
+inline V3<T> operator+(const V3<T>& a, const V3<T>& b)
 {
   return { a.x + b.x, a.y + b.y, a.z + b.z };
+}
+template <typename T>
+inline V3<T> operator*(const T& s, const V3<T>& a)
+{
+  return { s * a.x, s * a.y, s * a.z };
+}
+template <typename T>
+inline V3<T> operator*(double s, const V3<T>& a)
+{
+  return { s * a.x, s * a.y, s * a.z };
 }
 inline P3 operator*(double s, const P3& a)
 {
   return { s * a.x, s * a.y, s * a.z };
 }
-inline double dot(const P3& a, const P3& b)
+template <typename T>
+inline T dot(const V3<T>& a, const V3<T>& b)
 {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }
-inline P3 cross(const P3& a, const P3& b)
+template <typename T>
+inline V3<T> cross(const V3<T>& a, const V3<T>& b)
 {
   return { a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x };
+}
+template <typename T>
+inline V3<T> loadV3(const double* x, const double* y, const double* z)
+{
+  return { loadLanes<T>(x), loadLanes<T>(y), loadLanes<T>(z) };
+}
+template <typename T>
+inline P3 laneOf(const V3<T>& v, int l)
+{
+  return { lane(v.x, l), lane(v.y, l), lane(v.z, l) };
+}
+inline P3 load(const double* p)
+{
+  return { p[0], p[1], p[2] };
 }
 inline P3 toP3(const Vec3& v)
 {
@@ -77,15 +206,13 @@ inline double angleFromCosine(double c)
   return std::acos(clampCosine(c)) * radiansToDegrees;
 }
 
-// Hexahedron topology in VTK order. Edges are directed along increasing s, t or u.
+// ---------------------------------------------------------------------------------------
+// Cell shape: angles, scaled Jacobian, aspect ratio
+
+// Hexahedron topology in VTK order. Edges are directed along increasing s, t or u, as in
+// the block notation of Transfinite.h, so a grid edge has the same vector in all cells.
 constexpr int edgeEnds[12][2] = { { 0, 1 }, { 1, 2 }, { 3, 2 }, { 0, 3 }, { 4, 5 }, { 5, 6 },
   { 7, 6 }, { 4, 7 }, { 0, 4 }, { 1, 5 }, { 2, 6 }, { 3, 7 } };
-// At each corner, Verdict's (xi, eta, zeta) neighbours: the Jacobian there is
-// (n0 - v) . ((n1 - v) x (n2 - v)); the same pairs give the 3 face angles at the corner.
-constexpr int cornerNeighbours[8][3] = { { 1, 3, 4 }, { 2, 0, 5 }, { 3, 1, 6 }, { 0, 2, 7 },
-  { 7, 5, 0 }, { 4, 6, 1 }, { 5, 7, 2 }, { 6, 4, 3 } };
-constexpr int cornerEdges[8][3] = { { 0, 3, 8 }, { 1, 0, 9 }, { 2, 1, 10 }, { 3, 2, 11 },
-  { 7, 4, 8 }, { 4, 5, 9 }, { 5, 6, 10 }, { 6, 7, 11 } };
 // vtkHexahedron's faces.
 constexpr int hexFaces[6][4] = { { 0, 4, 7, 3 }, { 1, 2, 6, 5 }, { 0, 1, 5, 4 },
   { 3, 7, 6, 2 }, { 0, 3, 2, 1 }, { 4, 5, 6, 7 } };
@@ -94,6 +221,101 @@ struct CellShape
 {
   double minAngle, maxAngle, scaledJacobian, aspectRatio;
 };
+
+/// What the branch-free kernel leaves for the per-lane finish.
+template <typename T>
+struct ShapeSums
+{
+  T minCos, maxCos;      ///< over the 24 face corners (valid without collapsed edges)
+  T minCornerJacobian;   ///< scaled, over the 8 corners
+  T centreJacobian;      ///< scaled (NaN for a degenerate centre, not used then)
+  T shortest2, longest2; ///< squared edge lengths
+  T shortestAxis2;       ///< smallest squared efg vector
+  T narrowest, widest;   ///< mean widths
+};
+
+template <typename T>
+inline void edgeVectors(const V3<T> (&c)[8], V3<T> (&e)[12])
+{
+  for (int n = 0; n < 12; ++n)
+  {
+    e[n] = c[edgeEnds[n][1]] - c[edgeEnds[n][0]];
+  }
+}
+
+/// Accumulates one hexahedron corner: the vectors to its three neighbours are
+/// sa*E[ea], sb*E[eb], sw*E[ew] (Verdict's xi, eta, zeta there). Its three face angles
+/// are the angles between pairs of them; its Jacobian is their triple product.
+template <typename T>
+struct CornerAccumulator
+{
+  const V3<T>* e;
+  const T* inverseLength;
+  T minCos, maxCos, minJacobian;
+
+  template <int ea, int eb, int ew, int sa, int sb, int sw>
+  inline void corner()
+  {
+    const T ia = inverseLength[ea], ib = inverseLength[eb], iw = inverseLength[ew];
+    const T cab = double(sa * sb) * dot(e[ea], e[eb]) * (ia * ib);
+    const T caw = double(sa * sw) * dot(e[ea], e[ew]) * (ia * iw);
+    const T cbw = double(sb * sw) * dot(e[eb], e[ew]) * (ib * iw);
+    minCos = vmin(minCos, vmin(cab, vmin(caw, cbw)));
+    maxCos = vmax(maxCos, vmax(cab, vmax(caw, cbw)));
+    const T jacobian = double(sa * sb * sw) * dot(e[ea], cross(e[eb], e[ew])) * (ia * ib * iw);
+    minJacobian = vmin(minJacobian, jacobian);
+  }
+};
+
+/**
+ * Branch-free part of the shape measures, from the edge vectors, squared lengths and
+ * inverse lengths (0 for zero length). Angles and the Verdict clamp are finished per
+ * lane by finishShape.
+ */
+template <typename T>
+inline ShapeSums<T> shapeKernel(
+  const V3<T> (&e)[12], const T (&length2)[12], const T (&inverseLength)[12])
+{
+  ShapeSums<T> sums;
+  CornerAccumulator<T> corners{ e, inverseLength, splat<T>(1.0), splat<T>(-1.0),
+    splat<T>(verdictMax) };
+  corners.template corner<0, 3, 8, 1, 1, 1>();     // V0: V1, V3, V4
+  corners.template corner<1, 0, 9, 1, -1, 1>();    // V1: V2, V0, V5
+  corners.template corner<2, 1, 10, -1, -1, 1>();  // V2: V3, V1, V6
+  corners.template corner<3, 2, 11, -1, 1, 1>();   // V3: V0, V2, V7
+  corners.template corner<7, 4, 8, 1, 1, -1>();    // V4: V7, V5, V0
+  corners.template corner<4, 5, 9, -1, 1, -1>();   // V5: V4, V6, V1
+  corners.template corner<5, 6, 10, -1, -1, -1>(); // V6: V5, V7, V2
+  corners.template corner<6, 7, 11, 1, -1, -1>();  // V7: V6, V4, V3
+  sums.minCos = corners.minCos;
+  sums.maxCos = corners.maxCos;
+  sums.minCornerJacobian = corners.minJacobian;
+
+  // Centre Jacobian from the efg (principal axis) vectors: sums of the 4 parallel edges.
+  const V3<T> xi = (e[0] + e[2]) + (e[4] + e[6]);
+  const V3<T> eta = (e[3] + e[1]) + (e[7] + e[5]);
+  const V3<T> zeta = (e[8] + e[9]) + (e[10] + e[11]);
+  const T xi2 = dot(xi, xi), eta2 = dot(eta, eta), zeta2 = dot(zeta, zeta);
+  sums.centreJacobian = dot(xi, cross(eta, zeta)) / vsqrt(xi2 * eta2 * zeta2);
+  sums.shortestAxis2 = vmin(xi2, vmin(eta2, zeta2));
+
+  T shortest2 = length2[0], longest2 = length2[0];
+  T length[12];
+  for (int n = 0; n < 12; ++n)
+  {
+    shortest2 = vmin(shortest2, length2[n]);
+    longest2 = vmax(longest2, length2[n]);
+    length[n] = length2[n] * inverseLength[n];
+  }
+  sums.shortest2 = shortest2;
+  sums.longest2 = longest2;
+  const T widthS = 0.25 * ((length[0] + length[2]) + (length[4] + length[6]));
+  const T widthT = 0.25 * ((length[3] + length[1]) + (length[7] + length[5]));
+  const T widthU = 0.25 * ((length[8] + length[9]) + (length[10] + length[11]));
+  sums.narrowest = vmin(widthS, vmin(widthT, widthU));
+  sums.widest = vmax(widthS, vmax(widthT, widthU));
+  return sums;
+}
 
 /// Face angles of a cell with collapsed edges: each face loses its collapsed edges and
 /// the angles are taken between the remaining consecutive edges (a triangle for one
@@ -143,198 +365,238 @@ void collapsedCellAngles(const P3 (&c)[8], double collapsedLength2, double& minA
 }
 
 /**
- * Angles, scaled Jacobian and aspect ratio of one hexahedron from a single set of edge
- * lengths. The scaled Jacobian follows Verdict's hex_scaled_jacobian (VTK 9.2): the
- * minimum over the 8 corner Jacobians and the centre Jacobian (from the efg vectors),
- * each divided by the lengths of its three vectors; any of those lengths squared at or
- * below 1e-30 makes the result 1e30, and the result is clamped to +-1e30.
+ * Finishes one lane. The scaled Jacobian is Verdict's hex_scaled_jacobian (VTK 9.2):
+ * the minimum of the 8 corner Jacobians and the centre Jacobian, each divided by the
+ * lengths of its three vectors; a squared length at or below 1e-30 (any edge or efg
+ * vector) makes it 1e30, and it is clamped to +-1e30.
  */
-inline CellShape evaluateCellShape(const P3 (&c)[8])
+template <typename T>
+inline CellShape finishShape(const ShapeSums<T>& sums, int l, const V3<T> (&c)[8])
 {
-  double length2[12];
-  double longest2 = 0.0;
-  for (int e = 0; e < 12; ++e)
-  {
-    const P3 v = c[edgeEnds[e][1]] - c[edgeEnds[e][0]];
-    length2[e] = dot(v, v);
-    longest2 = std::max(longest2, length2[e]);
-  }
-  const double collapsedLength2 = collapsedEdgeFraction * collapsedEdgeFraction * longest2;
-  bool anyCollapsed = false;
-  bool verdictDegenerate = false;
-  double length[12], inverseLength[12];
-  for (int e = 0; e < 12; ++e)
-  {
-    anyCollapsed |= length2[e] <= collapsedLength2;
-    verdictDegenerate |= length2[e] <= verdictMin;
-    length[e] = std::sqrt(length2[e]);
-    inverseLength[e] = length[e] > 0.0 ? 1.0 / length[e] : 0.0;
-  }
-
   CellShape shape;
-  double minJacobian = verdictMax;
-  double minCos = 1.0, maxCos = -1.0;
-  if (!anyCollapsed)
+  const double shortest2 = lane(sums.shortest2, l);
+  const double collapsedLength2 =
+    collapsedEdgeFraction * collapsedEdgeFraction * lane(sums.longest2, l);
+  if (shortest2 > collapsedLength2)
   {
-    for (int v = 0; v < 8; ++v)
-    {
-      const P3 a = c[cornerNeighbours[v][0]] - c[v];
-      const P3 b = c[cornerNeighbours[v][1]] - c[v];
-      const P3 w = c[cornerNeighbours[v][2]] - c[v];
-      const double ia = inverseLength[cornerEdges[v][0]];
-      const double ib = inverseLength[cornerEdges[v][1]];
-      const double iw = inverseLength[cornerEdges[v][2]];
-      const double cab = dot(a, b) * (ia * ib);
-      const double caw = dot(a, w) * (ia * iw);
-      const double cbw = dot(b, w) * (ib * iw);
-      minCos = std::min(minCos, std::min(cab, std::min(caw, cbw)));
-      maxCos = std::max(maxCos, std::max(cab, std::max(caw, cbw)));
-      minJacobian = std::min(minJacobian, dot(a, cross(b, w)) * (ia * ib * iw));
-    }
-    shape.minAngle = angleFromCosine(maxCos);
-    shape.maxAngle = angleFromCosine(minCos);
+    shape.minAngle = angleFromCosine(lane(sums.maxCos, l));
+    shape.maxAngle = angleFromCosine(lane(sums.minCos, l));
   }
   else
   {
-    collapsedCellAngles(c, collapsedLength2, shape.minAngle, shape.maxAngle);
-    if (!verdictDegenerate)
+    P3 corners[8];
+    for (int v = 0; v < 8; ++v)
     {
-      for (int v = 0; v < 8; ++v)
-      {
-        const P3 a = c[cornerNeighbours[v][0]] - c[v];
-        const P3 b = c[cornerNeighbours[v][1]] - c[v];
-        const P3 w = c[cornerNeighbours[v][2]] - c[v];
-        const double scale = inverseLength[cornerEdges[v][0]] *
-          inverseLength[cornerEdges[v][1]] * inverseLength[cornerEdges[v][2]];
-        minJacobian = std::min(minJacobian, dot(a, cross(b, w)) * scale);
-      }
+      corners[v] = laneOf(c[v], l);
     }
+    collapsedCellAngles(corners, collapsedLength2, shape.minAngle, shape.maxAngle);
   }
-
-  // Centre Jacobian from the efg (principal axis) vectors.
-  const P3 xi = (c[1] + c[2] + c[5] + c[6]) - (c[0] + c[3] + c[4] + c[7]);
-  const P3 eta = (c[2] + c[3] + c[6] + c[7]) - (c[0] + c[1] + c[4] + c[5]);
-  const P3 zeta = (c[4] + c[5] + c[6] + c[7]) - (c[0] + c[1] + c[2] + c[3]);
-  const double xi2 = dot(xi, xi), eta2 = dot(eta, eta), zeta2 = dot(zeta, zeta);
-  verdictDegenerate |= xi2 <= verdictMin || eta2 <= verdictMin || zeta2 <= verdictMin;
-  if (verdictDegenerate)
+  if (shortest2 <= verdictMin || lane(sums.shortestAxis2, l) <= verdictMin)
   {
     shape.scaledJacobian = verdictMax;
   }
   else
   {
-    minJacobian =
-      std::min(minJacobian, dot(xi, cross(eta, zeta)) / std::sqrt(xi2 * eta2 * zeta2));
-    shape.scaledJacobian = minJacobian > 0 ? std::min(minJacobian, verdictMax)
-                                           : std::max(minJacobian, -verdictMax);
+    const double jacobian =
+      std::min(lane(sums.minCornerJacobian, l), lane(sums.centreJacobian, l));
+    shape.scaledJacobian =
+      jacobian > 0 ? std::min(jacobian, verdictMax) : std::max(jacobian, -verdictMax);
   }
-
-  const double widthS = 0.25 * (length[0] + length[2] + length[4] + length[6]);
-  const double widthT = 0.25 * (length[3] + length[1] + length[7] + length[5]);
-  const double widthU = 0.25 * (length[8] + length[9] + length[11] + length[10]);
-  const double narrowest = std::min(widthS, std::min(widthT, widthU));
-  const double widest = std::max(widthS, std::max(widthT, widthU));
-  shape.aspectRatio = narrowest > 0.0 ? widest / narrowest : degenerateAspectRatio;
+  const double narrowest = lane(sums.narrowest, l);
+  shape.aspectRatio = narrowest > 0.0 ? lane(sums.widest, l) / narrowest : degenerateAspectRatio;
   return shape;
 }
 
-inline void loadCorners(const std::array<Vec3, 8>& corners, P3 (&c)[8])
+CellShape evaluateCellShape(const P3 (&c)[8])
 {
-  for (int v = 0; v < 8; ++v)
+  P3 e[12];
+  edgeVectors(c, e);
+  double length2[12], inverseLength[12];
+  for (int n = 0; n < 12; ++n)
   {
-    c[v] = toP3(corners[v]);
+    length2[n] = dot(e[n], e[n]);
+    inverseLength[n] = length2[n] > 0.0 ? 1.0 / std::sqrt(length2[n]) : 0.0;
   }
+  return finishShape(shapeKernel(e, length2, inverseLength), 0, c);
 }
 
-/// Face area vector, centre and their derived lengths (OpenFOAM's face::areaAndCentre).
+// ---------------------------------------------------------------------------------------
+// Faces
+
+/// Face area vector and centre (OpenFOAM's face::areaAndCentre) with what the special
+/// cases need.
+template <typename T>
 struct FaceGeometry
 {
-  P3 area;
-  P3 centre;
-  double areaMagnitude;
-  bool collapsed; ///< no usable normal (zero area up to round-off)
+  V3<T> area;
+  V3<T> centre;
+  T area2;        ///< |area|^2
+  T diagonals2;   ///< sum of the squared diagonals (the face's size)
+  T weightSum;    ///< sum of the projected triangle weights
+  V3<T> average;  ///< point average (OpenFOAM's fallback centre)
 };
 
 /**
  * OpenFOAM (current -dev) face::areaAndCentre: triangle fan about the point average;
  * the centre weights each triangle centre by its area projected on the face normal.
- * Weights are kept unnormalised (n . sumN) which divides out.
+ * Corners are taken relative to the average, q_k = p_k - average, where each fan
+ * triangle's area vector is simply q_k x q_k+1; the projection weights are kept
+ * unnormalised (n_k . sum n), which divides out. Branch-free: check faceUsable.
  */
-inline FaceGeometry quadFace(const P3& a, const P3& b, const P3& c, const P3& d)
+template <typename T>
+inline FaceGeometry<T> quadFace(const V3<T> (&p)[4])
 {
-  const P3 average = 0.25 * (a + b + c + d);
-  const P3 n0 = cross(b - a, average - a);
-  const P3 n1 = cross(c - b, average - b);
-  const P3 n2 = cross(d - c, average - c);
-  const P3 n3 = cross(a - d, average - d);
-  const P3 sumN = (n0 + n1) + (n2 + n3);
-  const double sumN2 = dot(sumN, sumN);
-  const double magnitude = std::sqrt(sumN2);
-
-  FaceGeometry face;
+  FaceGeometry<T> face;
+  face.average = 0.25 * ((p[0] + p[1]) + (p[2] + p[3]));
+  const V3<T> q0 = p[0] - face.average, q1 = p[1] - face.average, q2 = p[2] - face.average,
+              q3 = p[3] - face.average;
+  const V3<T> n0 = cross(q0, q1), n1 = cross(q1, q2), n2 = cross(q2, q3), n3 = cross(q3, q0);
+  const V3<T> sumN = (n0 + n1) + (n2 + n3);
   face.area = 0.5 * sumN;
-  face.areaMagnitude = 0.5 * magnitude;
-  const double w0 = dot(n0, sumN), w1 = dot(n1, sumN), w2 = dot(n2, sumN), w3 = dot(n3, sumN);
-  const double sumW = (w0 + w1) + (w2 + w3);
-  // OpenFOAM's "sumAn > vSmall" with sumAn = sumW / |sumN|.
-  if (magnitude > 0.0 && sumW > vSmall * magnitude)
+  face.area2 = dot(face.area, face.area);
+  const T w0 = dot(n0, sumN), w1 = dot(n1, sumN), w2 = dot(n2, sumN), w3 = dot(n3, sumN);
+  face.weightSum = (w0 + w1) + (w2 + w3);
+  const V3<T> weighted = (w0 * (q0 + q1) + w1 * (q1 + q2)) + (w2 * (q2 + q3) + w3 * (q3 + q0));
+  const T scale = 1.0 / (3.0 * face.weightSum);
+  face.centre = face.average + scale * weighted;
+  const V3<T> diagonal0 = q2 - q0, diagonal1 = q3 - q1;
+  face.diagonals2 = dot(diagonal0, diagonal0) + dot(diagonal1, diagonal1);
+  return face;
+}
+
+/// No usable normal: zero area up to round-off (collapsed edges of wedges and prisms).
+inline bool faceCollapsed(double area2, double diagonals2)
+{
+  return area2 <= collapsedFaceFraction * collapsedFaceFraction * diagonals2 * diagonals2;
+}
+
+/// Scalar face with OpenFOAM's guard for the centre: "sumAn > vSmall", where
+/// sumAn = weightSum / |sum n| = weightSum / (2 |area|).
+FaceGeometry<double> scalarFace(const P3 (&p)[4])
+{
+  FaceGeometry<double> face = quadFace(p);
+  if (!(face.weightSum > 0.0 && face.weightSum * face.weightSum > 4.0 * vSmall * vSmall * face.area2))
   {
-    const P3 weighted = w0 * (a + b) + w1 * (b + c) + w2 * (c + d) + w3 * (d + a);
-    face.centre = (1.0 / (3.0 * sumW)) * weighted + (1.0 / 3.0) * average;
+    face.centre = face.average;
   }
-  else
-  {
-    face.centre = average;
-  }
-  const P3 diagonal0 = c - a, diagonal1 = d - b;
-  const double scale2 = dot(diagonal0, diagonal0) + dot(diagonal1, diagonal1);
-  face.collapsed = face.areaMagnitude <= collapsedFaceFraction * scale2;
   return face;
 }
 
 /// Cosine of the non-orthogonality angle (OpenFOAM's faceOrthogonality).
-inline double orthogonalityCosine(const P3& ownerToNeighbour, const P3& area, double areaMagnitude)
+inline double orthogonalityCosine(const P3& ownerToNeighbour, const P3& area)
 {
-  const double distance = std::sqrt(dot(ownerToNeighbour, ownerToNeighbour));
-  return dot(ownerToNeighbour, area) / (distance * areaMagnitude + rootVSmall);
+  return dot(ownerToNeighbour, area) /
+    (std::sqrt(dot(ownerToNeighbour, ownerToNeighbour) * dot(area, area)) + rootVSmall);
 }
 
 /// OpenFOAM's skewness of a face with the given owner-to-neighbour vector `d`
 /// (meshCheck::faceSkewness; boundaryFaceSkewness passes the projected d and 0.4).
 inline double skewness(const P3& ownerCentre, const P3& d, double distanceFactor,
-  const FaceGeometry& face, const P3 (&corners)[4])
+  const P3& area, const P3& centre, const P3 (&corners)[4])
 {
-  const P3 ownerToFace = face.centre - ownerCentre;
-  const double along =
-    dot(face.area, ownerToFace) / (dot(face.area, d) + rootVSmall);
+  const P3 ownerToFace = centre - ownerCentre;
+  const double along = dot(area, ownerToFace) / (dot(area, d) + rootVSmall);
   const P3 sv = ownerToFace - along * d;
   const double svLength = std::sqrt(dot(sv, sv));
   const P3 svHat = (1.0 / (svLength + rootVSmall)) * sv;
   double normalisation = distanceFactor * std::sqrt(dot(d, d)) + rootVSmall;
   for (const P3& corner : corners)
   {
-    normalisation = std::max(normalisation, std::abs(dot(svHat, corner - face.centre)));
+    normalisation = std::max(normalisation, std::abs(dot(svHat, corner - centre)));
   }
   return svLength / normalisation;
 }
 
-inline double boundarySkewness(const P3& ownerCentre, const FaceGeometry& face,
-  const P3 (&corners)[4])
+inline double boundarySkewness(
+  const P3& ownerCentre, const P3& area, const P3& centre, const P3 (&corners)[4])
 {
-  const P3 normal = (1.0 / (face.areaMagnitude + rootVSmall)) * face.area;
-  const P3 d = dot(normal, face.centre - ownerCentre) * normal;
-  return skewness(ownerCentre, d, 0.4, face, corners);
+  const P3 normal = (1.0 / (std::sqrt(dot(area, area)) + rootVSmall)) * area;
+  const P3 d = dot(normal, centre - ownerCentre) * normal;
+  return skewness(ownerCentre, d, 0.4, area, centre, corners);
+}
+
+/// cos * |cos|: ordered like the cosine, and needs no square root per face.
+inline double signedSquare(double cosine)
+{
+  return cosine * std::abs(cosine);
+}
+
+/// Face measures before the per-lane checks.
+template <typename T>
+struct FaceMeasures
+{
+  T cosine2; ///< signed squared cosine of the non-orthogonality
+  T skew;
+  T areaDotD; ///< S . d, the denominator OpenFOAM guards
+  T sv2;
+};
+
+/**
+ * Non-orthogonality (as signed squared cosine) and skewness of an internal face whose
+ * area vector points from owner to neighbour, with one root and three divisions.
+ * Skewness is OpenFOAM's |sv| / fd rewritten with sv' = (S.d) sv, which avoids forming
+ * sv and its unit vector:
+ *   |sv| / max(0.2 |d|, max_k |sv^.r_k|) = |sv'|^2 / (|S.d| max(0.2 |d||sv'|, max_k |sv'.r_k|)).
+ * Branch-free; internalFaceUsable says whether a lane needs the literal formulas.
+ */
+template <typename T>
+inline FaceMeasures<T> internalFaceKernel(const V3<T> (&q)[4], const FaceGeometry<T>& face,
+  const V3<T>& ownerCentre, const V3<T>& neighbourCentre)
+{
+  FaceMeasures<T> m;
+  const V3<T> d = neighbourCentre - ownerCentre;
+  const T dd = dot(d, d);
+  const T g = dot(face.area, d);
+  m.areaDotD = g;
+  m.cosine2 = g * vabs(g) / (dd * face.area2 + rootVSmall * rootVSmall);
+  const V3<T> ownerToFace = face.centre - ownerCentre;
+  const V3<T> svScaled = g * ownerToFace - dot(face.area, ownerToFace) * d;
+  m.sv2 = dot(svScaled, svScaled);
+  T largestProjection = vabs(dot(svScaled, q[0] - face.centre));
+  for (int k = 1; k < 4; ++k)
+  {
+    largestProjection = vmax(largestProjection, vabs(dot(svScaled, q[k] - face.centre)));
+  }
+  m.skew = m.sv2 / (vabs(g) * vmax(0.2 * vsqrt(dd * m.sv2), largestProjection));
+  return m;
+}
+
+/// The literal formulas for the lanes the kernel cannot handle; true if the face counts.
+bool internalFaceSpecialCase(const P3 (&q)[4], const P3& ownerCentre,
+  const P3& neighbourCentre, double& cosine2, double& skew)
+{
+  const FaceGeometry<double> face = scalarFace(q);
+  if (faceCollapsed(face.area2, face.diagonals2))
+  {
+    return false;
+  }
+  const P3 d = neighbourCentre - ownerCentre;
+  cosine2 = signedSquare(orthogonalityCosine(d, face.area));
+  skew = skewness(ownerCentre, d, 0.2, face.area, face.centre, q);
+  return true;
+}
+
+/// Checks one lane of the kernel's result: a usable face with S.d and sv' away from 0
+/// and a regular centre.
+template <typename T>
+inline bool internalFaceUsable(const FaceGeometry<T>& face, const FaceMeasures<T>& m, int l)
+{
+  const double area2 = lane(face.area2, l);
+  const double weightSum = lane(face.weightSum, l);
+  return !faceCollapsed(area2, lane(face.diagonals2, l)) &&
+    std::abs(lane(m.areaDotD, l)) >= 1e-100 && lane(m.sv2, l) > 0.0 && weightSum > 0.0 &&
+    weightSum * weightSum > 4.0 * vSmall * vSmall * area2;
 }
 
 // ---------------------------------------------------------------------------------------
-// Grid pass
+// Block interfaces
 
 /// One block's structured addressing.
 struct BlockView
 {
   const double* xyz;
-  int ni, nj, nk;    // nodes
-  int ci, cj, ck;    // cells
+  int ni, nj, nk; // nodes
+  int ci, cj, ck; // cells
   long cellCount;
 
   explicit BlockView(const StructuredBlock& b)
@@ -540,7 +802,8 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     P3 q[4];
     int cellIjk[3];
     views[ref.block].sideFace(ref.side, ref.a, ref.b, q, cellIjk);
-    if (quadFace(q[0], q[1], q[2], q[3]).collapsed)
+    const FaceGeometry<double> face = quadFace(q);
+    if (faceCollapsed(face.area2, face.diagonals2))
     {
       table.partner[n] = InterfaceTable::collapsed;
       continue;
@@ -592,7 +855,10 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
   return table;
 }
 
-/// Reports progress at most `maxReports` times, whatever the number of blocks or cells.
+// ---------------------------------------------------------------------------------------
+// Grid pass
+
+/// Reports progress at most about 32 times, whatever the number of blocks or cells.
 class ProgressReporter
 {
 public:
@@ -633,88 +899,268 @@ private:
   double reported_ = 0.0;
 };
 
-/// Internal face between cells `owner` and `neighbour`, corners ordered so the area
-/// vector points from owner to neighbour.
-inline void internalFace(const P3 (&q)[4], const double* centres, long owner, long neighbour,
-  double* minCosine, double* maxSkewness)
+/**
+ * Sizes a result array. Large arrays are first-touched here, and with 4 KiB pages the
+ * page faults can cost as much as the whole quality computation (about 10 us each on
+ * some virtual machines); asking for transparent huge pages removes most of them.
+ * Purely advisory: without THP support the call fails and nothing changes.
+ */
+void allocateCellArray(std::vector<double>& values, long count, double initial)
 {
-  const FaceGeometry face = quadFace(q[0], q[1], q[2], q[3]);
-  if (face.collapsed)
+  values.clear();
+  values.reserve(count);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t hugePage = std::uintptr_t(1) << 21;
+  const auto begin = reinterpret_cast<std::uintptr_t>(values.data());
+  const std::uintptr_t end = begin + sizeof(double) * static_cast<std::uintptr_t>(count);
+  const std::uintptr_t alignedBegin = (begin + hugePage - 1) & ~(hugePage - 1);
+  const std::uintptr_t alignedEnd = end & ~(hugePage - 1);
+  if (alignedEnd > alignedBegin)
   {
-    return;
+    madvise(reinterpret_cast<void*>(alignedBegin), alignedEnd - alignedBegin, MADV_HUGEPAGE);
   }
-  const P3 ownerCentre = load(centres + 3 * owner);
-  const P3 d = load(centres + 3 * neighbour) - ownerCentre;
-  const double cosine = orthogonalityCosine(d, face.area, face.areaMagnitude);
-  minCosine[owner] = std::min(minCosine[owner], cosine);
-  minCosine[neighbour] = std::min(minCosine[neighbour], cosine);
-  const double skew = skewness(ownerCentre, d, 0.2, face, q);
-  maxSkewness[owner] = std::max(maxSkewness[owner], skew);
-  maxSkewness[neighbour] = std::max(maxSkewness[neighbour], skew);
+#endif
+  values.assign(count, initial);
 }
 
-void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
-  const InterfaceTable& interfaces, CellQualityArrays& quality, std::vector<double>& centres,
-  ProgressReporter& progress)
+/// Node plane k in structure-of-arrays form, so that neighbouring cells load as lanes.
+struct NodePlane
 {
-  const BlockView& view = views[blockIndex];
-  const long cellCount = view.cellCount;
-  quality.minAngle.assign(cellCount, 0.0);
-  quality.maxAngle.assign(cellCount, 0.0);
-  quality.nonOrthogonality.assign(cellCount, 1.0); // smallest cosine until the end
-  quality.skewness.assign(cellCount, 0.0);
-  quality.aspectRatio.assign(cellCount, 0.0);
-  quality.scaledJacobian.assign(cellCount, 0.0);
-  if (cellCount == 0)
+  double *x, *y, *z;
+};
+
+/// Squared and inverse lengths (0 for zero length) of the grid edges leaving each node
+/// of a plane along i or j, or between two planes along k; indexed like the nodes.
+struct EdgeLengths
+{
+  double* length2;
+  double* inverseLength;
+};
+
+void invertLengths(EdgeLengths edges, long count)
+{
+  const Eigen::Map<const Eigen::ArrayXd> squared(edges.length2, count);
+  Eigen::Map<Eigen::ArrayXd> inverse(edges.inverseLength, count);
+  inverse = squared.sqrt().inverse();
+  inverse = (squared > 0.0).select(inverse, 0.0);
+}
+
+void loadPlane(const BlockView& view, int k, NodePlane plane)
+{
+  const long count = static_cast<long>(view.ni) * view.nj;
+  const double* p = view.node(0, 0, k);
+  for (long n = 0; n < count; ++n)
   {
-    return;
+    plane.x[n] = p[3 * n];
+    plane.y[n] = p[3 * n + 1];
+    plane.z[n] = p[3 * n + 2];
   }
-  centres.resize(3 * cellCount);
-  double* minCosine = quality.nonOrthogonality.data();
-  double* maxSkewness = quality.skewness.data();
+}
 
-  for (int k = 0; k < view.ck; ++k)
+/// Edge lengths of vectors b[n + offset] - a[n] for n < count - offset; the rest 0.
+void edgeLengths(const NodePlane& a, const NodePlane& b, long offset, long count,
+  EdgeLengths edges)
+{
+  for (long n = 0; n + offset < count; ++n)
   {
-    for (int j = 0; j < view.cj; ++j)
-    {
-      for (int i = 0; i < view.ci; ++i)
-      {
-        const long cell = view.cell(i, j, k);
-        P3 c[8];
-        view.cellCorners(i, j, k, c);
-        const CellShape shape = evaluateCellShape(c);
-        quality.minAngle[cell] = shape.minAngle;
-        quality.maxAngle[cell] = shape.maxAngle;
-        quality.scaledJacobian[cell] = shape.scaledJacobian;
-        quality.aspectRatio[cell] = shape.aspectRatio;
-        const P3 centre =
-          0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7])));
-        centres[3 * cell] = centre.x;
-        centres[3 * cell + 1] = centre.y;
-        centres[3 * cell + 2] = centre.z;
+    const double dx = b.x[n + offset] - a.x[n];
+    const double dy = b.y[n + offset] - a.y[n];
+    const double dz = b.z[n + offset] - a.z[n];
+    edges.length2[n] = dx * dx + dy * dy + dz * dz;
+  }
+  for (long n = std::max(count - offset, 0L); n < count; ++n)
+  {
+    edges.length2[n] = 0.0;
+  }
+  invertLengths(edges, count);
+}
 
-        // Each cell evaluates its lower faces: the neighbours there are already done.
-        if (i > 0)
-        {
-          const P3 q[4] = { c[0], c[3], c[7], c[4] };
-          internalFace(q, centres.data(), cell - 1, cell, minCosine, maxSkewness);
-        }
-        if (j > 0)
-        {
-          const P3 q[4] = { c[0], c[4], c[5], c[1] };
-          internalFace(q, centres.data(), cell - view.ci, cell, minCosine, maxSkewness);
-        }
-        if (k > 0)
-        {
-          const P3 q[4] = { c[0], c[1], c[2], c[3] };
-          internalFace(q, centres.data(), cell - static_cast<long>(view.ci) * view.cj, cell,
-            minCosine, maxSkewness);
-        }
+/// Rolling per-block buffers of the grid pass.
+class BlockPass
+{
+public:
+  BlockPass(const BlockView& view, CellQualityArrays& quality, std::vector<double>& scratch)
+    : view_(view)
+    , quality_(quality)
+    , plane_(static_cast<long>(view.ni) * view.nj)
+    , layerCells_(static_cast<long>(view.ci) * view.cj)
+  {
+    scratch.assign(16 * plane_ + 6 * layerCells_, 0.0);
+    double* buffer = scratch.data();
+    auto take = [&buffer](long count) {
+      double* start = buffer;
+      buffer += count;
+      return start;
+    };
+    for (int n = 0; n < 2; ++n)
+    {
+      planes_[n] = { take(plane_), take(plane_), take(plane_) };
+    }
+    for (int n = 0; n < 2; ++n)
+    {
+      iEdges_[n] = { take(plane_), take(plane_) };
+      jEdges_[n] = { take(plane_), take(plane_) };
+    }
+    kEdges_ = { take(plane_), take(plane_) };
+    for (int n = 0; n < 2; ++n)
+    {
+      centres_[n] = { take(layerCells_), take(layerCells_), take(layerCells_) };
+    }
+    minCosine2_ = quality.nonOrthogonality.data();
+    maxSkewness_ = quality.skewness.data();
+  }
+
+  /// Shape measures of every cell of layer k and the faces below and beside them.
+  void layer(int k)
+  {
+    if (k == 0)
+    {
+      loadPlane(view_, 0, planes_[0]);
+      planeEdges(0);
+    }
+    lower_ = k % 2;
+    upper_ = 1 - lower_;
+    loadPlane(view_, k + 1, planes_[upper_]);
+    planeEdges(upper_);
+    edgeLengths(planes_[lower_], planes_[upper_], 0, plane_, kEdges_);
+    k_ = k;
+    for (int j = 0; j < view_.cj; ++j)
+    {
+      j_ = j;
+      // Cell 0 has no lower i-face, so pairs start at cell 1.
+      cells<double>(0);
+      int i = 1;
+      for (; i + 1 < view_.ci; i += 2)
+      {
+        cells<Pair>(i);
+      }
+      if (i < view_.ci)
+      {
+        cells<double>(i);
       }
     }
-    progress.advance(static_cast<double>(view.ci) * view.cj);
   }
 
+private:
+  void planeEdges(int p)
+  {
+    edgeLengths(planes_[p], planes_[p], 1, plane_, iEdges_[p]);
+    edgeLengths(planes_[p], planes_[p], view_.ni, plane_, jEdges_[p]);
+  }
+
+  /// Cells (i, j_, k_) and, for a Pair, (i + 1, j_, k_).
+  template <typename T>
+  void cells(int i)
+  {
+    constexpr int lanes = laneCount<T>;
+    const long n00 = i + static_cast<long>(view_.ni) * j_; // node (i, j) in a plane
+    const long n10 = n00 + 1, n01 = n00 + view_.ni, n11 = n01 + 1;
+    const NodePlane& lowerPlane = planes_[lower_];
+    const NodePlane& upperPlane = planes_[upper_];
+    auto corner = [](const NodePlane& plane, long n) {
+      return loadV3<T>(plane.x + n, plane.y + n, plane.z + n);
+    };
+    const V3<T> c[8] = { corner(lowerPlane, n00), corner(lowerPlane, n10),
+      corner(lowerPlane, n11), corner(lowerPlane, n01), corner(upperPlane, n00),
+      corner(upperPlane, n10), corner(upperPlane, n11), corner(upperPlane, n01) };
+    V3<T> e[12];
+    edgeVectors(c, e);
+    const EdgeLengths edge[12] = { iEdges_[lower_], jEdges_[lower_], iEdges_[lower_],
+      jEdges_[lower_], iEdges_[upper_], jEdges_[upper_], iEdges_[upper_], jEdges_[upper_],
+      kEdges_, kEdges_, kEdges_, kEdges_ };
+    const long edgeStart[12] = { n00, n10, n01, n00, n00, n10, n01, n00, n00, n10, n11, n01 };
+    T length2[12], inverseLength[12];
+    for (int n = 0; n < 12; ++n)
+    {
+      length2[n] = loadLanes<T>(edge[n].length2 + edgeStart[n]);
+      inverseLength[n] = loadLanes<T>(edge[n].inverseLength + edgeStart[n]);
+    }
+    const ShapeSums<T> sums = shapeKernel(e, length2, inverseLength);
+    const long cell = view_.cell(i, j_, k_);
+    for (int l = 0; l < lanes; ++l)
+    {
+      const CellShape shape = finishShape(sums, l, c);
+      quality_.minAngle[cell + l] = shape.minAngle;
+      quality_.maxAngle[cell + l] = shape.maxAngle;
+      quality_.scaledJacobian[cell + l] = shape.scaledJacobian;
+      quality_.aspectRatio[cell + l] = shape.aspectRatio;
+    }
+
+    const V3<T> centre =
+      0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7])));
+    const long inLayer = i + static_cast<long>(view_.ci) * j_;
+    const NodePlane& centres = centres_[k_ % 2];
+    storeLanes(centres.x + inLayer, centre.x);
+    storeLanes(centres.y + inLayer, centre.y);
+    storeLanes(centres.z + inLayer, centre.z);
+
+    // Lower faces, corners ordered so that the area vector points into these cells.
+    if (i > 0)
+    {
+      const V3<T> q[4] = { c[0], c[3], c[7], c[4] };
+      lowerFace<T>(q, centres, inLayer - 1, cell - 1, centre, cell);
+    }
+    if (j_ > 0)
+    {
+      const V3<T> q[4] = { c[0], c[4], c[5], c[1] };
+      lowerFace<T>(q, centres, inLayer - view_.ci, cell - view_.ci, centre, cell);
+    }
+    if (k_ > 0)
+    {
+      const V3<T> q[4] = { c[0], c[1], c[2], c[3] };
+      lowerFace<T>(q, centres_[1 - k_ % 2], inLayer, cell - layerCells_, centre, cell);
+    }
+  }
+
+  template <typename T>
+  void lowerFace(const V3<T> (&q)[4], const NodePlane& neighbourCentres, long neighbourInLayer,
+    long neighbour, const V3<T>& centre, long cell)
+  {
+    const V3<T> neighbourCentre = loadV3<T>(neighbourCentres.x + neighbourInLayer,
+      neighbourCentres.y + neighbourInLayer, neighbourCentres.z + neighbourInLayer);
+    const FaceGeometry<T> face = quadFace(q);
+    FaceMeasures<T> m = internalFaceKernel(q, face, neighbourCentre, centre);
+    for (int l = 0; l < laneCount<T>; ++l)
+    {
+      if (!internalFaceUsable(face, m, l))
+      {
+        P3 corners[4];
+        for (int n = 0; n < 4; ++n)
+        {
+          corners[n] = laneOf(q[n], l);
+        }
+        double cosine2 = 1.0, skew = 0.0;
+        internalFaceSpecialCase(
+          corners, laneOf(neighbourCentre, l), laneOf(centre, l), cosine2, skew);
+        lane(m.cosine2, l) = cosine2;
+        lane(m.skew, l) = skew;
+      }
+    }
+    // Neighbours first: for a Pair, cell i is lane 1's neighbour and lane 0 itself.
+    for (long target : { neighbour, cell })
+    {
+      storeLanes(minCosine2_ + target, vmin(loadLanes<T>(minCosine2_ + target), m.cosine2));
+      storeLanes(maxSkewness_ + target, vmax(loadLanes<T>(maxSkewness_ + target), m.skew));
+    }
+  }
+
+  const BlockView& view_;
+  CellQualityArrays& quality_;
+  const long plane_, layerCells_;
+  NodePlane planes_[2];
+  EdgeLengths iEdges_[2], jEdges_[2], kEdges_;
+  NodePlane centres_[2];
+  double* minCosine2_;
+  double* maxSkewness_;
+  int lower_ = 0, upper_ = 1, j_ = 0, k_ = 0;
+};
+
+/// Block-boundary faces: interfaces are measured with the other cell's centre, true
+/// boundaries with OpenFOAM's boundary skewness only.
+void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
+  const InterfaceTable& interfaces, CellQualityArrays& quality)
+{
+  const BlockView& view = views[blockIndex];
   for (int side = 0; side < 6; ++side)
   {
     const bool lowerSide = side % 2 == 0;
@@ -722,8 +1168,7 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
     {
       for (int a = 0; a < view.sideWidth(side); ++a)
       {
-        const long faceIndex = interfaces.index(blockIndex, side, a, b, view);
-        const long partner = interfaces.partner[faceIndex];
+        const long partner = interfaces.partner[interfaces.index(blockIndex, side, a, b, view)];
         if (partner == InterfaceTable::collapsed)
         {
           continue;
@@ -731,13 +1176,12 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
         P3 q[4];
         int ijk[3];
         view.sideFace(side, a, b, q, ijk);
-        FaceGeometry face = quadFace(q[0], q[1], q[2], q[3]);
-        if (lowerSide)
-        {
-          face.area = -1.0 * face.area; // outward from the owner
-        }
+        const FaceGeometry<double> face = scalarFace(q);
+        const P3 outward = lowerSide ? -1.0 * face.area : face.area;
         const long owner = view.cell(ijk[0], ijk[1], ijk[2]);
-        const P3 ownerCentre = load(centres.data() + 3 * owner);
+        const P3 ownerCentre = view.cellCentre(ijk[0], ijk[1], ijk[2]);
+        double& minCosine2 = quality.nonOrthogonality[owner];
+        double& maxSkewness = quality.skewness[owner];
         if (partner >= 0)
         {
           const BoundaryFaceRef& other = interfaces.faces[partner];
@@ -746,21 +1190,62 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
           int otherIjk[3];
           otherView.sideFace(other.side, other.a, other.b, otherCorners, otherIjk);
           const P3 d = otherView.cellCentre(otherIjk[0], otherIjk[1], otherIjk[2]) - ownerCentre;
-          minCosine[owner] =
-            std::min(minCosine[owner], orthogonalityCosine(d, face.area, face.areaMagnitude));
-          maxSkewness[owner] = std::max(maxSkewness[owner], skewness(ownerCentre, d, 0.2, face, q));
+          minCosine2 = std::min(minCosine2, signedSquare(orthogonalityCosine(d, outward)));
+          maxSkewness =
+            std::max(maxSkewness, skewness(ownerCentre, d, 0.2, outward, face.centre, q));
         }
         else
         {
-          maxSkewness[owner] = std::max(maxSkewness[owner], boundarySkewness(ownerCentre, face, q));
+          maxSkewness =
+            std::max(maxSkewness, boundarySkewness(ownerCentre, outward, face.centre, q));
         }
       }
     }
   }
+}
 
-  for (long cell = 0; cell < cellCount; ++cell)
+void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
+  const InterfaceTable& interfaces, CellQualityArrays& quality, std::vector<double>& scratch,
+  ProgressReporter& progress)
+{
+  const BlockView& view = views[blockIndex];
+  const long cellCount = view.cellCount;
+  allocateCellArray(quality.minAngle, cellCount, 0.0);
+  allocateCellArray(quality.maxAngle, cellCount, 0.0);
+  allocateCellArray(quality.nonOrthogonality, cellCount, 1.0); // signed squared cosine first
+  allocateCellArray(quality.skewness, cellCount, 0.0);
+  allocateCellArray(quality.aspectRatio, cellCount, 0.0);
+  allocateCellArray(quality.scaledJacobian, cellCount, 0.0);
+  if (cellCount == 0)
   {
-    quality.nonOrthogonality[cell] = angleFromCosine(minCosine[cell]);
+    return;
+  }
+  BlockPass pass(view, quality, scratch);
+  for (int k = 0; k < view.ck; ++k)
+  {
+    pass.layer(k);
+    progress.advance(static_cast<double>(view.ci) * view.cj);
+  }
+  boundaryFaces(views, blockIndex, interfaces, quality);
+  for (double& value : quality.nonOrthogonality)
+  {
+    value = angleFromCosine(std::copysign(std::sqrt(std::abs(value)), value));
+  }
+}
+
+inline void loadCorners(const std::array<Vec3, 8>& corners, P3 (&c)[8])
+{
+  for (int v = 0; v < 8; ++v)
+  {
+    c[v] = toP3(corners[v]);
+  }
+}
+
+inline void loadFace(const std::array<Vec3, 4>& corners, P3 (&q)[4])
+{
+  for (int v = 0; v < 4; ++v)
+  {
+    q[v] = toP3(corners[v]);
   }
 }
 } // namespace
@@ -798,7 +1283,8 @@ Vec3 hexCentre(const std::array<Vec3, 8>& corners)
 void quadAreaAndCentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
   Vec3& area, Vec3& centre)
 {
-  const FaceGeometry face = quadFace(toP3(a), toP3(b), toP3(c), toP3(d));
+  const P3 q[4] = { toP3(a), toP3(b), toP3(c), toP3(d) };
+  const FaceGeometry<double> face = scalarFace(q);
   area = toVec3(face.area);
   centre = toVec3(face.centre);
 }
@@ -806,9 +1292,8 @@ void quadAreaAndCentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& 
 double faceNonOrthogonality(const Vec3& ownerCentre, const Vec3& neighbourCentre,
   const Vec3& faceArea)
 {
-  const P3 area = toP3(faceArea);
-  return angleFromCosine(orthogonalityCosine(
-    toP3(neighbourCentre) - toP3(ownerCentre), area, std::sqrt(dot(area, area))));
+  return angleFromCosine(
+    orthogonalityCosine(toP3(neighbourCentre) - toP3(ownerCentre), toP3(faceArea)));
 }
 
 double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre,
@@ -833,28 +1318,19 @@ double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea,
 double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre,
   const Vec3& faceArea, const Vec3& faceCentre, const std::array<Vec3, 4>& faceCorners)
 {
-  FaceGeometry face;
-  face.area = toP3(faceArea);
-  face.centre = toP3(faceCentre);
-  face.areaMagnitude = faceArea.norm();
-  face.collapsed = false;
-  const P3 corners[4] = { toP3(faceCorners[0]), toP3(faceCorners[1]), toP3(faceCorners[2]),
-    toP3(faceCorners[3]) };
+  P3 q[4];
+  loadFace(faceCorners, q);
   const P3 owner = toP3(ownerCentre);
-  return skewness(owner, toP3(neighbourCentre) - owner, 0.2, face, corners);
+  return skewness(owner, toP3(neighbourCentre) - owner, 0.2, toP3(faceArea),
+    toP3(faceCentre), q);
 }
 
 double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea,
   const Vec3& faceCentre, const std::array<Vec3, 4>& faceCorners)
 {
-  FaceGeometry face;
-  face.area = toP3(faceArea);
-  face.centre = toP3(faceCentre);
-  face.areaMagnitude = faceArea.norm();
-  face.collapsed = false;
-  const P3 corners[4] = { toP3(faceCorners[0]), toP3(faceCorners[1]), toP3(faceCorners[2]),
-    toP3(faceCorners[3]) };
-  return boundarySkewness(toP3(ownerCentre), face, corners);
+  P3 q[4];
+  loadFace(faceCorners, q);
+  return boundarySkewness(toP3(ownerCentre), toP3(faceArea), toP3(faceCentre), q);
 }
 
 std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBlock>& blocks,
@@ -883,10 +1359,10 @@ std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBl
   reporter.start();
   const InterfaceTable interfaces = matchBlockInterfaces(views);
   std::vector<CellQualityArrays> quality(blocks.size());
-  std::vector<double> centres;
+  std::vector<double> scratch;
   for (std::size_t n = 0; n < blocks.size(); ++n)
   {
-    evaluateBlock(views, static_cast<int>(n), interfaces, quality[n], centres, reporter);
+    evaluateBlock(views, static_cast<int>(n), interfaces, quality[n], scratch, reporter);
   }
   reporter.finish();
   return quality;

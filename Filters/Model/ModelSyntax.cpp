@@ -205,7 +205,10 @@ void checkKeys(const std::vector<MapEntry>& entries, const std::vector<std::stri
   {
     if (std::find(allowed.begin(), allowed.end(), entry.key) == allowed.end())
     {
-      std::string what = "unknown key '" + entry.key + "'";
+      // A misplaced comment or text block can make a long key: keep the message short.
+      std::string shown = entry.key.substr(0, 60) + (entry.key.size() > 60 ? "..." : "");
+      std::replace(shown.begin(), shown.end(), '\n', ' ');
+      std::string what = "unknown key '" + shown + "'";
       const std::string suggestion = closestName(entry.key, allowed);
       if (!suggestion.empty())
       {

@@ -15,12 +15,14 @@ from .BlockForgeFilters import (  # noqa: F401
     vtkBlockMesher,
     vtkBlockTemplateSource,
     vtkGridQuality,
+    vtkTurboPointSetsReader,
 )
 
 __all__ = [
     "vtkBlockMesher",
     "vtkBlockTemplateSource",
     "vtkGridQuality",
+    "vtkTurboPointSetsReader",
     "mesh_template",
     "MIN_ANGLE_CLASSES",
 ]

@@ -502,3 +502,44 @@ TEST(Mesher, Misuse)
   EXPECT_THROW(mesher.meshBlock(4, xyz.data()), std::out_of_range);
   EXPECT_NO_THROW(mesher.meshBlock(3, xyz.data()));
 }
+
+TEST(Mesher, SplineAndThroughArcEdges)
+{
+  // One unit box whose bottom front edge bows out as a spline and whose bottom back edge is
+  // an arc through a third point; both are symmetric, so their arc-length midpoints are
+  // known.
+  const std::string text = R"yaml(blockforge: 1
+vertices:
+  a0: [0, 0, 0]
+  a1: [1, 0, 0]
+  a2: [1, 1, 0]
+  a3: [0, 1, 0]
+  a4: [0, 0, 1]
+  a5: [1, 0, 1]
+  a6: [1, 1, 1]
+  a7: [0, 1, 1]
+edges:
+  bow: {spline: [a1, a0], points: [[0.75, -0.08, 0], [0.5, -0.1, 0], [0.25, -0.08, 0]]}
+  hump: {arc: [a3, a2], through: [0.5, 1.2, 0]}
+blocks:
+  box: {vertices: [a0, a1, a2, a3, a4, a5, a6, a7], cells: [4, 3, 2]}
+)yaml";
+  const BlockModel model = parseTemplate(text, "edges.yaml");
+  const auto grids = meshAll(model);
+  const BlockGrid& g = grids[0];
+  // Spline, defined from a1 to a0 (against the block's i direction).
+  EXPECT_LT((g.node(2, 0, 0) - Vec3(0.5, -0.1, 0)).norm(), 1e-9);
+  EXPECT_LT((g.node(1, 0, 0) - Vec3(1 - g.node(3, 0, 0).x(), g.node(3, 0, 0).y(), 0)).norm(), 1e-9);
+  // Arc through (0.5, 1.2, 0): centre (0.5, y0) with 0.25 + (1 - y0)^2 = (1.2 - y0)^2.
+  const double y0 = (1.44 - 1.0 - 0.25) / (2 * 0.2);
+  const double radius = 1.2 - y0;
+  EXPECT_LT((g.node(2, g.nj - 1, 0) - Vec3(0.5, 1.2, 0)).norm(), 1e-12);
+  for (int i = 0; i < g.ni; ++i)
+  {
+    EXPECT_NEAR((g.node(i, g.nj - 1, 0) - Vec3(0.5, y0, 0)).norm(), radius, 1e-12);
+  }
+  for (double v : g.xyz)
+  {
+    ASSERT_TRUE(std::isfinite(v));
+  }
+}

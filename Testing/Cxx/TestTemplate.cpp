@@ -531,6 +531,14 @@ TEST(TemplateErrors, NamedEdgeInMessage)
   expectTwoBoxesError(text, "  right:", "block 'right'", { "edge 'seam' (a1-a2)", "'left'" });
 }
 
+TEST(TemplateErrors, FaceSharedByThreeBlocks)
+{
+  const std::string text = replaced(TwoBoxes, "patches:",
+    "  again:\n    vertices: [a1, b1, b2, a2, a5, b5, b6, a6]\n    cells: [n, n, n]\npatches:");
+  expectTwoBoxesError(text, "  again:", "block 'again'",
+    { "face again.i0 is also a face of left.i1, right.i0", "at most two blocks" });
+}
+
 TEST(TemplateErrors, InsideOutBlock)
 {
   const std::string text = replaced(
