@@ -144,8 +144,9 @@ int vtkTurboPointSetsReader::RequestData(
   vtkNew<vtkMultiBlockDataSet> result;
   try
   {
-    const blockforge::io::TurboPointSets sets = blockforge::io::readTurboPointSets(
-      text(this->FileName), options, [this](double fraction) { this->UpdateProgress(0.8 * fraction); });
+    const blockforge::io::TurboPointSets sets =
+      blockforge::io::readTurboPointSets(text(this->FileName), options,
+        [this](double fraction) { this->UpdateProgress(0.8 * fraction); });
     for (const auto& warning : sets.warnings)
     {
       vtkWarningMacro(<< warning);

@@ -985,7 +985,9 @@ public:
     , plane_(static_cast<long>(view.ni) * view.nj)
     , layerCells_(static_cast<long>(view.ci) * view.cj)
   {
-    scratch.assign(16 * plane_ + 6 * layerCells_, 0.0);
+    // 2 node planes (x, y, z), i- and j-edges of both (length2, inverse), k-edges
+    // between them, 2 layers of cell centres (x, y, z).
+    scratch.assign(2 * 3 * plane_ + 2 * 2 * 2 * plane_ + 2 * plane_ + 2 * 3 * layerCells_, 0.0);
     double* buffer = scratch.data();
     auto take = [&buffer](long count) {
       double* start = buffer;

@@ -247,7 +247,8 @@ ClassifiedLine classify(const std::string& raw, const std::string& file, int lin
   if (text.compare(0, 2, "##") == 0)
   {
     result.kind = LineKind::Title;
-    result.title = trim(text.substr(text.find_first_not_of('#')));
+    const std::size_t start = text.find_first_not_of('#');
+    result.title = start == std::string::npos ? std::string() : trim(text.substr(start));
     return result;
   }
   if (text[0] == '#')
@@ -702,16 +703,15 @@ bool parseAxis(const std::string& text, Eigen::Vector3d& axis, std::string& name
 {
   std::string value = upper(trim(text));
   // "Z axis", "Z-axis", "Z_AXIS"
-  for (const char* suffix : { "AXIS" })
+  const std::string tail = "AXIS";
+  if (value.size() > tail.size() &&
+    value.compare(value.size() - tail.size(), tail.size(), tail) == 0)
   {
-    const std::string tail(suffix);
-    if (value.size() > tail.size() && value.compare(value.size() - tail.size(), tail.size(), tail) == 0)
+    value = value.substr(0, value.size() - tail.size());
+    while (!value.empty() &&
+      (isBlank(value.back()) || value.back() == '-' || value.back() == '_'))
     {
-      value = value.substr(0, value.size() - tail.size());
-      while (!value.empty() && (isBlank(value.back()) || value.back() == '-' || value.back() == '_'))
-      {
-        value.pop_back();
-      }
+      value.pop_back();
     }
   }
   std::string sign;
@@ -905,8 +905,8 @@ std::vector<ProfileSection> readPointFile(const std::string& path, bool sections
     return { all };
   }
 
-  if (result.empty() ||
-    std::all_of(result.begin(), result.end(), [](const ProfileSection& s) { return s.points.empty(); }))
+  if (result.empty() || std::all_of(result.begin(), result.end(),
+                          [](const ProfileSection& s) { return s.points.empty(); }))
   {
     throw ReadError(path, 0, "no points (expected rows of X Y Z)");
   }
@@ -1301,8 +1301,8 @@ bool canReadTurboPointSets(const std::string& fileName)
         headerAllowed = false;
         continue;
       }
-      const bool anyNumber = std::any_of(
-        fields.begin(), fields.end(), [&value](const std::string& f) { return parseNumber(f, value); });
+      const bool anyNumber = std::any_of(fields.begin(), fields.end(),
+        [&value](const std::string& f) { return parseNumber(f, value); });
       if (headerAllowed && !anyNumber)
       {
         headerAllowed = false;

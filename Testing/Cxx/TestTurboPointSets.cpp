@@ -414,6 +414,22 @@ TEST_F(TurboPointSetsVariations, BlankLinesSeparateSectionsWithoutHeaders)
   EXPECT_EQ(sets.warnings.size(), 1u);
 }
 
+TEST_F(TurboPointSetsVariations, ByteOrderMarkLoneCarriageReturnsAndBareHashes)
+{
+  const std::string file = write("profile.crv",
+    "\xEF\xBB\xBF##\r#\r# Profile 7 at 12.5 %\r0 0 1\r1 0 1\r2 0 1\r3 0 1\r"
+    "#\tPROFILE\t8\r0 0 2\r1 0 2\r2 0 2\r3 0 2");
+  const auto sections = readPointFile(file, true);
+  ASSERT_EQ(sections.size(), 2u);
+  EXPECT_EQ(sections[0].name, "Profile 7 (12.5%)");
+  EXPECT_EQ(sections[0].firstLine, 3);
+  EXPECT_EQ(sections[0].blade, "");
+  EXPECT_EQ(sections[1].number, 8);
+  EXPECT_FALSE(sections[1].spanGiven);
+  EXPECT_EQ(sections[1].firstLine, 8);
+  EXPECT_EQ(sections[1].points.back(), Eigen::Vector3d(3, 0, 2));
+}
+
 TEST_F(TurboPointSetsVariations, SeveralBladesNamedByDoubleHash)
 {
   const std::string file = write("profile.curve",
@@ -519,7 +535,8 @@ TEST_F(TurboPointSetsErrors, UnknownUnit)
 {
   write("hub.curve", "0 0 1\n1 0 1\n2 0 1\n3 0 1\n");
   const std::string inf = write("BladeGen.inf",
-    "Axis of Rotation: Z\nNumber of Blade Sets: 3\nGeometry Units: furlong\nHub Data File: hub.curve\n");
+    "Axis of Rotation: Z\nNumber of Blade Sets: 3\nGeometry Units: furlong\n"
+    "Hub Data File: hub.curve\n");
   const ReadError error = expectReadError([&] { readTurboPointSets(inf); });
   EXPECT_EQ(error.file(), inf);
   EXPECT_EQ(error.line(), 3);
@@ -551,7 +568,8 @@ TEST_F(TurboPointSetsErrors, BadValuesInTheDescription)
   const std::string axis = write("a.inf", "Hub Data File: hub.curve\nAxis of Rotation: W\n");
   EXPECT_TRUE(contains(expectReadError([&] { readTurboPointSets(axis); }).what(),
     "a.inf:2: unknown axis 'W'"));
-  const std::string blades = write("b.inf", "Number of Blade Sets: many\nHub Data File: hub.curve\n");
+  const std::string blades =
+    write("b.inf", "Number of Blade Sets: many\nHub Data File: hub.curve\n");
   EXPECT_TRUE(contains(expectReadError([&] { readTurboPointSets(blades); }).what(),
     "b.inf:1: blade count 'many' is not a positive whole number"));
   const std::string noColon = write("c.inf", "Hub Data File: hub.curve\nGeometry Units CM\n");

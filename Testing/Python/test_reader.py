@@ -156,7 +156,8 @@ class ReaderTest(unittest.TestCase):
         os.makedirs(OUTPUT, exist_ok=True)
         path = os.path.join(OUTPUT, "reader_tecplot.dat")
         with open(path, "w") as stream:
-            stream.write('TITLE = "t"\nVARIABLES = "X", "Y", "Z"\nZONE I=2, F=POINT\n0 0 0\n1 0 0\n')
+            stream.write('TITLE = "t"\nVARIABLES = "X", "Y", "Z"\n'
+                         'ZONE I=2, F=POINT\n0 0 0\n1 0 0\n')
         reader = OpenDataFile(path)
         self.assertNotEqual(reader.GetXMLLabel(), "Turbo Point Sets Reader")
         Delete(reader)
