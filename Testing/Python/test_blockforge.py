@@ -44,12 +44,13 @@ class ErrorCollector:
 
     def __init__(self, *algorithms):
         self.messages = []
-        for algorithm in algorithms:
-            algorithm.AddObserver(vtkCommand.ErrorEvent, self)
 
-    @calldata_type(VTK_STRING)
-    def __call__(self, _caller, _event, message):
-        self.messages.append(message)
+        @calldata_type(VTK_STRING)
+        def collect(_caller, _event, message):
+            self.messages.append(message)
+
+        for algorithm in algorithms:
+            algorithm.AddObserver(vtkCommand.ErrorEvent, collect)
 
 
 def pipeline(template, parameters=None, density=1.0):

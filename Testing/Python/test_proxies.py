@@ -7,8 +7,7 @@ import sys
 import unittest
 
 from paraview import servermanager
-from paraview.simple import (BlockMesher, BlockTemplateSource, Delete, GetActiveSource,
-                             GridQuality, LoadPlugin, OpenDataFile, SaveData)
+from paraview.simple import Delete, LoadPlugin, OpenDataFile, SaveData
 from paraview.vtk.numpy_interface import dataset_adapter as dsa
 import numpy as np
 
@@ -19,6 +18,7 @@ OUTPUT = os.environ.get("BLOCKFORGE_TEST_OUTPUT", "/tmp/blockforge-test-output")
 CYLINDER = os.path.join(SOURCE, "Templates", "cylinder_in_box.yaml")
 DATA = os.path.join(SOURCE, "Testing", "Data")
 
+# Defines BlockTemplateSource, BlockMesher, GridQuality, ... in this module.
 LoadPlugin(PLUGIN, remote=False, ns=globals())
 
 
