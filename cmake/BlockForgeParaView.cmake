@@ -7,8 +7,8 @@ find_package(MPI REQUIRED COMPONENTS C)
 find_package(ParaView 5.10 REQUIRED COMPONENTS RemotingClientServerStream)
 
 set(BLOCKFORGE_PYTHON_DESTINATION
-  "${CMAKE_INSTALL_LIBDIR}/python${Python3_VERSION_MAJOR}.${Python3_VERSION_MINOR}/site-packages"
-  CACHE STRING "Where the blockforge Python package is installed, relative to the prefix")
+  "lib/python${Python3_VERSION_MAJOR}.${Python3_VERSION_MINOR}/dist-packages"
+  CACHE STRING "Where the blockforge Python package is installed, relative to the prefix (Debian: dist-packages)")
 set(CMAKE_LIBRARY_OUTPUT_DIRECTORY "${CMAKE_BINARY_DIR}/${CMAKE_INSTALL_LIBDIR}")
 set(CMAKE_RUNTIME_OUTPUT_DIRECTORY "${CMAKE_BINARY_DIR}/${CMAKE_INSTALL_BINDIR}")
 set(CMAKE_ARCHIVE_OUTPUT_DIRECTORY "${CMAKE_BINARY_DIR}/${CMAKE_INSTALL_LIBDIR}")
