@@ -93,5 +93,27 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
     }
   }
 }
+
+void meshModel(const model::BlockModel& blockModel, const std::string& document,
+  double densityMultiplier, int cellCap, int piece, int pieceCount,
+  vtkMultiBlockDataSet* output, const std::function<void(double)>& progress)
+{
+  model::MultiBlockMesher mesher(blockModel, densityMultiplier);
+  mesher.setCellCap(cellCap);
+  mesher.computeBoundaries();
+  if (progress)
+  {
+    progress(0.05);
+  }
+  vtkNew<vtkMultiBlockDataSet> grid;
+  fillMultiBlock(blockModel, mesher, grid, piece, pieceCount, [&progress](double fraction) {
+    if (progress)
+    {
+      progress(0.05 + 0.95 * fraction);
+    }
+  });
+  attachModel(grid->GetFieldData(), document);
+  output->ShallowCopy(grid);
+}
 } // namespace vtkglue
 } // namespace blockforge

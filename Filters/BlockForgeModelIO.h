@@ -45,5 +45,14 @@ namespace vtkglue
 void fillMultiBlock(const model::BlockModel& model, const model::MultiBlockMesher& mesher,
   vtkMultiBlockDataSet* output, int piece, int pieceCount,
   const std::function<void(double)>& progress);
+
+/**
+ * Meshes `model` (density multiplier, optional cell cap for previews) into `output`
+ * through fillMultiBlock and attaches `document` to the output's field data. Throws
+ * (TemplateError, GeometryError) on any problem; `output` is only touched on success.
+ */
+void meshModel(const model::BlockModel& model, const std::string& document,
+  double densityMultiplier, int cellCap, int piece, int pieceCount,
+  vtkMultiBlockDataSet* output, const std::function<void(double)>& progress);
 } // namespace vtkglue
 } // namespace blockforge

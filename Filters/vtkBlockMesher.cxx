@@ -2,7 +2,6 @@
 
 #include "BlockForgeModelIO.h"
 
-#include "../Model/Mesher.h"
 #include "../Model/ModelDocument.h"
 
 #include <vtkDataObject.h>
@@ -52,14 +51,8 @@ int vtkBlockMesher::RequestData(
     this->UpdateProgress(0.0);
     const blockforge::model::BlockModel blockModel =
       blockforge::model::readModelDocument(document);
-    blockforge::model::MultiBlockMesher mesher(blockModel, this->DensityMultiplier);
-    mesher.computeBoundaries();
-    this->UpdateProgress(0.05);
-    vtkNew<vtkMultiBlockDataSet> grid;
-    blockforge::vtkglue::fillMultiBlock(blockModel, mesher, grid, piece, pieceCount,
-      [this](double fraction) { this->UpdateProgress(0.05 + 0.95 * fraction); });
-    blockforge::vtkglue::attachModel(grid->GetFieldData(), document);
-    output->ShallowCopy(grid);
+    blockforge::vtkglue::meshModel(blockModel, document, this->DensityMultiplier, 0, piece,
+      pieceCount, output, [this](double fraction) { this->UpdateProgress(fraction); });
   }
   catch (const std::exception& error)
   {

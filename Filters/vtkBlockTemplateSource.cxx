@@ -2,7 +2,6 @@
 
 #include "BlockForgeModelIO.h"
 
-#include "../Model/Mesher.h"
 #include "../Model/ModelDocument.h"
 #include "../Model/Template.h"
 
@@ -102,17 +101,10 @@ int vtkBlockTemplateSource::RequestData(
     this->UpdateProgress(0.0);
     const blockforge::model::BlockModel blockModel =
       blockforge::model::loadTemplate(this->TemplateFile, this->Parameters);
-    this->UpdateProgress(0.2);
-    blockforge::model::MultiBlockMesher mesher(blockModel, 1.0);
-    mesher.setCellCap(this->PreviewCells);
-    mesher.computeBoundaries();
-    this->UpdateProgress(0.4);
-    vtkNew<vtkMultiBlockDataSet> preview;
-    blockforge::vtkglue::fillMultiBlock(blockModel, mesher, preview, piece, pieceCount,
-      [this](double fraction) { this->UpdateProgress(0.4 + 0.6 * fraction); });
+    this->UpdateProgress(0.3);
     const std::string document = blockforge::model::writeModelDocument(blockModel);
-    blockforge::vtkglue::attachModel(preview->GetFieldData(), document);
-    output->ShallowCopy(preview);
+    blockforge::vtkglue::meshModel(blockModel, document, 1.0, this->PreviewCells, piece,
+      pieceCount, output, [this](double fraction) { this->UpdateProgress(0.3 + 0.7 * fraction); });
     this->ModelDocument = document;
   }
   catch (const std::exception& error)

@@ -22,6 +22,9 @@
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace blockforge
 {
@@ -43,7 +46,68 @@ constexpr double degenerateAspectRatio = verdictMax;
 // ---------------------------------------------------------------------------------------
 // Lane arithmetic: the kernels are templates on T = double (one cell) or Pair (two cells).
 
-using Pair = Eigen::Array2d;
+/**
+ * Two doubles processed together: SSE2 (part of every x86-64 CPU) where available,
+ * otherwise a plain pair that compilers vectorise for their target. A tiny type of our
+ * own rather than Eigen::Array2d so that every operation is inlined.
+ */
+struct Pair
+{
+#if defined(__SSE2__)
+  __m128d v;
+  Pair() = default;
+  explicit Pair(__m128d value)
+    : v(value)
+  {
+  }
+  static Pair load(const double* p) { return Pair(_mm_loadu_pd(p)); }
+  static Pair splat(double s) { return Pair(_mm_set1_pd(s)); }
+  void store(double* p) const { _mm_storeu_pd(p, v); }
+  double operator[](int l) const
+  {
+    double out[2];
+    _mm_storeu_pd(out, v);
+    return out[l];
+  }
+  void set(int l, double value)
+  {
+    double out[2];
+    _mm_storeu_pd(out, v);
+    out[l] = value;
+    v = _mm_loadu_pd(out);
+  }
+  friend Pair operator+(const Pair& a, const Pair& b) { return Pair(_mm_add_pd(a.v, b.v)); }
+  friend Pair operator-(const Pair& a, const Pair& b) { return Pair(_mm_sub_pd(a.v, b.v)); }
+  friend Pair operator*(const Pair& a, const Pair& b) { return Pair(_mm_mul_pd(a.v, b.v)); }
+  friend Pair operator/(const Pair& a, const Pair& b) { return Pair(_mm_div_pd(a.v, b.v)); }
+  friend Pair vmin(const Pair& a, const Pair& b) { return Pair(_mm_min_pd(a.v, b.v)); }
+  friend Pair vmax(const Pair& a, const Pair& b) { return Pair(_mm_max_pd(a.v, b.v)); }
+  friend Pair vsqrt(const Pair& a) { return Pair(_mm_sqrt_pd(a.v)); }
+  friend Pair vabs(const Pair& a) { return Pair(_mm_andnot_pd(_mm_set1_pd(-0.0), a.v)); }
+#else
+  double v[2];
+  static Pair load(const double* p) { return { { p[0], p[1] } }; }
+  static Pair splat(double s) { return { { s, s } }; }
+  void store(double* p) const
+  {
+    p[0] = v[0];
+    p[1] = v[1];
+  }
+  double operator[](int l) const { return v[l]; }
+  void set(int l, double value) { v[l] = value; }
+  friend Pair operator+(const Pair& a, const Pair& b) { return { { a.v[0] + b.v[0], a.v[1] + b.v[1] } }; }
+  friend Pair operator-(const Pair& a, const Pair& b) { return { { a.v[0] - b.v[0], a.v[1] - b.v[1] } }; }
+  friend Pair operator*(const Pair& a, const Pair& b) { return { { a.v[0] * b.v[0], a.v[1] * b.v[1] } }; }
+  friend Pair operator/(const Pair& a, const Pair& b) { return { { a.v[0] / b.v[0], a.v[1] / b.v[1] } }; }
+  friend Pair vmin(const Pair& a, const Pair& b) { return { { std::min(a.v[0], b.v[0]), std::min(a.v[1], b.v[1]) } }; }
+  friend Pair vmax(const Pair& a, const Pair& b) { return { { std::max(a.v[0], b.v[0]), std::max(a.v[1], b.v[1]) } }; }
+  friend Pair vsqrt(const Pair& a) { return { { std::sqrt(a.v[0]), std::sqrt(a.v[1]) } }; }
+  friend Pair vabs(const Pair& a) { return { { std::abs(a.v[0]), std::abs(a.v[1]) } }; }
+#endif
+  friend Pair operator*(double s, const Pair& a) { return splat(s) * a; }
+  friend Pair operator/(double s, const Pair& a) { return splat(s) / a; }
+  friend Pair operator+(const Pair& a, double s) { return a + splat(s); }
+};
 
 inline double vmin(double a, double b)
 {
@@ -61,22 +125,6 @@ inline double vsqrt(double a)
 {
   return std::sqrt(a);
 }
-inline Pair vmin(const Pair& a, const Pair& b)
-{
-  return a.min(b);
-}
-inline Pair vmax(const Pair& a, const Pair& b)
-{
-  return a.max(b);
-}
-inline Pair vabs(const Pair& a)
-{
-  return a.abs();
-}
-inline Pair vsqrt(const Pair& a)
-{
-  return a.sqrt();
-}
 
 template <typename T>
 constexpr int laneCount = 1;
@@ -93,7 +141,7 @@ inline double splat<double>(double value)
 template <>
 inline Pair splat<Pair>(double value)
 {
-  return Pair::Constant(value);
+  return Pair::splat(value);
 }
 
 template <typename T>
@@ -106,7 +154,7 @@ inline double loadLanes<double>(const double* p)
 template <>
 inline Pair loadLanes<Pair>(const double* p)
 {
-  return Eigen::Map<const Pair>(p);
+  return Pair::load(p);
 }
 inline void storeLanes(double* p, double v)
 {
@@ -114,24 +162,23 @@ inline void storeLanes(double* p, double v)
 }
 inline void storeLanes(double* p, const Pair& v)
 {
-  Eigen::Map<Pair> target(p);
-  target = v;
+  v.store(p);
 }
-inline double& lane(double& v, int)
+inline double lane(double v, int)
 {
   return v;
-}
-inline double lane(const double& v, int)
-{
-  return v;
-}
-inline double& lane(Pair& v, int l)
-{
-  return v[l];
 }
 inline double lane(const Pair& v, int l)
 {
   return v[l];
+}
+inline void setLane(double& v, int, double value)
+{
+  v = value;
+}
+inline void setLane(Pair& v, int l, double value)
+{
+  v.set(l, value);
 }
 
 template <typename T>
@@ -1134,8 +1181,8 @@ private:
         double cosine2 = 1.0, skew = 0.0;
         internalFaceSpecialCase(
           corners, laneOf(neighbourCentre, l), laneOf(centre, l), cosine2, skew);
-        lane(m.cosine2, l) = cosine2;
-        lane(m.skew, l) = skew;
+        setLane(m.cosine2, l, cosine2);
+        setLane(m.skew, l, skew);
       }
     }
     // Neighbours first: for a Pair, cell i is lane 1's neighbour and lane 0 itself.
