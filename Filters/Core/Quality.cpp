@@ -2,14 +2,14 @@
  * @file Quality.cpp
  * @brief Cell quality of structured hexahedral blocks.
  *
- * The grid pass is written for throughput. Per block it keeps rolling buffers of two
- * node planes in structure-of-arrays form, the squared and inverse lengths of the edges
- * leaving each node (shared by 4 cells) and the centres of two cell layers. Cells are
- * evaluated two at a time in SIMD lanes (Eigen::Array2d: SSE2 on x86-64, scalar code
- * elsewhere); each internal face is evaluated once, by the cell above it, and updates both
- * cells; non-orthogonality is accumulated as a signed squared cosine so that only one
- * root and one acos per cell remain. Rare special cases (collapsed edges or faces,
- * Verdict's degenerate cells) fall back to the literal formulas for that lane only.
+ * The grid pass is written for throughput. Per block it keeps rolling buffers: two node
+ * planes in structure-of-arrays form, the squared and inverse lengths of the edges
+ * leaving each node (each edge is shared by 4 cells) and the centres of two cell layers.
+ * Cells are evaluated several at a time in SIMD lanes (Eigen packets: 2 lanes with SSE2
+ * on x86-64). Each internal face is evaluated once, by the cell above it, and updates
+ * both cells; non-orthogonality is accumulated as a signed squared cosine, so one root
+ * and one acos per cell remain. Rare special cases (collapsed edges or faces, Verdict's
+ * degenerate cells) take the literal formulas, for that lane only.
  */
 #include "Quality.h"
 
@@ -21,9 +21,6 @@
 
 #if defined(__linux__)
 #include <sys/mman.h>
-#endif
-#if defined(__SSE2__)
-#include <emmintrin.h>
 #endif
 
 namespace blockforge
@@ -44,69 +41,44 @@ constexpr double collapsedFaceFraction = 1.0e-12;
 constexpr double degenerateAspectRatio = verdictMax;
 
 // ---------------------------------------------------------------------------------------
-// Lane arithmetic: the kernels are templates on T = double (one cell) or Pair (two cells).
+// Lane arithmetic: the kernels are templates on T = double (one cell) or Lanes (several).
 
 /**
- * Two doubles processed together: SSE2 (part of every x86-64 CPU) where available,
- * otherwise a plain pair that compilers vectorise for their target. A tiny type of our
- * own rather than Eigen::Array2d so that every operation is inlined.
+ * Several cells processed together in one SIMD register: Eigen's packet of doubles for
+ * the build's instruction set (2 lanes with SSE2, which every x86-64 CPU has; 1 lane
+ * when Eigen does not vectorise). A thin wrapper over Eigen's packet primitives rather
+ * than Eigen::Array2d, whose expression templates were not always inlined here.
  */
-struct Pair
+namespace packet = Eigen::internal;
+using Packet = packet::packet_traits<double>::type;
+constexpr int packetLanes = packet::packet_traits<double>::size;
+
+struct Lanes
 {
-#if defined(__SSE2__)
-  __m128d v;
-  Pair() = default;
-  explicit Pair(__m128d value)
-    : v(value)
-  {
-  }
-  static Pair load(const double* p) { return Pair(_mm_loadu_pd(p)); }
-  static Pair splat(double s) { return Pair(_mm_set1_pd(s)); }
-  void store(double* p) const { _mm_storeu_pd(p, v); }
-  double operator[](int l) const
-  {
-    double out[2];
-    _mm_storeu_pd(out, v);
-    return out[l];
-  }
+  Packet v;
+
+  static Lanes load(const double* p) { return { packet::ploadu<Packet>(p) }; }
+  static Lanes splat(double s) { return { packet::pset1<Packet>(s) }; }
+  void store(double* p) const { packet::pstoreu(p, v); }
+  void extract(double (&out)[packetLanes]) const { packet::pstoreu(out, v); }
   void set(int l, double value)
   {
-    double out[2];
-    _mm_storeu_pd(out, v);
+    double out[packetLanes];
+    extract(out);
     out[l] = value;
-    v = _mm_loadu_pd(out);
+    v = packet::ploadu<Packet>(out);
   }
-  friend Pair operator+(const Pair& a, const Pair& b) { return Pair(_mm_add_pd(a.v, b.v)); }
-  friend Pair operator-(const Pair& a, const Pair& b) { return Pair(_mm_sub_pd(a.v, b.v)); }
-  friend Pair operator*(const Pair& a, const Pair& b) { return Pair(_mm_mul_pd(a.v, b.v)); }
-  friend Pair operator/(const Pair& a, const Pair& b) { return Pair(_mm_div_pd(a.v, b.v)); }
-  friend Pair vmin(const Pair& a, const Pair& b) { return Pair(_mm_min_pd(a.v, b.v)); }
-  friend Pair vmax(const Pair& a, const Pair& b) { return Pair(_mm_max_pd(a.v, b.v)); }
-  friend Pair vsqrt(const Pair& a) { return Pair(_mm_sqrt_pd(a.v)); }
-  friend Pair vabs(const Pair& a) { return Pair(_mm_andnot_pd(_mm_set1_pd(-0.0), a.v)); }
-#else
-  double v[2];
-  static Pair load(const double* p) { return { { p[0], p[1] } }; }
-  static Pair splat(double s) { return { { s, s } }; }
-  void store(double* p) const
-  {
-    p[0] = v[0];
-    p[1] = v[1];
-  }
-  double operator[](int l) const { return v[l]; }
-  void set(int l, double value) { v[l] = value; }
-  friend Pair operator+(const Pair& a, const Pair& b) { return { { a.v[0] + b.v[0], a.v[1] + b.v[1] } }; }
-  friend Pair operator-(const Pair& a, const Pair& b) { return { { a.v[0] - b.v[0], a.v[1] - b.v[1] } }; }
-  friend Pair operator*(const Pair& a, const Pair& b) { return { { a.v[0] * b.v[0], a.v[1] * b.v[1] } }; }
-  friend Pair operator/(const Pair& a, const Pair& b) { return { { a.v[0] / b.v[0], a.v[1] / b.v[1] } }; }
-  friend Pair vmin(const Pair& a, const Pair& b) { return { { std::min(a.v[0], b.v[0]), std::min(a.v[1], b.v[1]) } }; }
-  friend Pair vmax(const Pair& a, const Pair& b) { return { { std::max(a.v[0], b.v[0]), std::max(a.v[1], b.v[1]) } }; }
-  friend Pair vsqrt(const Pair& a) { return { { std::sqrt(a.v[0]), std::sqrt(a.v[1]) } }; }
-  friend Pair vabs(const Pair& a) { return { { std::abs(a.v[0]), std::abs(a.v[1]) } }; }
-#endif
-  friend Pair operator*(double s, const Pair& a) { return splat(s) * a; }
-  friend Pair operator/(double s, const Pair& a) { return splat(s) / a; }
-  friend Pair operator+(const Pair& a, double s) { return a + splat(s); }
+  friend Lanes operator+(const Lanes& a, const Lanes& b) { return { packet::padd(a.v, b.v) }; }
+  friend Lanes operator-(const Lanes& a, const Lanes& b) { return { packet::psub(a.v, b.v) }; }
+  friend Lanes operator*(const Lanes& a, const Lanes& b) { return { packet::pmul(a.v, b.v) }; }
+  friend Lanes operator/(const Lanes& a, const Lanes& b) { return { packet::pdiv(a.v, b.v) }; }
+  friend Lanes operator*(double s, const Lanes& a) { return splat(s) * a; }
+  friend Lanes operator/(double s, const Lanes& a) { return splat(s) / a; }
+  friend Lanes operator+(const Lanes& a, double s) { return a + splat(s); }
+  friend Lanes vmin(const Lanes& a, const Lanes& b) { return { packet::pmin(a.v, b.v) }; }
+  friend Lanes vmax(const Lanes& a, const Lanes& b) { return { packet::pmax(a.v, b.v) }; }
+  friend Lanes vsqrt(const Lanes& a) { return { packet::psqrt(a.v) }; }
+  friend Lanes vabs(const Lanes& a) { return { packet::pabs(a.v) }; }
 };
 
 inline double vmin(double a, double b)
@@ -129,7 +101,7 @@ inline double vsqrt(double a)
 template <typename T>
 constexpr int laneCount = 1;
 template <>
-constexpr int laneCount<Pair> = 2;
+constexpr int laneCount<Lanes> = packetLanes;
 
 template <typename T>
 T splat(double value);
@@ -139,9 +111,9 @@ inline double splat<double>(double value)
   return value;
 }
 template <>
-inline Pair splat<Pair>(double value)
+inline Lanes splat<Lanes>(double value)
 {
-  return Pair::splat(value);
+  return Lanes::splat(value);
 }
 
 template <typename T>
@@ -152,31 +124,32 @@ inline double loadLanes<double>(const double* p)
   return *p;
 }
 template <>
-inline Pair loadLanes<Pair>(const double* p)
+inline Lanes loadLanes<Lanes>(const double* p)
 {
-  return Pair::load(p);
+  return Lanes::load(p);
 }
 inline void storeLanes(double* p, double v)
 {
   *p = v;
 }
-inline void storeLanes(double* p, const Pair& v)
+inline void storeLanes(double* p, const Lanes& v)
 {
   v.store(p);
 }
-inline double lane(double v, int)
+/// All lanes of a value as plain doubles.
+inline void extractLanes(double v, double (&out)[1])
 {
-  return v;
+  out[0] = v;
 }
-inline double lane(const Pair& v, int l)
+inline void extractLanes(const Lanes& v, double (&out)[packetLanes])
 {
-  return v[l];
+  v.extract(out);
 }
 inline void setLane(double& v, int, double value)
 {
   v = value;
 }
-inline void setLane(Pair& v, int l, double value)
+inline void setLane(Lanes& v, int l, double value)
 {
   v.set(l, value);
 }
@@ -230,7 +203,11 @@ inline V3<T> loadV3(const double* x, const double* y, const double* z)
 template <typename T>
 inline P3 laneOf(const V3<T>& v, int l)
 {
-  return { lane(v.x, l), lane(v.y, l), lane(v.z, l) };
+  double x[laneCount<T>], y[laneCount<T>], z[laneCount<T>];
+  extractLanes(v.x, x);
+  extractLanes(v.y, y);
+  extractLanes(v.z, z);
+  return { x[l], y[l], z[l] };
 }
 inline P3 load(const double* p)
 {
@@ -261,8 +238,8 @@ inline double angleFromCosine(double c)
 constexpr int edgeEnds[12][2] = { { 0, 1 }, { 1, 2 }, { 3, 2 }, { 0, 3 }, { 4, 5 }, { 5, 6 },
   { 7, 6 }, { 4, 7 }, { 0, 4 }, { 1, 5 }, { 2, 6 }, { 3, 7 } };
 // vtkHexahedron's faces.
-constexpr int hexFaces[6][4] = { { 0, 4, 7, 3 }, { 1, 2, 6, 5 }, { 0, 1, 5, 4 },
-  { 3, 7, 6, 2 }, { 0, 3, 2, 1 }, { 4, 5, 6, 7 } };
+constexpr int hexFaces[6][4] = { { 0, 4, 7, 3 }, { 1, 2, 6, 5 }, { 0, 1, 5, 4 }, { 3, 7, 6, 2 },
+  { 0, 3, 2, 1 }, { 4, 5, 6, 7 } };
 
 struct CellShape
 {
@@ -367,8 +344,8 @@ inline ShapeSums<T> shapeKernel(
 /// Face angles of a cell with collapsed edges: each face loses its collapsed edges and
 /// the angles are taken between the remaining consecutive edges (a triangle for one
 /// collapsed edge); faces left with fewer than 3 edges have no angles.
-void collapsedCellAngles(const P3 (&c)[8], double collapsedLength2, double& minAngle,
-  double& maxAngle)
+void collapsedCellAngles(
+  const P3 (&c)[8], double collapsedLength2, double& minAngle, double& maxAngle)
 {
   double minCos = 2.0, maxCos = -2.0;
   for (const auto& face : hexFaces)
@@ -411,23 +388,45 @@ void collapsedCellAngles(const P3 (&c)[8], double collapsedLength2, double& minA
   maxAngle = angleFromCosine(minCos);
 }
 
+/// The kernel's sums as one ShapeSums<double> per lane.
+template <typename T>
+inline void splitLanes(const ShapeSums<T>& sums, ShapeSums<double> (&out)[laneCount<T>])
+{
+  double values[laneCount<T>];
+  auto split = [&](const T& value, double ShapeSums<double>::*member)
+  {
+    extractLanes(value, values);
+    for (int l = 0; l < laneCount<T>; ++l)
+    {
+      out[l].*member = values[l];
+    }
+  };
+  split(sums.minCos, &ShapeSums<double>::minCos);
+  split(sums.maxCos, &ShapeSums<double>::maxCos);
+  split(sums.minCornerJacobian, &ShapeSums<double>::minCornerJacobian);
+  split(sums.centreJacobian, &ShapeSums<double>::centreJacobian);
+  split(sums.shortest2, &ShapeSums<double>::shortest2);
+  split(sums.longest2, &ShapeSums<double>::longest2);
+  split(sums.shortestAxis2, &ShapeSums<double>::shortestAxis2);
+  split(sums.narrowest, &ShapeSums<double>::narrowest);
+  split(sums.widest, &ShapeSums<double>::widest);
+}
+
 /**
- * Finishes one lane. The scaled Jacobian is Verdict's hex_scaled_jacobian (VTK 9.2):
- * the minimum of the 8 corner Jacobians and the centre Jacobian, each divided by the
- * lengths of its three vectors; a squared length at or below 1e-30 (any edge or efg
- * vector) makes it 1e30, and it is clamped to +-1e30.
+ * Finishes lane l. The scaled Jacobian is Verdict's hex_scaled_jacobian (VTK 9.2): the
+ * minimum of the 8 corner Jacobians and the centre Jacobian, each divided by the lengths
+ * of its three vectors; a squared length at or below 1e-30 (any edge or efg vector)
+ * makes it 1e30, and it is clamped to +-1e30.
  */
 template <typename T>
-inline CellShape finishShape(const ShapeSums<T>& sums, int l, const V3<T> (&c)[8])
+inline CellShape finishShape(const ShapeSums<double>& sums, const V3<T> (&c)[8], int l)
 {
   CellShape shape;
-  const double shortest2 = lane(sums.shortest2, l);
-  const double collapsedLength2 =
-    collapsedEdgeFraction * collapsedEdgeFraction * lane(sums.longest2, l);
-  if (shortest2 > collapsedLength2)
+  const double collapsedLength2 = collapsedEdgeFraction * collapsedEdgeFraction * sums.longest2;
+  if (sums.shortest2 > collapsedLength2)
   {
-    shape.minAngle = angleFromCosine(lane(sums.maxCos, l));
-    shape.maxAngle = angleFromCosine(lane(sums.minCos, l));
+    shape.minAngle = angleFromCosine(sums.maxCos);
+    shape.maxAngle = angleFromCosine(sums.minCos);
   }
   else
   {
@@ -438,19 +437,17 @@ inline CellShape finishShape(const ShapeSums<T>& sums, int l, const V3<T> (&c)[8
     }
     collapsedCellAngles(corners, collapsedLength2, shape.minAngle, shape.maxAngle);
   }
-  if (shortest2 <= verdictMin || lane(sums.shortestAxis2, l) <= verdictMin)
+  if (sums.shortest2 <= verdictMin || sums.shortestAxis2 <= verdictMin)
   {
     shape.scaledJacobian = verdictMax;
   }
   else
   {
-    const double jacobian =
-      std::min(lane(sums.minCornerJacobian, l), lane(sums.centreJacobian, l));
+    const double jacobian = std::min(sums.minCornerJacobian, sums.centreJacobian);
     shape.scaledJacobian =
       jacobian > 0 ? std::min(jacobian, verdictMax) : std::max(jacobian, -verdictMax);
   }
-  const double narrowest = lane(sums.narrowest, l);
-  shape.aspectRatio = narrowest > 0.0 ? lane(sums.widest, l) / narrowest : degenerateAspectRatio;
+  shape.aspectRatio = sums.narrowest > 0.0 ? sums.widest / sums.narrowest : degenerateAspectRatio;
   return shape;
 }
 
@@ -464,7 +461,7 @@ CellShape evaluateCellShape(const P3 (&c)[8])
     length2[n] = dot(e[n], e[n]);
     inverseLength[n] = length2[n] > 0.0 ? 1.0 / std::sqrt(length2[n]) : 0.0;
   }
-  return finishShape(shapeKernel(e, length2, inverseLength), 0, c);
+  return finishShape(shapeKernel(e, length2, inverseLength), c, 0);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -477,10 +474,10 @@ struct FaceGeometry
 {
   V3<T> area;
   V3<T> centre;
-  T area2;        ///< |area|^2
-  T diagonals2;   ///< sum of the squared diagonals (the face's size)
-  T weightSum;    ///< sum of the projected triangle weights
-  V3<T> average;  ///< point average (OpenFOAM's fallback centre)
+  T area2;       ///< |area|^2
+  T diagonals2;  ///< sum of the squared diagonals (the face's size)
+  T weightSum;   ///< sum of the projected triangle weights
+  V3<T> average; ///< point average (OpenFOAM's fallback centre)
 };
 
 /**
@@ -488,7 +485,8 @@ struct FaceGeometry
  * the centre weights each triangle centre by its area projected on the face normal.
  * Corners are taken relative to the average, q_k = p_k - average, where each fan
  * triangle's area vector is simply q_k x q_k+1; the projection weights are kept
- * unnormalised (n_k . sum n), which divides out. Branch-free: check faceUsable.
+ * unnormalised (n_k . sum n), which divides out. Branch-free: see scalarFace and
+ * usableLanes for the degenerate cases.
  */
 template <typename T>
 inline FaceGeometry<T> quadFace(const V3<T> (&p)[4])
@@ -522,7 +520,8 @@ inline bool faceCollapsed(double area2, double diagonals2)
 FaceGeometry<double> scalarFace(const P3 (&p)[4])
 {
   FaceGeometry<double> face = quadFace(p);
-  if (!(face.weightSum > 0.0 && face.weightSum * face.weightSum > 4.0 * vSmall * vSmall * face.area2))
+  if (!(face.weightSum > 0.0 &&
+        face.weightSum * face.weightSum > 4.0 * vSmall * vSmall * face.area2))
   {
     face.centre = face.average;
   }
@@ -538,8 +537,8 @@ inline double orthogonalityCosine(const P3& ownerToNeighbour, const P3& area)
 
 /// OpenFOAM's skewness of a face with the given owner-to-neighbour vector `d`
 /// (meshCheck::faceSkewness; boundaryFaceSkewness passes the projected d and 0.4).
-inline double skewness(const P3& ownerCentre, const P3& d, double distanceFactor,
-  const P3& area, const P3& centre, const P3 (&corners)[4])
+inline double skewness(const P3& ownerCentre, const P3& d, double distanceFactor, const P3& area,
+  const P3& centre, const P3 (&corners)[4])
 {
   const P3 ownerToFace = centre - ownerCentre;
   const double along = dot(area, ownerToFace) / (dot(area, d) + rootVSmall);
@@ -584,7 +583,7 @@ struct FaceMeasures
  * Skewness is OpenFOAM's |sv| / fd rewritten with sv' = (S.d) sv, which avoids forming
  * sv and its unit vector:
  *   |sv| / max(0.2 |d|, max_k |sv^.r_k|) = |sv'|^2 / (|S.d| max(0.2 |d||sv'|, max_k |sv'.r_k|)).
- * Branch-free; internalFaceUsable says whether a lane needs the literal formulas.
+ * Branch-free; usableLanes says which lanes need the literal formulas.
  */
 template <typename T>
 inline FaceMeasures<T> internalFaceKernel(const V3<T> (&q)[4], const FaceGeometry<T>& face,
@@ -609,8 +608,8 @@ inline FaceMeasures<T> internalFaceKernel(const V3<T> (&q)[4], const FaceGeometr
 }
 
 /// The literal formulas for the lanes the kernel cannot handle; true if the face counts.
-bool internalFaceSpecialCase(const P3 (&q)[4], const P3& ownerCentre,
-  const P3& neighbourCentre, double& cosine2, double& skew)
+bool internalFaceSpecialCase(
+  const P3 (&q)[4], const P3& ownerCentre, const P3& neighbourCentre, double& cosine2, double& skew)
 {
   const FaceGeometry<double> face = scalarFace(q);
   if (faceCollapsed(face.area2, face.diagonals2))
@@ -623,16 +622,76 @@ bool internalFaceSpecialCase(const P3 (&q)[4], const P3& ownerCentre,
   return true;
 }
 
-/// Checks one lane of the kernel's result: a usable face with S.d and sv' away from 0
-/// and a regular centre.
+/// Lanes (bits) where the kernel's result holds: a usable face with S.d and sv' away
+/// from 0 and a regular centre; the others take internalFaceSpecialCase.
 template <typename T>
-inline bool internalFaceUsable(const FaceGeometry<T>& face, const FaceMeasures<T>& m, int l)
+inline int usableLanes(const FaceGeometry<T>& face, const FaceMeasures<T>& m)
 {
-  const double area2 = lane(face.area2, l);
-  const double weightSum = lane(face.weightSum, l);
-  return !faceCollapsed(area2, lane(face.diagonals2, l)) &&
-    std::abs(lane(m.areaDotD, l)) >= 1e-100 && lane(m.sv2, l) > 0.0 && weightSum > 0.0 &&
-    weightSum * weightSum > 4.0 * vSmall * vSmall * area2;
+  constexpr int lanes = laneCount<T>;
+  double area2[lanes], diagonals2[lanes], weightSum[lanes], areaDotD[lanes], sv2[lanes];
+  extractLanes(face.area2, area2);
+  extractLanes(face.diagonals2, diagonals2);
+  extractLanes(face.weightSum, weightSum);
+  extractLanes(m.areaDotD, areaDotD);
+  extractLanes(m.sv2, sv2);
+  int usable = 0;
+  for (int l = 0; l < lanes; ++l)
+  {
+    if (!faceCollapsed(area2[l], diagonals2[l]) && std::abs(areaDotD[l]) >= 1e-100 &&
+      sv2[l] > 0.0 && weightSum[l] > 0.0 &&
+      weightSum[l] * weightSum[l] > 4.0 * vSmall * vSmall * area2[l])
+    {
+      usable |= 1 << l;
+    }
+  }
+  return usable;
+}
+
+// ---------------------------------------------------------------------------------------
+// Memory
+
+/**
+ * Fresh memory is first-touched page by page, and page faults can cost as much as the
+ * whole quality computation (about 10 us per 4 KiB page on some virtual machines).
+ * prefault() prepares a range with two Linux hints: transparent huge pages for its
+ * 2 MiB-aligned interior, then one prefault of the whole range, which costs far less
+ * than faulting page by page. Neither changes memory contents; both are advisory (older
+ * kernels, or other systems, simply skip them).
+ */
+void prefault(std::uintptr_t begin, std::uintptr_t end)
+{
+#if defined(__linux__)
+  constexpr std::uintptr_t smallPage = 4096;
+  constexpr std::uintptr_t hugePage = std::uintptr_t(1) << 21;
+  constexpr int populateWrite = 23; // MADV_POPULATE_WRITE (Linux 5.14), absent from older headers
+  if (end - begin < 16 * smallPage)
+  {
+    return; // not worth two system calls
+  }
+#if defined(MADV_HUGEPAGE)
+  const std::uintptr_t hugeBegin = (begin + hugePage - 1) & ~(hugePage - 1);
+  const std::uintptr_t hugeEnd = end & ~(hugePage - 1);
+  if (hugeEnd > hugeBegin)
+  {
+    madvise(reinterpret_cast<void*>(hugeBegin), hugeEnd - hugeBegin, MADV_HUGEPAGE);
+  }
+#endif
+  const std::uintptr_t pageBegin = begin & ~(smallPage - 1);
+  const std::uintptr_t pageEnd = (end + smallPage - 1) & ~(smallPage - 1);
+  madvise(reinterpret_cast<void*>(pageBegin), pageEnd - pageBegin, populateWrite);
+#else
+  (void)begin;
+  (void)end;
+#endif
+}
+
+/// Reserves a vector's storage and prefaults it.
+template <typename Value>
+void reservePrefaulted(std::vector<Value>& values, std::size_t count)
+{
+  values.reserve(count);
+  const auto begin = reinterpret_cast<std::uintptr_t>(values.data());
+  prefault(begin, begin + sizeof(Value) * values.capacity());
 }
 
 // ---------------------------------------------------------------------------------------
@@ -735,59 +794,53 @@ struct BlockView
   }
 };
 
-/// Boundary face identity: its four corners sorted, with -0.0 folded onto +0.0 so that
-/// comparing bits equals comparing values.
-struct FaceKey
+/// Order-independent hash of a face's corners (a sum of per-corner hashes), with -0.0
+/// folded onto +0.0 so that equal coordinates hash equally.
+std::uint64_t hashFaceCorners(const P3 (&q)[4])
 {
-  double v[12];
-  bool operator==(const FaceKey& o) const { return std::memcmp(v, o.v, sizeof(v)) == 0; }
-};
-
-inline bool lexicographicLess(const P3& a, const P3& b)
-{
-  if (a.x != b.x)
+  auto mix = [](double value)
   {
-    return a.x < b.x;
-  }
-  if (a.y != b.y)
-  {
-    return a.y < b.y;
-  }
-  return a.z < b.z;
-}
-
-FaceKey makeFaceKey(const P3 (&q)[4])
-{
-  P3 sorted[4] = { q[0], q[1], q[2], q[3] };
-  for (P3& p : sorted)
-  {
-    p.x += 0.0;
-    p.y += 0.0;
-    p.z += 0.0;
-  }
-  std::sort(sorted, sorted + 4, lexicographicLess);
-  FaceKey key;
-  for (int m = 0; m < 4; ++m)
-  {
-    key.v[3 * m] = sorted[m].x;
-    key.v[3 * m + 1] = sorted[m].y;
-    key.v[3 * m + 2] = sorted[m].z;
-  }
-  return key;
-}
-
-std::uint64_t hashFaceKey(const FaceKey& key)
-{
-  std::uint64_t h = 0x9E3779B97F4A7C15ull;
-  for (double value : key.v)
-  {
+    value += 0.0;
     std::uint64_t bits;
     std::memcpy(&bits, &value, sizeof(bits));
-    h ^= bits + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
-    h *= 0xBF58476D1CE4E5B9ull;
-    h ^= h >> 31;
+    bits ^= bits >> 31;
+    bits *= 0xBF58476D1CE4E5B9ull;
+    bits ^= bits >> 29;
+    return bits;
+  };
+  std::uint64_t sum = 0;
+  for (const P3& p : q)
+  {
+    std::uint64_t h = mix(p.x);
+    h = (h ^ mix(p.y)) * 0x94D049BB133111EBull;
+    h = (h ^ mix(p.z)) * 0x9E3779B97F4A7C15ull;
+    sum += h ^ (h >> 32);
   }
-  return h;
+  return sum;
+}
+
+/// Same 4 corners as multisets, coordinates compared exactly.
+bool sameCorners(const P3* a, const P3* b)
+{
+  auto equal = [](const P3& p, const P3& q)
+  {
+    return p.x == q.x && p.y == q.y && p.z == q.z;
+  };
+  for (int n = 0; n < 4; ++n)
+  {
+    const P3& p = a[n];
+    int inA = 0, inB = 0;
+    for (int m = 0; m < 4; ++m)
+    {
+      inA += equal(p, a[m]);
+      inB += equal(p, b[m]);
+    }
+    if (inA != inB)
+    {
+      return false;
+    }
+  }
+  return true;
 }
 
 struct BoundaryFaceRef
@@ -796,70 +849,96 @@ struct BoundaryFaceRef
 };
 
 /**
- * All block-boundary faces of the grid and, for each, the index of the coincident face
- * (another block's, or the same block's across a seam) or a marker: unmatched faces are
- * true boundaries, collapsed faces (no normal) are ignored altogether.
+ * All block-boundary faces of the grid, numbered block by block, side by side, and for
+ * each the index of the coincident face (another block's, or the same block's across a
+ * seam) or -1 for a true boundary.
  */
 struct InterfaceTable
 {
   static constexpr long unmatched = -1;
-  static constexpr long collapsed = -2;
 
-  std::vector<BoundaryFaceRef> faces;
   std::vector<long> partner;
-  std::vector<std::array<long, 6>> sideOffset; // per block, first face of each side
+  std::vector<long> sideOffset; // first face of each (block, side), block-major
 
   long index(int block, int side, int a, int b, const BlockView& view) const
   {
-    return sideOffset[block][side] + a + static_cast<long>(view.sideWidth(side)) * b;
+    return sideOffset[6 * block + side] + a + static_cast<long>(view.sideWidth(side)) * b;
+  }
+  BoundaryFaceRef face(long index, const std::vector<BlockView>& views) const
+  {
+    // The last (block, side) starting at or before index: sides without faces share
+    // their offset with the next side, so they are never the last one.
+    const auto found = std::upper_bound(sideOffset.begin(), sideOffset.end(), index) - 1;
+    const long blockSide = found - sideOffset.begin();
+    const int block = static_cast<int>(blockSide / 6), side = static_cast<int>(blockSide % 6);
+    const long local = index - *found;
+    const int width = views[block].sideWidth(side);
+    return { block, side, static_cast<int>(local % width), static_cast<int>(local / width) };
   }
 };
 
+/**
+ * Pairs boundary faces whose four corners coincide exactly. Order-independent hashes of
+ * the corners are sorted (deterministic). Two faces alone with a hash are paired
+ * provisionally: the boundary pass, which reads both faces' corners anyway, confirms
+ * them bit for bit (a face's true partner has the same hash, so a pair that fails has no
+ * partner at all). Larger groups are resolved here on the corners: a face pairs only
+ * when exactly one other face has its corners; more would be an ambiguous, non-manifold
+ * contact (or collapsed faces along a wedge's axis, which the boundary pass skips).
+ */
 InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
 {
   InterfaceTable table;
-  table.sideOffset.resize(views.size());
+  table.sideOffset.resize(6 * views.size());
+  long count = 0;
   for (std::size_t blockIndex = 0; blockIndex < views.size(); ++blockIndex)
   {
     const BlockView& view = views[blockIndex];
     for (int side = 0; side < 6; ++side)
     {
-      table.sideOffset[blockIndex][side] = static_cast<long>(table.faces.size());
-      if (view.cellCount == 0)
+      table.sideOffset[6 * blockIndex + side] = count;
+      if (view.cellCount > 0)
       {
-        continue;
+        count += static_cast<long>(view.sideWidth(side)) * view.sideHeight(side);
       }
+    }
+  }
+  reservePrefaulted(table.partner, count);
+  table.partner.assign(count, InterfaceTable::unmatched);
+
+  std::vector<std::pair<std::uint64_t, long>> hashed;
+  reservePrefaulted(hashed, count);
+  for (std::size_t blockIndex = 0; blockIndex < views.size(); ++blockIndex)
+  {
+    const BlockView& view = views[blockIndex];
+    if (view.cellCount == 0)
+    {
+      continue;
+    }
+    for (int side = 0; side < 6; ++side)
+    {
       for (int b = 0; b < view.sideHeight(side); ++b)
       {
         for (int a = 0; a < view.sideWidth(side); ++a)
         {
-          table.faces.push_back({ static_cast<int>(blockIndex), side, a, b });
+          P3 q[4];
+          int cellIjk[3];
+          view.sideFace(side, a, b, q, cellIjk);
+          hashed.emplace_back(
+            hashFaceCorners(q), table.index(static_cast<int>(blockIndex), side, a, b, view));
         }
       }
     }
   }
-
-  const long count = static_cast<long>(table.faces.size());
-  table.partner.assign(count, InterfaceTable::unmatched);
-  std::vector<std::pair<std::uint64_t, long>> hashed;
-  hashed.reserve(count);
-  for (long n = 0; n < count; ++n)
-  {
-    const BoundaryFaceRef& ref = table.faces[n];
-    P3 q[4];
-    int cellIjk[3];
-    views[ref.block].sideFace(ref.side, ref.a, ref.b, q, cellIjk);
-    const FaceGeometry<double> face = quadFace(q);
-    if (faceCollapsed(face.area2, face.diagonals2))
-    {
-      table.partner[n] = InterfaceTable::collapsed;
-      continue;
-    }
-    hashed.emplace_back(hashFaceKey(makeFaceKey(q)), n);
-  }
   std::sort(hashed.begin(), hashed.end());
 
-  std::vector<FaceKey> groupKeys;
+  auto corners = [&](long index, P3(&q)[4])
+  {
+    const BoundaryFaceRef ref = table.face(index, views);
+    int cellIjk[3];
+    views[ref.block].sideFace(ref.side, ref.a, ref.b, q, cellIjk);
+  };
+  std::vector<std::array<P3, 4>> group;
   for (std::size_t first = 0; first < hashed.size();)
   {
     std::size_t last = first + 1;
@@ -867,25 +946,26 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     {
       ++last;
     }
-    if (last - first >= 2)
+    if (last - first == 2)
     {
-      // Same hash: pair faces whose sorted corners are identical, and only when exactly
-      // two faces share those corners (more would be an ambiguous, non-manifold contact).
-      groupKeys.clear();
-      for (std::size_t m = first; m < last; ++m)
+      table.partner[hashed[first].second] = hashed[first + 1].second;
+      table.partner[hashed[first + 1].second] = hashed[first].second;
+    }
+    else if (last - first > 2)
+    {
+      group.resize(last - first);
+      for (std::size_t m = 0; m < group.size(); ++m)
       {
-        const BoundaryFaceRef& ref = table.faces[hashed[m].second];
         P3 q[4];
-        int cellIjk[3];
-        views[ref.block].sideFace(ref.side, ref.a, ref.b, q, cellIjk);
-        groupKeys.push_back(makeFaceKey(q));
+        corners(hashed[first + m].second, q);
+        std::copy(q, q + 4, group[m].begin());
       }
-      for (std::size_t m = 0; m < groupKeys.size(); ++m)
+      for (std::size_t m = 0; m < group.size(); ++m)
       {
         std::size_t equalCount = 0, other = m;
-        for (std::size_t n = 0; n < groupKeys.size(); ++n)
+        for (std::size_t n = 0; n < group.size(); ++n)
         {
-          if (n != m && groupKeys[n] == groupKeys[m])
+          if (n != m && sameCorners(group[m].data(), group[n].data()))
           {
             ++equalCount;
             other = n;
@@ -946,32 +1026,47 @@ private:
   double reported_ = 0.0;
 };
 
-/**
- * Sizes a result array. Large arrays are first-touched here, and with 4 KiB pages the
- * page faults can cost as much as the whole quality computation (about 10 us each on
- * some virtual machines); asking for transparent huge pages removes most of them.
- * Purely advisory: without THP support the call fails and nothing changes.
- */
-void allocateCellArray(std::vector<double>& values, long count, double initial)
+/// Reserves all result arrays up front, so that arrays the allocator placed next to
+/// each other (small blocks) are prefaulted as one span.
+void reserveResultArrays(
+  std::vector<CellQualityArrays>& quality, const std::vector<BlockView>& views)
 {
-  values.clear();
-  values.reserve(count);
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  constexpr std::uintptr_t hugePage = std::uintptr_t(1) << 21;
-  const auto begin = reinterpret_cast<std::uintptr_t>(values.data());
-  const std::uintptr_t end = begin + sizeof(double) * static_cast<std::uintptr_t>(count);
-  const std::uintptr_t alignedBegin = (begin + hugePage - 1) & ~(hugePage - 1);
-  const std::uintptr_t alignedEnd = end & ~(hugePage - 1);
-  if (alignedEnd > alignedBegin)
+  struct Range
   {
-    madvise(reinterpret_cast<void*>(alignedBegin), alignedEnd - alignedBegin, MADV_HUGEPAGE);
+    std::uintptr_t begin, end;
+  };
+  std::vector<Range> ranges;
+  for (std::size_t n = 0; n < views.size(); ++n)
+  {
+    CellQualityArrays& q = quality[n];
+    for (std::vector<double>* values : { &q.minAngle, &q.maxAngle, &q.nonOrthogonality, &q.skewness,
+           &q.aspectRatio, &q.scaledJacobian })
+    {
+      values->reserve(views[n].cellCount);
+      const auto begin = reinterpret_cast<std::uintptr_t>(values->data());
+      ranges.push_back({ begin, begin + sizeof(double) * values->capacity() });
+    }
   }
-#endif
-  values.assign(count, initial);
+  std::sort(
+    ranges.begin(), ranges.end(), [](const Range& a, const Range& b) { return a.begin < b.begin; });
+  constexpr std::uintptr_t allocatorGap = 4096; // headers between neighbouring blocks
+  for (std::size_t first = 0; first < ranges.size();)
+  {
+    std::uintptr_t spanEnd = ranges[first].end;
+    std::size_t last = first + 1;
+    while (last < ranges.size() && ranges[last].begin <= spanEnd + allocatorGap)
+    {
+      spanEnd = std::max(spanEnd, ranges[last].end);
+      ++last;
+    }
+    prefault(ranges[first].begin, spanEnd);
+    first = last;
+  }
 }
 
-/// Node plane k in structure-of-arrays form, so that neighbouring cells load as lanes.
-struct NodePlane
+/// Points in structure-of-arrays form (a node plane, a layer of cell centres), so that
+/// neighbouring cells load as SIMD lanes.
+struct CoordinateArrays
 {
   double *x, *y, *z;
 };
@@ -992,7 +1087,7 @@ void invertLengths(EdgeLengths edges, long count)
   inverse = (squared > 0.0).select(inverse, 0.0);
 }
 
-void loadPlane(const BlockView& view, int k, NodePlane plane)
+void loadPlane(const BlockView& view, int k, CoordinateArrays plane)
 {
   const long count = static_cast<long>(view.ni) * view.nj;
   const double* p = view.node(0, 0, k);
@@ -1005,8 +1100,8 @@ void loadPlane(const BlockView& view, int k, NodePlane plane)
 }
 
 /// Edge lengths of vectors b[n + offset] - a[n] for n < count - offset; the rest 0.
-void edgeLengths(const NodePlane& a, const NodePlane& b, long offset, long count,
-  EdgeLengths edges)
+void edgeLengths(
+  const CoordinateArrays& a, const CoordinateArrays& b, long offset, long count, EdgeLengths edges)
 {
   for (long n = 0; n + offset < count; ++n)
   {
@@ -1034,9 +1129,16 @@ public:
   {
     // 2 node planes (x, y, z), i- and j-edges of both (length2, inverse), k-edges
     // between them, 2 layers of cell centres (x, y, z).
-    scratch.assign(2 * 3 * plane_ + 2 * 2 * 2 * plane_ + 2 * plane_ + 2 * 3 * layerCells_, 0.0);
+    const long size = 2 * 3 * plane_ + 2 * 2 * 2 * plane_ + 2 * plane_ + 2 * 3 * layerCells_;
+    if (scratch.capacity() < static_cast<std::size_t>(size))
+    {
+      scratch = std::vector<double>();
+      reservePrefaulted(scratch, size);
+    }
+    scratch.assign(size, 0.0);
     double* buffer = scratch.data();
-    auto take = [&buffer](long count) {
+    auto take = [&buffer](long count)
+    {
       double* start = buffer;
       buffer += count;
       return start;
@@ -1076,14 +1178,14 @@ public:
     for (int j = 0; j < view_.cj; ++j)
     {
       j_ = j;
-      // Cell 0 has no lower i-face, so pairs start at cell 1.
+      // Cell 0 has no lower i-face, so SIMD groups start at cell 1.
       cells<double>(0);
       int i = 1;
-      for (; i + 1 < view_.ci; i += 2)
+      for (; i + packetLanes <= view_.ci; i += packetLanes)
       {
-        cells<Pair>(i);
+        cells<Lanes>(i);
       }
-      if (i < view_.ci)
+      for (; i < view_.ci; ++i)
       {
         cells<double>(i);
       }
@@ -1097,26 +1199,27 @@ private:
     edgeLengths(planes_[p], planes_[p], view_.ni, plane_, jEdges_[p]);
   }
 
-  /// Cells (i, j_, k_) and, for a Pair, (i + 1, j_, k_).
+  /// Cells (i, j_, k_) to (i + lanes - 1, j_, k_).
   template <typename T>
   void cells(int i)
   {
     constexpr int lanes = laneCount<T>;
     const long n00 = i + static_cast<long>(view_.ni) * j_; // node (i, j) in a plane
     const long n10 = n00 + 1, n01 = n00 + view_.ni, n11 = n01 + 1;
-    const NodePlane& lowerPlane = planes_[lower_];
-    const NodePlane& upperPlane = planes_[upper_];
-    auto corner = [](const NodePlane& plane, long n) {
+    const CoordinateArrays& lowerPlane = planes_[lower_];
+    const CoordinateArrays& upperPlane = planes_[upper_];
+    auto corner = [](const CoordinateArrays& plane, long n)
+    {
       return loadV3<T>(plane.x + n, plane.y + n, plane.z + n);
     };
-    const V3<T> c[8] = { corner(lowerPlane, n00), corner(lowerPlane, n10),
-      corner(lowerPlane, n11), corner(lowerPlane, n01), corner(upperPlane, n00),
-      corner(upperPlane, n10), corner(upperPlane, n11), corner(upperPlane, n01) };
+    const V3<T> c[8] = { corner(lowerPlane, n00), corner(lowerPlane, n10), corner(lowerPlane, n11),
+      corner(lowerPlane, n01), corner(upperPlane, n00), corner(upperPlane, n10),
+      corner(upperPlane, n11), corner(upperPlane, n01) };
     V3<T> e[12];
     edgeVectors(c, e);
     const EdgeLengths edge[12] = { iEdges_[lower_], jEdges_[lower_], iEdges_[lower_],
-      jEdges_[lower_], iEdges_[upper_], jEdges_[upper_], iEdges_[upper_], jEdges_[upper_],
-      kEdges_, kEdges_, kEdges_, kEdges_ };
+      jEdges_[lower_], iEdges_[upper_], jEdges_[upper_], iEdges_[upper_], jEdges_[upper_], kEdges_,
+      kEdges_, kEdges_, kEdges_ };
     const long edgeStart[12] = { n00, n10, n01, n00, n00, n10, n01, n00, n00, n10, n11, n01 };
     T length2[12], inverseLength[12];
     for (int n = 0; n < 12; ++n)
@@ -1124,11 +1227,12 @@ private:
       length2[n] = loadLanes<T>(edge[n].length2 + edgeStart[n]);
       inverseLength[n] = loadLanes<T>(edge[n].inverseLength + edgeStart[n]);
     }
-    const ShapeSums<T> sums = shapeKernel(e, length2, inverseLength);
+    ShapeSums<double> sums[lanes];
+    splitLanes(shapeKernel(e, length2, inverseLength), sums);
     const long cell = view_.cell(i, j_, k_);
     for (int l = 0; l < lanes; ++l)
     {
-      const CellShape shape = finishShape(sums, l, c);
+      const CellShape shape = finishShape(sums[l], c, l);
       quality_.minAngle[cell + l] = shape.minAngle;
       quality_.maxAngle[cell + l] = shape.maxAngle;
       quality_.scaledJacobian[cell + l] = shape.scaledJacobian;
@@ -1138,7 +1242,7 @@ private:
     const V3<T> centre =
       0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7])));
     const long inLayer = i + static_cast<long>(view_.ci) * j_;
-    const NodePlane& centres = centres_[k_ % 2];
+    const CoordinateArrays& centres = centres_[k_ % 2];
     storeLanes(centres.x + inLayer, centre.x);
     storeLanes(centres.y + inLayer, centre.y);
     storeLanes(centres.z + inLayer, centre.z);
@@ -1162,16 +1266,17 @@ private:
   }
 
   template <typename T>
-  void lowerFace(const V3<T> (&q)[4], const NodePlane& neighbourCentres, long neighbourInLayer,
-    long neighbour, const V3<T>& centre, long cell)
+  void lowerFace(const V3<T> (&q)[4], const CoordinateArrays& neighbourCentres,
+    long neighbourInLayer, long neighbour, const V3<T>& centre, long cell)
   {
     const V3<T> neighbourCentre = loadV3<T>(neighbourCentres.x + neighbourInLayer,
       neighbourCentres.y + neighbourInLayer, neighbourCentres.z + neighbourInLayer);
     const FaceGeometry<T> face = quadFace(q);
     FaceMeasures<T> m = internalFaceKernel(q, face, neighbourCentre, centre);
-    for (int l = 0; l < laneCount<T>; ++l)
+    const int usable = usableLanes(face, m);
+    for (int l = 0; usable != (1 << laneCount<T>)-1 && l < laneCount<T>; ++l)
     {
-      if (!internalFaceUsable(face, m, l))
+      if (!(usable & (1 << l)))
       {
         P3 corners[4];
         for (int n = 0; n < 4; ++n)
@@ -1185,7 +1290,7 @@ private:
         setLane(m.skew, l, skew);
       }
     }
-    // Neighbours first: for a Pair, cell i is lane 1's neighbour and lane 0 itself.
+    // Neighbours first: along i, lane l's neighbour is lane l - 1.
     for (long target : { neighbour, cell })
     {
       storeLanes(minCosine2_ + target, vmin(loadLanes<T>(minCosine2_ + target), m.cosine2));
@@ -1196,9 +1301,9 @@ private:
   const BlockView& view_;
   CellQualityArrays& quality_;
   const long plane_, layerCells_;
-  NodePlane planes_[2];
+  CoordinateArrays planes_[2];
   EdgeLengths iEdges_[2], jEdges_[2], kEdges_;
-  NodePlane centres_[2];
+  CoordinateArrays centres_[2];
   double* minCosine2_;
   double* maxSkewness_;
   int lower_ = 0, upper_ = 1, j_ = 0, k_ = 0;
@@ -1218,27 +1323,35 @@ void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
       for (int a = 0; a < view.sideWidth(side); ++a)
       {
         const long partner = interfaces.partner[interfaces.index(blockIndex, side, a, b, view)];
-        if (partner == InterfaceTable::collapsed)
-        {
-          continue;
-        }
         P3 q[4];
         int ijk[3];
         view.sideFace(side, a, b, q, ijk);
         const FaceGeometry<double> face = scalarFace(q);
+        if (faceCollapsed(face.area2, face.diagonals2))
+        {
+          continue; // no normal, e.g. along a wedge's axis
+        }
         const P3 outward = lowerSide ? -1.0 * face.area : face.area;
         const long owner = view.cell(ijk[0], ijk[1], ijk[2]);
         const P3 ownerCentre = view.cellCentre(ijk[0], ijk[1], ijk[2]);
         double& minCosine2 = quality.nonOrthogonality[owner];
         double& maxSkewness = quality.skewness[owner];
+        const BlockView* otherView = nullptr;
+        P3 otherCorners[4];
+        int otherIjk[3];
         if (partner >= 0)
         {
-          const BoundaryFaceRef& other = interfaces.faces[partner];
-          const BlockView& otherView = views[other.block];
-          P3 otherCorners[4];
-          int otherIjk[3];
-          otherView.sideFace(other.side, other.a, other.b, otherCorners, otherIjk);
-          const P3 d = otherView.cellCentre(otherIjk[0], otherIjk[1], otherIjk[2]) - ownerCentre;
+          const BoundaryFaceRef other = interfaces.face(partner, views);
+          otherView = &views[other.block];
+          otherView->sideFace(other.side, other.a, other.b, otherCorners, otherIjk);
+          if (!sameCorners(q, otherCorners))
+          {
+            otherView = nullptr; // hashes collided: a true boundary face
+          }
+        }
+        if (otherView)
+        {
+          const P3 d = otherView->cellCentre(otherIjk[0], otherIjk[1], otherIjk[2]) - ownerCentre;
           minCosine2 = std::min(minCosine2, signedSquare(orthogonalityCosine(d, outward)));
           maxSkewness =
             std::max(maxSkewness, skewness(ownerCentre, d, 0.2, outward, face.centre, q));
@@ -1259,12 +1372,12 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
 {
   const BlockView& view = views[blockIndex];
   const long cellCount = view.cellCount;
-  allocateCellArray(quality.minAngle, cellCount, 0.0);
-  allocateCellArray(quality.maxAngle, cellCount, 0.0);
-  allocateCellArray(quality.nonOrthogonality, cellCount, 1.0); // signed squared cosine first
-  allocateCellArray(quality.skewness, cellCount, 0.0);
-  allocateCellArray(quality.aspectRatio, cellCount, 0.0);
-  allocateCellArray(quality.scaledJacobian, cellCount, 0.0);
+  quality.minAngle.assign(cellCount, 0.0);
+  quality.maxAngle.assign(cellCount, 0.0);
+  quality.nonOrthogonality.assign(cellCount, 1.0); // signed squared cosine until the end
+  quality.skewness.assign(cellCount, 0.0);
+  quality.aspectRatio.assign(cellCount, 0.0);
+  quality.scaledJacobian.assign(cellCount, 0.0);
   if (cellCount == 0)
   {
     return;
@@ -1329,8 +1442,8 @@ Vec3 hexCentre(const std::array<Vec3, 8>& corners)
   return toVec3(0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7]))));
 }
 
-void quadAreaAndCentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
-  Vec3& area, Vec3& centre)
+void quadAreaAndCentre(
+  const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Vec3& area, Vec3& centre)
 {
   const P3 q[4] = { toP3(a), toP3(b), toP3(c), toP3(d) };
   const FaceGeometry<double> face = scalarFace(q);
@@ -1338,15 +1451,15 @@ void quadAreaAndCentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& 
   centre = toVec3(face.centre);
 }
 
-double faceNonOrthogonality(const Vec3& ownerCentre, const Vec3& neighbourCentre,
-  const Vec3& faceArea)
+double faceNonOrthogonality(
+  const Vec3& ownerCentre, const Vec3& neighbourCentre, const Vec3& faceArea)
 {
   return angleFromCosine(
     orthogonalityCosine(toP3(neighbourCentre) - toP3(ownerCentre), toP3(faceArea)));
 }
 
-double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre,
-  const Vec3& faceArea, const Vec3& faceCentre)
+double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre, const Vec3& faceArea,
+  const Vec3& faceCentre)
 {
   const P3 owner = toP3(ownerCentre);
   const P3 d = toP3(neighbourCentre) - owner;
@@ -1356,34 +1469,32 @@ double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre,
   return std::sqrt(dot(sv, sv)) / (std::sqrt(dot(d, d)) + rootVSmall);
 }
 
-double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea,
-  const Vec3& faceCentre)
+double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea, const Vec3& faceCentre)
 {
   const Vec3 normal = faceArea / (faceArea.norm() + rootVSmall);
   const Vec3 mirrored = ownerCentre + 2.0 * normal * normal.dot(faceCentre - ownerCentre);
   return faceSkewness(ownerCentre, mirrored, faceArea, faceCentre);
 }
 
-double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre,
-  const Vec3& faceArea, const Vec3& faceCentre, const std::array<Vec3, 4>& faceCorners)
+double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre, const Vec3& faceArea,
+  const Vec3& faceCentre, const std::array<Vec3, 4>& faceCorners)
 {
   P3 q[4];
   loadFace(faceCorners, q);
   const P3 owner = toP3(ownerCentre);
-  return skewness(owner, toP3(neighbourCentre) - owner, 0.2, toP3(faceArea),
-    toP3(faceCentre), q);
+  return skewness(owner, toP3(neighbourCentre) - owner, 0.2, toP3(faceArea), toP3(faceCentre), q);
 }
 
-double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea,
-  const Vec3& faceCentre, const std::array<Vec3, 4>& faceCorners)
+double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea, const Vec3& faceCentre,
+  const std::array<Vec3, 4>& faceCorners)
 {
   P3 q[4];
   loadFace(faceCorners, q);
   return boundarySkewness(toP3(ownerCentre), toP3(faceArea), toP3(faceCentre), q);
 }
 
-std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBlock>& blocks,
-  const std::function<void(double)>& progress)
+std::vector<CellQualityArrays> computeGridQuality(
+  const std::vector<StructuredBlock>& blocks, const std::function<void(double)>& progress)
 {
   std::vector<BlockView> views;
   views.reserve(blocks.size());
@@ -1393,8 +1504,8 @@ std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBl
     const StructuredBlock& block = blocks[n];
     if (block.ni < 0 || block.nj < 0 || block.nk < 0)
     {
-      throw GeometryError("grid quality: block " + std::to_string(n) +
-        " has a negative node count");
+      throw GeometryError(
+        "grid quality: block " + std::to_string(n) + " has a negative node count");
     }
     views.emplace_back(block);
     if (views.back().cellCount > 0 && !block.xyz)
@@ -1408,6 +1519,7 @@ std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBl
   reporter.start();
   const InterfaceTable interfaces = matchBlockInterfaces(views);
   std::vector<CellQualityArrays> quality(blocks.size());
+  reserveResultArrays(quality, views);
   std::vector<double> scratch;
   for (std::size_t n = 0; n < blocks.size(); ++n)
   {

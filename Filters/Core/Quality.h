@@ -16,7 +16,8 @@
 namespace blockforge
 {
 /// Smallest and largest corner angle of the 6 quadrilateral faces (24 angles), degrees.
-/// Degenerate faces (a collapsed edge) count as triangles; collapsed faces are skipped.
+/// Degenerate faces (a collapsed edge: shorter than 1e-14 of the cell's longest edge)
+/// count as triangles; collapsed faces are skipped; a cell with no face left gets 0, 180.
 void hexFaceAngles(const std::array<Vec3, 8>& corners, double& minAngle, double& maxAngle);
 
 /// Verdict's hex scaled Jacobian (as vtkMeshQuality::HexScaledJacobian): the minimum of
@@ -24,13 +25,16 @@ void hexFaceAngles(const std::array<Vec3, 8>& corners, double& minAngle, double&
 /// negative for an inverted cell.
 double hexScaledJacobian(const std::array<Vec3, 8>& corners);
 
-/// Longest over shortest of the cell's three mean widths (mean of 4 parallel edges).
+/// Longest over shortest of the cell's three mean widths (mean of 4 parallel edges);
+/// 1e30 when a width is zero.
 double hexAspectRatio(const std::array<Vec3, 8>& corners);
 
 /// Cell centre (mean of the corners, as OpenFOAM's cell centre for a planar hex).
 Vec3 hexCentre(const std::array<Vec3, 8>& corners);
 
-/// Face area vector (sum of the triangle fan about the face centre) and face centre.
+/// Face area vector (sum of the triangle fan about the face centre) and face centre,
+/// as OpenFOAM's face::areaAndCentre: fan about the corners' average, centre weighted
+/// by the triangle areas projected on the face normal.
 void quadAreaAndCentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
   Vec3& area, Vec3& centre);
 
@@ -41,11 +45,12 @@ double faceNonOrthogonality(const Vec3& ownerCentre, const Vec3& neighbourCentre
 
 /// OpenFOAM's face skewness: distance from the face centre to the point where the
 /// owner-neighbour line crosses the face plane, over the owner-neighbour distance.
+/// (checkMesh normalises differently; see the overload taking the face corners.)
 double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre,
   const Vec3& faceArea, const Vec3& faceCentre);
 
-/// OpenFOAM's boundary-face skewness (neighbour replaced by the face centre mirrored
-/// along the face normal).
+/// OpenFOAM's boundary-face skewness (neighbour replaced by the owner centre mirrored
+/// through the face plane).
 double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea,
   const Vec3& faceCentre);
 

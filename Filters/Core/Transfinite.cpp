@@ -68,8 +68,8 @@ void copyBoundary(const BlockFaces& faces, int ni, int nj, int nk, double* out)
   {
     double* layer = out + 3 * plane * k;
     std::memcpy(layer, faces.t0(0, k), sizeof(double) * 3 * ni);
-    std::memcpy(layer + 3 * static_cast<long>(ni) * (nj - 1), faces.t1(0, k),
-      sizeof(double) * 3 * ni);
+    std::memcpy(
+      layer + 3 * static_cast<long>(ni) * (nj - 1), faces.t1(0, k), sizeof(double) * 3 * ni);
     for (int j = 1; j < nj - 1; ++j)
     {
       double* row = layer + 3 * static_cast<long>(ni) * j;
@@ -81,14 +81,16 @@ void copyBoundary(const BlockFaces& faces, int ni, int nj, int nk, double* out)
 
 /**
  * Interior when every direction is separable: s = s(i), t = t(j), u = u(k). Eq. 6 is
- * regrouped so that everything independent of i is formed once per (j, k) line:
- *   P = A + s (B - A) + C2(i) + t D(i) + F4(i, j) + u G(i, j)
- * with A, B the s-face terms plus the t/u-edge and vertex terms that carry (1-s) or s,
- * C2 = F2 - t-independent part of the s-edges, D = (F3 - ...) - C2, G = F5 - F4.
- * The innermost loop then reads four contiguous rows and writes one.
+ * regrouped so that only three-term blends remain per node:
+ *   P = A + s (B - A) + L(i) + t (H(i) - L(i)) + F4(i, j) + u (F5(i, j) - F4(i, j))
+ *   L = F2(i, k) - [(1-u) E0(i) + u E4(i)],   H = F3(i, k) - [(1-u) E2(i) + u E6(i)]
+ *   A = F0(j, k) - [(1-u) E3(j) + u E7(j)] - [(1-t) E8(k) + t E11(k)] + vertex terms of (1-s)
+ *   B = F1(j, k) - [(1-u) E1(j) + u E5(j)] - [(1-t) E9(k) + t E10(k)] + vertex terms of s
+ * A and B are formed once per (j, k) line, L and H once per k-layer, F5 - F4 once per
+ * block; the innermost loop over i reads four contiguous rows and writes one.
  */
-void interiorSeparable(const BlockFaces& F, const std::array<const double*, 12>& params,
-  int ni, int nj, int nk, double* out)
+void interiorSeparable(const BlockFaces& F, const std::array<const double*, 12>& params, int ni,
+  int nj, int nk, double* out)
 {
   const double* sOfI = params[0];
   const double* tOfJ = params[3];
@@ -163,8 +165,8 @@ void interiorSeparable(const BlockFaces& F, const std::array<const double*, 12>&
       {
         const double s = sOfI[i];
         const int n = 3 * i;
-        row[n] = A[0] + s * BminusA[0] + tBlendBase[n] + t * tBlendSlope[n] + bottom[n] +
-          u * slope[n];
+        row[n] =
+          A[0] + s * BminusA[0] + tBlendBase[n] + t * tBlendSlope[n] + bottom[n] + u * slope[n];
         row[n + 1] = A[1] + s * BminusA[1] + tBlendBase[n + 1] + t * tBlendSlope[n + 1] +
           bottom[n + 1] + u * slope[n + 1];
         row[n + 2] = A[2] + s * BminusA[2] + tBlendBase[n + 2] + t * tBlendSlope[n + 2] +
@@ -186,8 +188,8 @@ void interiorSeparable(const BlockFaces& F, const std::array<const double*, 12>&
  * edges, so a handful of sweeps reach round-off for any sensible grading. The sweep
  * count is bounded so the result is deterministic.
  */
-void interiorCoupled(const BlockFaces& F, const std::array<const double*, 12>& p, int ni,
-  int nj, int nk, double* out)
+void interiorCoupled(
+  const BlockFaces& F, const std::array<const double*, 12>& p, int ni, int nj, int nk, double* out)
 {
   constexpr int maxSweeps = 50;
   constexpr double tolerance = 1e-15;
@@ -248,11 +250,11 @@ void interiorCoupled(const BlockFaces& F, const std::array<const double*, 12>& p
         const double* U1 = F.u1(i, j);
         for (int c = 0; c < 3; ++c)
         {
-          const double faces = s1 * S0[c] + s * S1[c] + t1 * T0[c] + t * T1[c] + u1 * U0[c] +
-            u * U1[c];
-          const double edges = t1 * u1 * E0[c] + t * u1 * E2[c] + t1 * u * E4[c] +
-            t * u * E6[c] + s1 * u1 * E3[c] + s * u1 * E1[c] + s1 * u * E7[c] + s * u * E5[c] +
-            s1 * t1 * E8[c] + s * t1 * E9[c] + s1 * t * E11[c] + s * t * E10[c];
+          const double faces =
+            s1 * S0[c] + s * S1[c] + t1 * T0[c] + t * T1[c] + u1 * U0[c] + u * U1[c];
+          const double edges = t1 * u1 * E0[c] + t * u1 * E2[c] + t1 * u * E4[c] + t * u * E6[c] +
+            s1 * u1 * E3[c] + s * u1 * E1[c] + s1 * u * E7[c] + s * u * E5[c] + s1 * t1 * E8[c] +
+            s * t1 * E9[c] + s1 * t * E11[c] + s * t * E10[c];
           const double vertices = s1 * t1 * u1 * V[0][c] + s * t1 * u1 * V[1][c] +
             s * t * u1 * V[2][c] + s1 * t * u1 * V[3][c] + s1 * t1 * u * V[4][c] +
             s * t1 * u * V[5][c] + s * t * u * V[6][c] + s1 * t * u * V[7][c];
@@ -345,8 +347,8 @@ void transfiniteBlock(const BlockBoundary& boundary, int ni, int nj, int nk, dou
     throw GeometryError("transfinite block: no output buffer");
   }
 
-  BlockFaces faces{ { boundary.faces[0], boundary.faces[1], boundary.faces[2],
-                      boundary.faces[3], boundary.faces[4], boundary.faces[5] },
+  BlockFaces faces{ { boundary.faces[0], boundary.faces[1], boundary.faces[2], boundary.faces[3],
+                      boundary.faces[4], boundary.faces[5] },
     ni, nj };
   copyBoundary(faces, ni, nj, nk, out);
   if (ni < 3 || nj < 3 || nk < 3)

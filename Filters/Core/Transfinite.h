@@ -59,7 +59,10 @@ struct BlockBoundary
  * from the faces) and 8 vertices. When the four parallel edges in a direction share the
  * same parameters the interpolation variables are separable and the loop is the fast
  * path; otherwise (s, t, u) of each node solve the coupled bilinear blends of the edge
- * parameters. Degenerate blocks (collapsed edges or faces) need no special treatment.
+ * parameters (a few Gauss-Seidel sweeps from the edge averages, see Transfinite.cpp).
+ * Degenerate blocks (collapsed edges or faces) need no special treatment. Where faces
+ * share nodes (block edges and vertices), faces 4/5 are copied over 2/3 and those over
+ * 0/1; faces built from the same edge arrays agree there bit for bit anyway.
  * `out` holds ni * nj * nk * 3 doubles.
  */
 void transfiniteBlock(const BlockBoundary& boundary, int ni, int nj, int nk, double* out);

@@ -19,8 +19,8 @@ using Corners = std::array<Vec3, 8>;
 
 Corners unitCube()
 {
-  return { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0), Vec3(0, 0, 1),
-    Vec3(1, 0, 1), Vec3(1, 1, 1), Vec3(0, 1, 1) };
+  return { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 0, 1),
+    Vec3(1, 1, 1), Vec3(0, 1, 1) };
 }
 
 /// Unit cube whose top face is shifted by tan(angle) along x.
@@ -106,7 +106,8 @@ TEST(Quality, UnitCube)
 
 TEST(Quality, CartesianGridIsPerfect)
 {
-  const Grid g = makeGrid(5, 4, 3, [](int i, int j, int k) { return Vec3(0.5 * i, 0.25 * j, 2.0 * k); });
+  const Grid g =
+    makeGrid(5, 4, 3, [](int i, int j, int k) { return Vec3(0.5 * i, 0.25 * j, 2.0 * k); });
   const auto q = computeGridQuality({ g.block() });
   ASSERT_EQ(q[0].nonOrthogonality.size(), 4u * 3u * 2u);
   for (std::size_t c = 0; c < q[0].nonOrthogonality.size(); ++c)
@@ -157,9 +158,12 @@ TEST(Quality, NonOrthogonalityAndSkewnessAcrossBlockInterface)
 {
   const double shift = 0.4;
   const double expectedAngle = std::atan(shift / 2) * degrees;
-  const Grid single = makeGrid(3, 2, 2, [=](int i, int j, int k) { return twoCellNode(i, j, k, shift); });
-  const Grid left = makeGrid(2, 2, 2, [=](int i, int j, int k) { return twoCellNode(i, j, k, shift); });
-  const Grid right = makeGrid(2, 2, 2, [=](int i, int j, int k) { return twoCellNode(i + 1, j, k, shift); });
+  const Grid single =
+    makeGrid(3, 2, 2, [=](int i, int j, int k) { return twoCellNode(i, j, k, shift); });
+  const Grid left =
+    makeGrid(2, 2, 2, [=](int i, int j, int k) { return twoCellNode(i, j, k, shift); });
+  const Grid right =
+    makeGrid(2, 2, 2, [=](int i, int j, int k) { return twoCellNode(i + 1, j, k, shift); });
 
   const auto one = computeGridQuality({ single.block() });
   const auto two = computeGridQuality({ left.block(), right.block() });
@@ -175,6 +179,14 @@ TEST(Quality, NonOrthogonalityAndSkewnessAcrossBlockInterface)
   EXPECT_NEAR(two[1].skewness[0], one[0].skewness[1], 1e-14);
   // The far face of the second cell is a boundary face: |sv| = shift / 2 over 0.5.
   EXPECT_NEAR(one[0].skewness[1], std::max(shift / 2 / 0.5, shift / 2), 1e-14);
+
+  // A block without cells between them changes nothing.
+  const Grid flat = makeGrid(3, 3, 1, [](int i, int j, int) { return Vec3(i, j, 5.0); });
+  const auto withEmpty = computeGridQuality({ left.block(), flat.block(), right.block() });
+  ASSERT_EQ(withEmpty.size(), 3u);
+  EXPECT_TRUE(withEmpty[1].minAngle.empty());
+  EXPECT_EQ(withEmpty[0].nonOrthogonality, two[0].nonOrthogonality);
+  EXPECT_EQ(withEmpty[2].skewness, two[1].skewness);
 
   // Interfaces match bit for bit only: a face one ulp away is a boundary.
   Grid moved = right;
@@ -202,7 +214,8 @@ TEST(Quality, FaceFunctions)
   const Vec3 owner(0.5, 0.5, 0.5), neighbour(1.5, 0.7, 0.5);
   const Vec3 faceArea(1, 0, 0), faceCentre(1, 0.5, 0.5);
   const std::array<Vec3, 4> face = { Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(1, 1, 1), Vec3(1, 0, 1) };
-  EXPECT_NEAR(faceSkewness(owner, neighbour, faceArea, faceCentre), 0.1 / std::hypot(1.0, 0.2), 1e-15);
+  EXPECT_NEAR(
+    faceSkewness(owner, neighbour, faceArea, faceCentre), 0.1 / std::hypot(1.0, 0.2), 1e-15);
   EXPECT_NEAR(faceSkewness(owner, neighbour, faceArea, faceCentre, face), 0.2, 1e-15);
 
   // Boundary face x = 2 of the shifted cell: tangential offset 0.2, normal distance 0.5.
@@ -211,6 +224,40 @@ TEST(Quality, FaceFunctions)
     Vec3(2, 0.4, 1) };
   EXPECT_NEAR(boundaryFaceSkewness(shiftedOwner, faceArea, boundaryCentre), 0.2 / 1.0, 1e-15);
   EXPECT_NEAR(boundaryFaceSkewness(shiftedOwner, faceArea, boundaryCentre, boundary), 0.4, 1e-15);
+}
+
+TEST(Quality, ScaledJacobianMatchesVtkMeshQuality)
+{
+  // Reference values from vtkMeshQuality (VTK 9.2, HexScaledJacobian) on these cells,
+  // including a collapsed edge (Verdict's 1e30) and a tangled corner.
+  const std::pair<Corners, double> cells[] = {
+    { { Vec3(0.003, 0.136, 0.122), Vec3(1.949, -0.03, -0.053), Vec3(2.057, 0.994, 0.075),
+        Vec3(-0.185, 1.157, -0.01), Vec3(0.068, -0.014, 0.462), Vec3(2.046, 0.082, 0.48),
+        Vec3(1.985, 1.069, 0.413), Vec3(-0.151, 1.039, 0.433) },
+      0.8195702617209352 },
+    { { Vec3(-0.48, -0.204, -0.117), Vec3(1.702, -0.373, 0.009), Vec3(2.224, 0.942, -0.186),
+        Vec3(0.096, 1.179, -0.075), Vec3(0.136, 0.261, 0.448), Vec3(1.797, 0.087, 0.562),
+        Vec3(2.275, 0.679, 0.335), Vec3(-0.21, 0.566, 0.532) },
+      0.18460170584656468 },
+    { { Vec3(0.211, -0.296, 0.554), Vec3(2.329, 0.251, 0.161), Vec3(2.382, 0.467, 0.246),
+        Vec3(0.241, 0.293, 0.139), Vec3(-0.1, 0.313, 0.324), Vec3(1.993, 0.137, 0.149),
+        Vec3(2.239, 0.958, 0.697), Vec3(-0.209, 1.434, 0.742) },
+      -0.5991672370892749 },
+    { { Vec3(-0.107, 0.379, 0.756), Vec3(3.075, -0.944, 0.53), Vec3(2.279, 0.944, -0.604),
+        Vec3(0.754, 0.243, 0.34), Vec3(0.781, -0.96, 0.318), Vec3(1.214, 0.146, 1.409),
+        Vec3(3.214, -0.067, 0.155), Vec3(0.422, 1.948, 0.753) },
+      -0.29397991480103663 },
+    { { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 1),
+        Vec3(1, 1, 1), Vec3(0, 1, 1) },
+      1e30 },
+    { { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 0, 1),
+        Vec3(0.2, 0.3, 0.1), Vec3(0, 1, 1) },
+      -0.9127731372919945 },
+  };
+  for (const auto& cell : cells)
+  {
+    EXPECT_NEAR(hexScaledJacobian(cell.first), cell.second, 1e-12);
+  }
 }
 
 TEST(Quality, InvertedCellsHaveNegativeScaledJacobian)
@@ -227,9 +274,8 @@ TEST(Quality, InvertedCellsHaveNegativeScaledJacobian)
   EXPECT_LT(hexScaledJacobian(tangled), 0.0);
 
   // In a grid, the inverted cell's faces point backwards: non-orthogonality > 90.
-  const Grid folded = makeGrid(3, 2, 2, [](int i, int j, int k) {
-    return Vec3(i == 2 ? -0.5 : i, j, k);
-  });
+  const Grid folded =
+    makeGrid(3, 2, 2, [](int i, int j, int k) { return Vec3(i == 2 ? -0.5 : i, j, k); });
   const auto q = computeGridQuality({ folded.block() });
   EXPECT_LT(q[0].scaledJacobian[1], 0.0);
   EXPECT_GT(q[0].nonOrthogonality[1], 90.0);
@@ -265,7 +311,8 @@ TEST(Quality, CollapsedCells)
   EXPECT_EQ(hexScaledJacobian(point), 1e30);
 
   // A grid whose i = 0 face is collapsed onto a line gives no NaN anywhere.
-  const Grid wedge = makeGrid(4, 3, 3, [](int i, int j, int k) { return Vec3(i, i * (j - 1.0), k); });
+  const Grid wedge =
+    makeGrid(4, 3, 3, [](int i, int j, int k) { return Vec3(i, i * (j - 1.0), k); });
   const auto q = computeGridQuality({ wedge.block() });
   for (const auto* values : { &q[0].minAngle, &q[0].maxAngle, &q[0].nonOrthogonality,
          &q[0].skewness, &q[0].aspectRatio, &q[0].scaledJacobian })
@@ -289,10 +336,11 @@ TEST(Quality, GridPassMatchesCellAndFaceFunctions)
   {
     o = Vec3(jitter(random), jitter(random), jitter(random));
   }
-  auto at = [&](int i, int j, int k) -> Vec3 {
+  auto at = [&](int i, int j, int k) -> Vec3
+  {
     // Global i in [0, 2 ni - 2]; node i = ni - 1 is shared by both blocks.
-    const bool boundaryNode = i == 0 || i == 2 * ni - 2 || j == 0 || j == nj - 1 || k == 0 ||
-      k == nk - 1;
+    const bool boundaryNode =
+      i == 0 || i == 2 * ni - 2 || j == 0 || j == nj - 1 || k == 0 || k == nk - 1;
     const Vec3 o = boundaryNode ? Vec3::Zero() : offsets[i + 2 * ni * (j + nj * k)];
     return Vec3(i * 0.7, j * 1.1 + 0.1 * i * i, k * 0.9 + 0.05 * j * i) + o;
   };
@@ -303,7 +351,10 @@ TEST(Quality, GridPassMatchesCellAndFaceFunctions)
   const auto joined = computeGridQuality({ whole.block() });
 
   const int ci = 2 * ni - 2, cj = nj - 1, ck = nk - 1;
-  auto centre = [&](int i, int j, int k) { return hexCentre(cellCorners(whole, i, j, k)); };
+  auto centre = [&](int i, int j, int k)
+  {
+    return hexCentre(cellCorners(whole, i, j, k));
+  };
   for (int k = 0; k < ck; ++k)
   {
     for (int j = 0; j < cj; ++j)
@@ -380,14 +431,16 @@ TEST(Quality, OGridSeamIsAnInternalFace)
   {
     angles[i] = 2 * M_PI * (i + 0.3 * std::sin(2 * M_PI * i / n)) / n;
   }
-  auto ringNode = [&](int i, int j, int k) {
+  auto ringNode = [&](int i, int j, int k)
+  {
     const double r = 1.0 + 0.4 * j + 0.05 * j * j;
     const double theta = angles[((i % n) + n) % n];
     return Vec3(r * std::cos(theta), r * std::sin(theta), 0.3 * k);
   };
   const int m = 7;
   const Grid original = makeGrid(n + 1, nr, 2, ringNode);
-  const Grid rotated = makeGrid(n + 1, nr, 2, [&](int i, int j, int k) { return ringNode(i + m, j, k); });
+  const Grid rotated =
+    makeGrid(n + 1, nr, 2, [&](int i, int j, int k) { return ringNode(i + m, j, k); });
   const auto q0 = computeGridQuality({ original.block() });
   const auto q1 = computeGridQuality({ rotated.block() });
   bool anySkew = false;
@@ -416,7 +469,8 @@ TEST(Quality, MinAngleClasses)
 
   // Sheared grid: 2 cells with MinAngle 60 and a cube: 90.
   const double t = std::tan(30.0 / degrees);
-  const Grid sheared = makeGrid(3, 2, 2, [t](int i, int j, int k) { return Vec3(i + t * k, j, k); });
+  const Grid sheared =
+    makeGrid(3, 2, 2, [t](int i, int j, int k) { return Vec3(i + t * k, j, k); });
   const Grid cube = makeGrid(2, 2, 2, [](int i, int j, int k) { return Vec3(i + 5, j, k); });
   const auto gridClasses = minAngleClasses(computeGridQuality({ sheared.block(), cube.block() }));
   EXPECT_EQ(gridClasses, (std::array<long long, 5>{ 0, 0, 0, 2, 1 }));

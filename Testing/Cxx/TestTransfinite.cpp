@@ -51,7 +51,8 @@ Vec3 node(const std::vector<double>& xyz, long index)
 }
 
 /// Edge of the unit parameter cube from `from` to `to` (one coordinate varying), mapped.
-Edge makeEdge(const PointMap& map, const Vec3& from, const Vec3& to, const std::vector<double>& params)
+Edge makeEdge(
+  const PointMap& map, const Vec3& from, const Vec3& to, const std::vector<double>& params)
 {
   Edge e;
   e.params = params;
@@ -95,17 +96,17 @@ TestBlock buildBlock(const PointMap& map, const std::array<std::vector<double>, 
   b.ni = static_cast<int>(params[0].size());
   b.nj = static_cast<int>(params[3].size());
   b.nk = static_cast<int>(params[8].size());
-  const Vec3 V[8] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { 0, 0, 1 },
-    { 1, 0, 1 }, { 1, 1, 1 }, { 0, 1, 1 } };
-  const int ends[12][2] = { { 0, 1 }, { 1, 2 }, { 3, 2 }, { 0, 3 }, { 4, 5 }, { 5, 6 },
-    { 7, 6 }, { 4, 7 }, { 0, 4 }, { 1, 5 }, { 2, 6 }, { 3, 7 } };
+  const Vec3 V[8] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { 0, 0, 1 }, { 1, 0, 1 },
+    { 1, 1, 1 }, { 0, 1, 1 } };
+  const int ends[12][2] = { { 0, 1 }, { 1, 2 }, { 3, 2 }, { 0, 3 }, { 4, 5 }, { 5, 6 }, { 7, 6 },
+    { 4, 7 }, { 0, 4 }, { 1, 5 }, { 2, 6 }, { 3, 7 } };
   for (int e = 0; e < 12; ++e)
   {
     b.edges[e] = makeEdge(map, V[ends[e][0]], V[ends[e][1]], params[e]);
   }
   // (bottom, top, left, right) per face.
-  const int faceEdges[6][4] = { { 3, 7, 8, 11 }, { 1, 5, 9, 10 }, { 0, 4, 8, 9 },
-    { 2, 6, 11, 10 }, { 0, 2, 3, 1 }, { 4, 6, 7, 5 } };
+  const int faceEdges[6][4] = { { 3, 7, 8, 11 }, { 1, 5, 9, 10 }, { 0, 4, 8, 9 }, { 2, 6, 11, 10 },
+    { 0, 2, 3, 1 }, { 4, 6, 7, 5 } };
   for (int f = 0; f < 6; ++f)
   {
     const auto& fe = faceEdges[f];
@@ -129,7 +130,10 @@ PointMap affineMap()
   Eigen::Matrix3d A;
   A << 2.0, 0.3, -0.4, 0.1, 1.5, 0.25, -0.2, 0.35, 3.0;
   const Vec3 offset(1.25, -0.5, 2.0);
-  return [A, offset](double s, double t, double u) { return Vec3(A * Vec3(s, t, u) + offset); };
+  return [A, offset](double s, double t, double u)
+  {
+    return Vec3(A * Vec3(s, t, u) + offset);
+  };
 }
 
 long index3(const TestBlock& b, int i, int j, int k)
@@ -140,7 +144,8 @@ long index3(const TestBlock& b, int i, int j, int k)
 /// Every node of the block equals the face node it comes from, bit for bit.
 void expectBoundaryCopied(const TestBlock& b)
 {
-  auto same = [&](long blockIndex, const std::vector<double>& face, long faceIndex) {
+  auto same = [&](long blockIndex, const std::vector<double>& face, long faceIndex)
+  {
     return std::memcmp(&b.nodes[3 * blockIndex], &face[3 * faceIndex], 3 * sizeof(double)) == 0;
   };
   for (int k = 0; k < b.nk; ++k)
@@ -221,7 +226,8 @@ TEST(TransfiniteFace, RejectsMismatchedEdges)
   const Edge top = makeEdge(map, { 0, 1, 0 }, { 1, 1, 0 }, graded(6, 1.0));
   const Edge side = makeEdge(map, { 0, 0, 0 }, { 0, 1, 0 }, graded(4, 1.0));
   std::vector<double> face(3 * 6 * 4);
-  EXPECT_THROW(transfiniteFace(bottom.nodes(), top.nodes(), side.nodes(), side.nodes(), face.data()),
+  EXPECT_THROW(
+    transfiniteFace(bottom.nodes(), top.nodes(), side.nodes(), side.nodes(), face.data()),
     GeometryError);
 }
 
@@ -274,7 +280,8 @@ TEST(TransfiniteBlock, CoupledParametersReproduceAffineMapWhenOneDirectionVaries
 
 TEST(TransfiniteBlock, CoupledPathAgreesWithSeparablePathInTheLimit)
 {
-  const PointMap map = [](double s, double t, double u) {
+  const PointMap map = [](double s, double t, double u)
+  {
     return Vec3(s + 0.2 * std::sin(3 * t), t + 0.1 * s * u, u + 0.3 * s * s);
   };
   const std::vector<double> s = graded(8, 1.2), t = graded(9, 0.9), u = graded(6, 1.1);
@@ -316,7 +323,8 @@ TEST(TransfiniteBlock, CylinderSectorKeepsWallNodesOnTheWall)
 {
   // s: angle 0..60 deg, t: radius 1..2, u: height 0..0.5. Arc edges are exact.
   const double innerRadius = 1.0, outerRadius = 2.0, height = 0.5, sector = M_PI / 3;
-  const PointMap map = [=](double s, double t, double u) {
+  const PointMap map = [=](double s, double t, double u)
+  {
     const double r = innerRadius + t * (outerRadius - innerRadius);
     return Vec3(r * std::cos(s * sector), r * std::sin(s * sector), u * height);
   };
@@ -347,10 +355,12 @@ TEST(TransfiniteBlock, CylinderSectorKeepsWallNodesOnTheWall)
 TEST(TransfiniteBlock, WedgeWithCollapsedFaceGivesValidCells)
 {
   // Prism: the s = 0 face collapses onto the axis (V0 = V3, V4 = V7).
-  const PointMap map = [](double s, double t, double u) {
+  const PointMap map = [](double s, double t, double u)
+  {
     return Vec3(s, s * (t - 0.5), u + 0.1 * s * t);
   };
-  const TestBlock b = buildBlock(map, separableParams(graded(9, 1.2), graded(7, 1.0), graded(5, 1.0)));
+  const TestBlock b =
+    buildBlock(map, separableParams(graded(9, 1.2), graded(7, 1.0), graded(5, 1.0)));
   expectBoundaryCopied(b);
   for (double x : b.nodes)
   {
@@ -392,11 +402,13 @@ TEST(TransfiniteBlock, WedgeWithCollapsedFaceGivesValidCells)
 TEST(TransfiniteBlock, WedgeWithOneCollapsedEdgeGivesFiniteNonInvertedCells)
 {
   // Only V0 = V3 (edge 3 collapsed): faces s = 0 and u = 0 are triangles.
-  const PointMap map = [](double s, double t, double u) {
+  const PointMap map = [](double s, double t, double u)
+  {
     const double w = s + u - s * u; // 0 only on the edge s = u = 0
     return Vec3(s, w * (t - 0.5), u);
   };
-  const TestBlock b = buildBlock(map, separableParams(graded(8, 1.0), graded(6, 1.0), graded(7, 1.0)));
+  const TestBlock b =
+    buildBlock(map, separableParams(graded(8, 1.0), graded(6, 1.0), graded(7, 1.0)));
   for (double x : b.nodes)
   {
     EXPECT_TRUE(std::isfinite(x));
