@@ -1,0 +1,1121 @@
+#include "Carriers.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace blockforge
+{
+namespace
+{
+/// Blend values per direction kept on the stack during one evaluation; networks with
+/// more nodes recompute them on the fly (still without allocating).
+constexpr int StackNodes = 64;
+
+std::string format(double value)
+{
+  std::ostringstream s;
+  s.precision(10);
+  s << value;
+  return s.str();
+}
+
+bool isFinite(const Vec3& v)
+{
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
+
+double clampUnit(double u)
+{
+  return u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+}
+
+// ---------------------------------------------------------------------------------------
+// Curves continued beyond [0, 1] by their end tangent line. Carriers are extrapolated
+// (blade past hub/shroud); B-spline curves clamp their parameter, which would leave a
+// kink and a flat piece, whereas the tangent line keeps the surface C1.
+
+/// Point of the curve, continued linearly outside [0, 1]. Inside, exactly curve.point(u).
+Vec3 extendedCurvePoint(const Curve& curve, double u)
+{
+  const double inside = clampUnit(u);
+  if (inside == u)
+  {
+    return curve.point(u);
+  }
+  return curve.point(inside) + (u - inside) * curve.derivative(inside, 1);
+}
+
+/// Point, first and second derivative of the continued curve; B-splines from one basis
+/// evaluation.
+void extendedCurveJet(const Curve& curve, const BSplineCurve* spline, double u, Vec3 jet[3])
+{
+  const double inside = clampUnit(u);
+  if (spline)
+  {
+    spline->derivatives(inside, 2, jet);
+  }
+  else
+  {
+    jet[0] = curve.point(inside);
+    jet[1] = curve.derivative(inside, 1);
+    jet[2] = curve.derivative(inside, 2);
+  }
+  if (inside != u)
+  {
+    jet[0] += (u - inside) * jet[1];
+    jet[2].setZero();
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Blend functions.
+
+/// Node interval of x: -1 left of the first node, n-1 at or right of the last node,
+/// otherwise k with x_k <= x < x_{k+1}. Binary search, no allocation.
+int locateInterval(const std::vector<double>& nodes, double x)
+{
+  const int n = static_cast<int>(nodes.size());
+  if (x < nodes.front())
+  {
+    return -1;
+  }
+  if (x >= nodes.back())
+  {
+    return n - 1;
+  }
+  return static_cast<int>(std::upper_bound(nodes.begin(), nodes.end(), x) - nodes.begin()) - 1;
+}
+
+/// Lagrange polynomial L_i (paper eq. 5) and its first two derivatives at x. The factors
+/// (x - x_k) / (x_i - x_k) are exactly 1 at x = x_i and exactly 0 at the other nodes, so
+/// the surface passes through its curves bit for bit.
+void lagrangeJet(const std::vector<double>& nodes, int i, double x, double jet[3])
+{
+  double p = 1.0, p1 = 0.0, p2 = 0.0;
+  const double xi = nodes[i];
+  for (int k = 0; k < static_cast<int>(nodes.size()); ++k)
+  {
+    if (k == i)
+    {
+      continue;
+    }
+    const double d = xi - nodes[k];
+    const double q = (x - nodes[k]) / d, q1 = 1.0 / d;
+    // Product rule on (p, p', p'') * (q, q', 0); update from the highest order down.
+    p2 = p2 * q + 2.0 * p1 * q1;
+    p1 = p1 * q + p * q1;
+    p = p * q;
+  }
+  jet[0] = p;
+  jet[1] = p1;
+  jet[2] = p2;
+}
+
+/**
+ * Natural cubic spline through (x_k, delta_jk): coefficients (a, b, c, d) per interval,
+ * then the slope at the last node. Natural end conditions (zero second derivative) make
+ * the linear continuation C2 and reproduce linear data exactly; the tridiagonal system is
+ * diagonally dominant, so the Thomas algorithm is stable without pivoting.
+ */
+std::vector<double> naturalCardinalSpline(const std::vector<double>& x, int j)
+{
+  const int n = static_cast<int>(x.size());
+  std::vector<double> y(n, 0.0), m(n, 0.0);
+  y[j] = 1.0;
+  if (n > 2)
+  {
+    const int unknowns = n - 2;
+    std::vector<double> diagonal(unknowns), upper(unknowns), rhs(unknowns);
+    for (int k = 1; k <= n - 2; ++k)
+    {
+      const double h0 = x[k] - x[k - 1], h1 = x[k + 1] - x[k];
+      diagonal[k - 1] = 2.0 * (h0 + h1);
+      upper[k - 1] = h1;
+      rhs[k - 1] = 6.0 * ((y[k + 1] - y[k]) / h1 - (y[k] - y[k - 1]) / h0);
+    }
+    // Forward elimination (sub-diagonal entry of row k is h_{k-1} = x[k] - x[k-1]).
+    for (int r = 1; r < unknowns; ++r)
+    {
+      const double lower = x[r + 1] - x[r];
+      const double factor = lower / diagonal[r - 1];
+      diagonal[r] -= factor * upper[r - 1];
+      rhs[r] -= factor * rhs[r - 1];
+    }
+    m[n - 2] = rhs[unknowns - 1] / diagonal[unknowns - 1];
+    for (int r = unknowns - 2; r >= 0; --r)
+    {
+      m[r + 1] = (rhs[r] - upper[r] * m[r + 2]) / diagonal[r];
+    }
+  }
+  std::vector<double> coefficients(4 * (n - 1) + 1);
+  for (int k = 0; k + 1 < n; ++k)
+  {
+    const double h = x[k + 1] - x[k];
+    coefficients[4 * k + 0] = y[k]; // exactly 0 or 1: the blend is exact at the nodes
+    coefficients[4 * k + 1] = (y[k + 1] - y[k]) / h - h * (2.0 * m[k] + m[k + 1]) / 6.0;
+    coefficients[4 * k + 2] = 0.5 * m[k];
+    coefficients[4 * k + 3] = (m[k + 1] - m[k]) / (6.0 * h);
+  }
+  const double h = x[n - 1] - x[n - 2];
+  coefficients[4 * (n - 1)] = (y[n - 1] - y[n - 2]) / h + h * (m[n - 2] + 2.0 * m[n - 1]) / 6.0;
+  return coefficients;
+}
+
+/// Cardinal spline j at x in node interval k (from locateInterval), linear beyond the ends.
+void splineJet(const std::vector<double>& nodes, const std::vector<double>& coefficients,
+  int j, int k, double x, double jet[3])
+{
+  const int n = static_cast<int>(nodes.size());
+  if (k < 0 || k >= n - 1)
+  {
+    const bool left = k < 0;
+    const double value = (left ? j == 0 : j == n - 1) ? 1.0 : 0.0;
+    const double slope = left ? coefficients[1] : coefficients[4 * (n - 1)];
+    jet[0] = value + slope * (x - (left ? nodes.front() : nodes.back()));
+    jet[1] = slope;
+    jet[2] = 0.0;
+    return;
+  }
+  const double* c = &coefficients[4 * k];
+  const double h = x - nodes[k];
+  jet[0] = c[0] + h * (c[1] + h * (c[2] + h * c[3]));
+  jet[1] = c[1] + h * (2.0 * c[2] + 3.0 * h * c[3]);
+  jet[2] = 2.0 * c[2] + 6.0 * h * c[3];
+}
+
+/// One direction's blend functions bound to an evaluation point: the interval search is
+/// done once, the values of up to StackNodes functions are cached on the stack.
+class BlendAt
+{
+public:
+  BlendAt(GordonSurface::Blending blending, const std::vector<double>& nodes,
+    const std::vector<std::vector<double>>& coefficients, double x)
+    : Blending(blending)
+    , Nodes(nodes)
+    , Coefficients(coefficients)
+    , X(x)
+    , Interval(nodes.empty() ? 0 : locateInterval(nodes, x))
+    , Cached(static_cast<int>(nodes.size()) <= StackNodes)
+  {
+    if (Cached)
+    {
+      for (int i = 0; i < static_cast<int>(nodes.size()); ++i)
+      {
+        compute(i, &Values[3 * i]);
+      }
+    }
+  }
+
+  /// jet[0..2] = value, first and second derivative of blend i.
+  void jet(int i, double out[3]) const
+  {
+    if (Cached)
+    {
+      out[0] = Values[3 * i];
+      out[1] = Values[3 * i + 1];
+      out[2] = Values[3 * i + 2];
+    }
+    else
+    {
+      compute(i, out);
+    }
+  }
+  double value(int i) const
+  {
+    double out[3];
+    jet(i, out);
+    return out[0];
+  }
+
+private:
+  void compute(int i, double out[3]) const
+  {
+    if (Blending == GordonSurface::Blending::Lagrange)
+    {
+      lagrangeJet(Nodes, i, X, out);
+    }
+    else
+    {
+      splineJet(Nodes, Coefficients[i], i, Interval, X, out);
+    }
+  }
+
+  GordonSurface::Blending Blending;
+  const std::vector<double>& Nodes;
+  const std::vector<std::vector<double>>& Coefficients;
+  double X;
+  int Interval;
+  bool Cached;
+  std::array<double, 3 * StackNodes> Values;
+};
+
+// ---------------------------------------------------------------------------------------
+/// The contour in the meridional half-plane: (axial, radius, 0). Its closest point to a
+/// point's (axial, radius) is the meridional foot point on the surface of revolution.
+class MeridionalCurve : public Curve
+{
+public:
+  MeridionalCurve(CurvePtr contour, const Vec3& axisPoint, const Vec3& axisDirection)
+    : Contour(std::move(contour))
+    , Spline(dynamic_cast<const BSplineCurve*>(Contour.get()))
+    , AxisPoint(axisPoint)
+    , Axis(axisDirection)
+  {
+  }
+
+  Vec3 point(double s) const override
+  {
+    const Vec3 v = Contour->point(s) - AxisPoint;
+    const double axial = Axis.dot(v);
+    return Vec3(axial, (v - axial * Axis).norm(), 0.0);
+  }
+
+  Vec3 derivative(double s, int order = 1) const override
+  {
+    if (order <= 0)
+    {
+      return point(s);
+    }
+    if (order > 2)
+    {
+      return Vec3::Zero();
+    }
+    Vec3 c[3];
+    if (Spline)
+    {
+      Spline->derivatives(s, 2, c);
+    }
+    else
+    {
+      c[0] = Contour->point(s);
+      c[1] = Contour->derivative(s, 1);
+      c[2] = order == 2 ? Contour->derivative(s, 2) : Vec3::Zero();
+    }
+    const Vec3 v = c[0] - AxisPoint;
+    const Vec3 w = v - Axis.dot(v) * Axis; // radial vector
+    const double r = w.norm();
+    const double axial1 = Axis.dot(c[1]);
+    const Vec3 w1 = c[1] - axial1 * Axis;
+    // r = |w|: r' = w.w'/r. On the axis (r = 0) the one-sided limit |w'| is used.
+    const double r1 = r > 0.0 ? w.dot(w1) / r : w1.norm();
+    if (order == 1)
+    {
+      return Vec3(axial1, r1, 0.0);
+    }
+    const double axial2 = Axis.dot(c[2]);
+    const Vec3 w2 = c[2] - axial2 * Axis;
+    // From r r' = w.w': r'^2 + r r'' = w'.w' + w.w''.
+    const double r2 = r > 0.0 ? (w1.squaredNorm() + w.dot(w2) - r1 * r1) / r : 0.0;
+    return Vec3(axial2, r2, 0.0);
+  }
+
+private:
+  CurvePtr Contour;
+  const BSplineCurve* Spline;
+  Vec3 AxisPoint, Axis;
+};
+
+/// Rotation of a direction (no translation) about the unit axis k: the part along k is
+/// kept, the perpendicular part turned in its plane, so the radius is kept to rounding.
+Vec3 rotateVector(const Vec3& v, const Vec3& k, double c, double s)
+{
+  const Vec3 along = k.dot(v) * k;
+  const Vec3 perpendicular = v - along;
+  return along + c * perpendicular + s * k.cross(perpendicular);
+}
+} // namespace
+
+// =======================================================================================
+Vec3 rotateAboutAxis(const Vec3& p, const Vec3& axisPoint, const Vec3& axisDirection,
+  double angle)
+{
+  if (angle == 0.0)
+  {
+    return p; // exactly: unrotated images coincide with their source bit for bit
+  }
+  const double norm = axisDirection.norm();
+  if (!(norm > 0.0) || !std::isfinite(norm) || !std::isfinite(angle))
+  {
+    throw GeometryError("rotation about an axis: the axis direction is zero or not finite, "
+                        "or the angle is not finite");
+  }
+  // Rodrigues' formula in the split form v_par + cos v_perp + sin k x v_perp.
+  const Vec3 k = axisDirection / norm;
+  return axisPoint + rotateVector(p - axisPoint, k, std::cos(angle), std::sin(angle));
+}
+
+// =======================================================================================
+SurfaceOfRevolution::SurfaceOfRevolution(CurvePtr contour, const Vec3& axisPoint,
+  const Vec3& axisDirection, double angleStart, double angleEnd)
+  : Contour(std::move(contour))
+  , AxisPoint(axisPoint)
+  , AngleStart(angleStart)
+  , AngleEnd(angleEnd)
+{
+  if (!Contour)
+  {
+    throw GeometryError("surface of revolution: no contour given");
+  }
+  const double norm = axisDirection.norm();
+  if (!isFinite(axisPoint) || !(norm > 0.0) || !std::isfinite(norm))
+  {
+    throw GeometryError("surface of revolution: the axis point is not finite or the axis "
+                        "direction is zero or not finite");
+  }
+  if (!std::isfinite(angleStart) || !std::isfinite(angleEnd) || angleStart == angleEnd)
+  {
+    throw GeometryError("surface of revolution: the sweep from " + format(angleStart) +
+      " to " + format(angleEnd) + " rad is empty or not finite");
+  }
+  AxisDirection = axisDirection / norm;
+  Meridional = std::make_shared<MeridionalCurve>(Contour, AxisPoint, AxisDirection);
+  // 256 samples: hub/shroud contours are smooth; candidates are refined by Newton anyway.
+  MeridionalProjector = std::make_shared<CurveProjector>(Meridional, 256);
+}
+
+Vec3 SurfaceOfRevolution::point(double s, double t) const
+{
+  const double angle = AngleStart + t * (AngleEnd - AngleStart);
+  if (angle == 0.0)
+  {
+    return Contour->point(s);
+  }
+  return AxisPoint +
+    rotateVector(Contour->point(s) - AxisPoint, AxisDirection, std::cos(angle), std::sin(angle));
+}
+
+void SurfaceOfRevolution::derivatives(double s, double t, SurfaceDerivatives& out) const
+{
+  Vec3 c[3];
+  if (const auto* spline = dynamic_cast<const BSplineCurve*>(Contour.get()))
+  {
+    spline->derivatives(s, 2, c);
+  }
+  else
+  {
+    c[0] = Contour->point(s);
+    c[1] = Contour->derivative(s, 1);
+    c[2] = Contour->derivative(s, 2);
+  }
+  const double sweep = AngleEnd - AngleStart;
+  const double angle = AngleStart + t * sweep;
+  const double cs = std::cos(angle), sn = std::sin(angle);
+  const Vec3& k = AxisDirection;
+  const Vec3 arm = angle == 0.0 ? Vec3(c[0] - AxisPoint) : rotateVector(c[0] - AxisPoint, k, cs, sn);
+  out.P = angle == 0.0 ? c[0] : Vec3(AxisPoint + arm);
+  out.Ps = rotateVector(c[1], k, cs, sn);
+  out.Pss = rotateVector(c[2], k, cs, sn);
+  // d/dangle of a rotation is k x (rotated vector).
+  out.Pt = sweep * k.cross(arm);
+  out.Ptt = sweep * sweep * k.cross(k.cross(arm));
+  out.Pst = sweep * k.cross(out.Ps);
+}
+
+void SurfaceOfRevolution::axialRadial(const Vec3& p, double& axial, double& radius) const
+{
+  const Vec3 v = p - AxisPoint;
+  axial = AxisDirection.dot(v);
+  radius = (v - axial * AxisDirection).norm();
+}
+
+CurveProjection SurfaceOfRevolution::projectMeridional(const Vec3& p) const
+{
+  double axial, radius;
+  axialRadial(p, axial, radius);
+  return MeridionalProjector->project(Vec3(axial, radius, 0.0));
+}
+
+double SurfaceOfRevolution::signedMeridionalDistance(const Vec3& p) const
+{
+  double axial, radius;
+  axialRadial(p, axial, radius);
+  const CurveProjection foot = MeridionalProjector->project(Vec3(axial, radius, 0.0));
+  const Vec3 tangent = Meridional->derivative(foot.t, 1);
+  // Left normal of the tangent (axial', radius') is (-radius', axial').
+  const double side =
+    (axial - foot.point.x()) * -tangent.y() + (radius - foot.point.y()) * tangent.x();
+  return side < 0.0 ? -foot.distance : foot.distance;
+}
+
+double SurfaceOfRevolution::contourParameter(const Vec3& p) const
+{
+  return projectMeridional(p).t;
+}
+
+// =======================================================================================
+namespace
+{
+void requireNodes(const std::vector<double>& nodes, const char* what)
+{
+  for (std::size_t k = 0; k < nodes.size(); ++k)
+  {
+    if (!std::isfinite(nodes[k]))
+    {
+      throw GeometryError(std::string("Gordon surface: ") + what + " " + std::to_string(k) +
+        " is not finite");
+    }
+    if (k > 0 && !(nodes[k] > nodes[k - 1]))
+    {
+      throw GeometryError(std::string("Gordon surface: ") + what + "s must increase strictly (" +
+        what + " " + std::to_string(k - 1) + " = " + format(nodes[k - 1]) + ", " + what + " " +
+        std::to_string(k) + " = " + format(nodes[k]) + ")");
+    }
+  }
+}
+
+void requireCurves(const std::vector<CurvePtr>& curves, const char* what)
+{
+  for (std::size_t k = 0; k < curves.size(); ++k)
+  {
+    if (!curves[k])
+    {
+      throw GeometryError(std::string("Gordon surface: ") + what + " " + std::to_string(k) +
+        " is missing");
+    }
+  }
+}
+} // namespace
+
+GordonSurface GordonSurface::fromSections(std::vector<CurvePtr> sections,
+  std::vector<double> sectionParameters, Blending blending)
+{
+  if (sections.size() < 2)
+  {
+    throw GeometryError("Gordon surface: lofting needs at least 2 sections, got " +
+      std::to_string(sections.size()));
+  }
+  if (sections.size() != sectionParameters.size())
+  {
+    throw GeometryError("Gordon surface: " + std::to_string(sections.size()) + " sections but " +
+      std::to_string(sectionParameters.size()) + " section parameters");
+  }
+  requireCurves(sections, "section");
+  requireNodes(sectionParameters, "section parameter");
+  const double first = sectionParameters.front(), last = sectionParameters.back();
+  if (first != 0.0 || last != 1.0)
+  {
+    for (double& t : sectionParameters)
+    {
+      t = (t - first) / (last - first);
+    }
+    sectionParameters.front() = 0.0;
+    sectionParameters.back() = 1.0;
+    requireNodes(sectionParameters, "section parameter"); // still distinct after scaling
+  }
+  GordonSurface surface;
+  surface.SCurves = std::move(sections);
+  surface.TNodes = std::move(sectionParameters);
+  surface.TheBlending = blending;
+  surface.prepare();
+  return surface;
+}
+
+GordonSurface GordonSurface::fromNetwork(std::vector<CurvePtr> sCurves,
+  std::vector<double> tNodes, std::vector<CurvePtr> tCurves, std::vector<double> sNodes,
+  Blending blending)
+{
+  if (sCurves.size() < 2 || tCurves.size() < 2)
+  {
+    throw GeometryError("Gordon surface: a network needs at least 2 curves in each direction, "
+                        "got " +
+      std::to_string(sCurves.size()) + " s-curves and " + std::to_string(tCurves.size()) +
+      " t-curves");
+  }
+  if (sCurves.size() != tNodes.size() || tCurves.size() != sNodes.size())
+  {
+    throw GeometryError("Gordon surface: every s-curve needs one t node and every t-curve one s "
+                        "node (" +
+      std::to_string(sCurves.size()) + " s-curves, " + std::to_string(tNodes.size()) +
+      " t nodes, " + std::to_string(tCurves.size()) + " t-curves, " +
+      std::to_string(sNodes.size()) + " s nodes)");
+  }
+  requireCurves(sCurves, "s-curve");
+  requireCurves(tCurves, "t-curve");
+  requireNodes(tNodes, "t node");
+  requireNodes(sNodes, "s node");
+  // The nodes are parameters of the crossing curves, so they cannot be rescaled.
+  for (const std::vector<double>* nodes : { &tNodes, &sNodes })
+  {
+    if (nodes->front() < 0.0 || nodes->back() > 1.0)
+    {
+      throw GeometryError(std::string("Gordon surface: the ") +
+        (nodes == &tNodes ? "t" : "s") + " nodes must lie in [0, 1] (they are parameters of "
+        "the crossing curves), got " + format(nodes->front()) + " .. " + format(nodes->back()));
+    }
+  }
+
+  GordonSurface surface;
+  surface.SCurves = std::move(sCurves);
+  surface.TCurves = std::move(tCurves);
+  surface.TNodes = std::move(tNodes);
+  surface.SNodes = std::move(sNodes);
+  surface.TheBlending = blending;
+  surface.prepare();
+
+  // Compatibility: C_j(s_i) must be D_i(t_j); the tolerance is relative to the network's
+  // size (as for Coons patches).
+  const int m = static_cast<int>(surface.SNodes.size());
+  const int n = static_cast<int>(surface.TNodes.size());
+  Vec3 lower = surface.NodePoints.front(), upper = lower;
+  for (const Vec3& q : surface.NodePoints)
+  {
+    lower = lower.cwiseMin(q);
+    upper = upper.cwiseMax(q);
+  }
+  const double size = (upper - lower).norm();
+  const double tolerance = 1e-9 * (size > 0.0 ? size : 1.0);
+  for (int j = 0; j < n; ++j)
+  {
+    for (int i = 0; i < m; ++i)
+    {
+      const Vec3 fromT = extendedCurvePoint(*surface.TCurves[i], surface.TNodes[j]);
+      const double gap = (fromT - surface.NodePoints[i + j * m]).norm();
+      if (!(gap <= tolerance))
+      {
+        std::ostringstream s;
+        s.precision(6);
+        s << "Gordon surface: s-curve " << j << " (t = " << surface.TNodes[j] << ") and t-curve "
+          << i << " (s = " << surface.SNodes[i] << ") do not meet: mismatch " << gap
+          << " (tolerance " << tolerance << ")";
+        throw GeometryError(s.str());
+      }
+    }
+  }
+  return surface;
+}
+
+void GordonSurface::prepare()
+{
+  if (TheBlending != Blending::Lagrange && TheBlending != Blending::Spline)
+  {
+    throw GeometryError("Gordon surface: unknown blending");
+  }
+  SSplines.clear();
+  TSplines.clear();
+  for (const CurvePtr& c : SCurves)
+  {
+    SSplines.push_back(dynamic_cast<const BSplineCurve*>(c.get()));
+  }
+  for (const CurvePtr& c : TCurves)
+  {
+    TSplines.push_back(dynamic_cast<const BSplineCurve*>(c.get()));
+  }
+  TBlendCoefficients.clear();
+  SBlendCoefficients.clear();
+  if (TheBlending == Blending::Spline)
+  {
+    for (int j = 0; j < static_cast<int>(TNodes.size()); ++j)
+    {
+      TBlendCoefficients.push_back(naturalCardinalSpline(TNodes, j));
+    }
+    for (int i = 0; i < static_cast<int>(SNodes.size()); ++i)
+    {
+      SBlendCoefficients.push_back(naturalCardinalSpline(SNodes, i));
+    }
+  }
+  // Same evaluation as in point(), so that C_j(s_i) - Q_ij vanishes exactly at s = s_i.
+  NodePoints.clear();
+  for (std::size_t j = 0; j < SCurves.size(); ++j)
+  {
+    for (double s : SNodes)
+    {
+      NodePoints.push_back(extendedCurvePoint(*SCurves[j], s));
+    }
+  }
+}
+
+void GordonSurface::blend(bool tDirection, int index, double x, double jet[3]) const
+{
+  const std::vector<double>& nodes = tDirection ? TNodes : SNodes;
+  if (index < 0 || index >= static_cast<int>(nodes.size()))
+  {
+    throw GeometryError("Gordon surface: blend function " + std::to_string(index) +
+      " does not exist");
+  }
+  if (TheBlending == Blending::Lagrange)
+  {
+    lagrangeJet(nodes, index, x, jet);
+  }
+  else
+  {
+    splineJet(nodes, (tDirection ? TBlendCoefficients : SBlendCoefficients)[index], index,
+      locateInterval(nodes, x), x, jet);
+  }
+}
+
+// The network form is evaluated grouped as
+//   P = sum_j B_j(t) [C_j(s) - sum_i A_i(s) Q_ij] + sum_i A_i(s) D_i(t),
+// which equals eq. 4 and makes the bracket vanish exactly at s = s_i (A_i = delta), so
+// the surface reproduces its t-curves bit for bit (as the Coons patch does its sides).
+// For lofts there are no t-curves and P = sum_j B_j(t) C_j(s).
+Vec3 GordonSurface::point(double s, double t) const
+{
+  const int n = static_cast<int>(TNodes.size());
+  const int m = static_cast<int>(SNodes.size());
+  const BlendAt b(TheBlending, TNodes, TBlendCoefficients, t);
+  const BlendAt a(TheBlending, SNodes, SBlendCoefficients, s);
+  Vec3 result = Vec3::Zero();
+  for (int j = 0; j < n; ++j)
+  {
+    const double bj = b.value(j);
+    if (bj == 0.0)
+    {
+      continue; // at a node: the other sections do not contribute at all
+    }
+    Vec3 bracket = extendedCurvePoint(*SCurves[j], s);
+    for (int i = 0; i < m; ++i)
+    {
+      bracket -= a.value(i) * NodePoints[i + j * m];
+    }
+    result += bj * bracket;
+  }
+  for (int i = 0; i < m; ++i)
+  {
+    const double ai = a.value(i);
+    if (ai != 0.0)
+    {
+      result += ai * extendedCurvePoint(*TCurves[i], t);
+    }
+  }
+  return result;
+}
+
+void GordonSurface::derivatives(double s, double t, SurfaceDerivatives& out) const
+{
+  const int n = static_cast<int>(TNodes.size());
+  const int m = static_cast<int>(SNodes.size());
+  const BlendAt b(TheBlending, TNodes, TBlendCoefficients, t);
+  const BlendAt a(TheBlending, SNodes, SBlendCoefficients, s);
+  out.P = out.Ps = out.Pt = out.Pss = out.Pst = out.Ptt = Vec3::Zero();
+  Vec3 c[3];
+  double bj[3], ai[3];
+  for (int j = 0; j < n; ++j)
+  {
+    b.jet(j, bj);
+    extendedCurveJet(*SCurves[j], SSplines[j], s, c);
+    for (int i = 0; i < m; ++i)
+    {
+      a.jet(i, ai);
+      const Vec3& q = NodePoints[i + j * m];
+      c[0] -= ai[0] * q;
+      c[1] -= ai[1] * q;
+      c[2] -= ai[2] * q;
+    }
+    out.P += bj[0] * c[0];
+    out.Ps += bj[0] * c[1];
+    out.Pss += bj[0] * c[2];
+    out.Pt += bj[1] * c[0];
+    out.Ptt += bj[2] * c[0];
+    out.Pst += bj[1] * c[1];
+  }
+  for (int i = 0; i < m; ++i)
+  {
+    a.jet(i, ai);
+    extendedCurveJet(*TCurves[i], TSplines[i], t, c);
+    out.P += ai[0] * c[0];
+    out.Ps += ai[1] * c[0];
+    out.Pss += ai[2] * c[0];
+    out.Pt += ai[0] * c[1];
+    out.Ptt += ai[0] * c[2];
+    out.Pst += ai[1] * c[1];
+  }
+}
+
+// =======================================================================================
+SurfaceCurve::SurfaceCurve(SurfacePtr surface, std::vector<Eigen::Vector2d> parameterPoints)
+  : TheSurface(std::move(surface))
+  , ParameterPoints(std::move(parameterPoints))
+{
+  if (!TheSurface)
+  {
+    throw GeometryError("surface curve: no surface given");
+  }
+  if (ParameterPoints.size() < 2)
+  {
+    throw GeometryError("surface curve needs at least 2 (s, t) points, got " +
+      std::to_string(ParameterPoints.size()));
+  }
+  std::vector<Vec3> points;
+  points.reserve(ParameterPoints.size());
+  for (const Eigen::Vector2d& st : ParameterPoints)
+  {
+    points.emplace_back(st.x(), st.y(), 0.0);
+  }
+  try
+  {
+    // Degree min(3, n - 1) (interpolate lowers it), chord length in (s, t).
+    ParameterCurve = std::make_shared<const BSplineCurve>(
+      BSplineCurve::interpolate(points, 3, ParameterMethod::ChordLength));
+  }
+  catch (const GeometryError& e)
+  {
+    throw GeometryError(std::string("surface curve (in (s, t) space): ") + e.what());
+  }
+}
+
+Eigen::Vector2d SurfaceCurve::parameters(double u) const
+{
+  const Vec3 q = ParameterCurve->point(u);
+  return Eigen::Vector2d(q.x(), q.y());
+}
+
+Vec3 SurfaceCurve::point(double u) const
+{
+  const Vec3 q = ParameterCurve->point(u);
+  return TheSurface->point(q.x(), q.y());
+}
+
+Vec3 SurfaceCurve::derivative(double u, int order) const
+{
+  if (order <= 0)
+  {
+    return point(u);
+  }
+  if (order > 2)
+  {
+    return Vec3::Zero();
+  }
+  Vec3 q[3];
+  ParameterCurve->derivatives(u, 2, q);
+  SurfaceDerivatives d;
+  TheSurface->derivatives(q[0].x(), q[0].y(), d);
+  const double s1 = q[1].x(), t1 = q[1].y();
+  if (order == 1)
+  {
+    return s1 * d.Ps + t1 * d.Pt;
+  }
+  // Chain rule: d2/du2 S(s(u), t(u)).
+  return s1 * s1 * d.Pss + 2.0 * s1 * t1 * d.Pst + t1 * t1 * d.Ptt + q[2].x() * d.Ps +
+    q[2].y() * d.Pt;
+}
+
+// =======================================================================================
+namespace
+{
+/// Brent's method (Brent 1973; zbrent in Numerical Recipes) on a sign-changing bracket:
+/// inverse quadratic / secant steps with bisection fallback, always converges. Stops when
+/// the bracket is narrower than `tolerance` (absolute in t) or f hits 0.
+template <typename F>
+double brentRoot(const F& f, double a, double b, double fa, double fb, double tolerance)
+{
+  constexpr double Eps = std::numeric_limits<double>::epsilon();
+  double c = b, fc = fb, d = b - a, e = d;
+  for (int iteration = 0; iteration < 200; ++iteration)
+  {
+    if ((fb > 0.0 && fc > 0.0) || (fb < 0.0 && fc < 0.0))
+    {
+      c = a;
+      fc = fa;
+      e = d = b - a;
+    }
+    if (std::abs(fc) < std::abs(fb))
+    {
+      a = b;
+      b = c;
+      c = a;
+      fa = fb;
+      fb = fc;
+      fc = fa;
+    }
+    const double tol1 = 2.0 * Eps * std::abs(b) + 0.5 * tolerance;
+    const double xm = 0.5 * (c - b);
+    if (std::abs(xm) <= tol1 || fb == 0.0)
+    {
+      return b;
+    }
+    if (std::abs(e) >= tol1 && std::abs(fa) > std::abs(fb))
+    {
+      const double s = fb / fa;
+      double p, q;
+      if (a == c)
+      {
+        p = 2.0 * xm * s;
+        q = 1.0 - s;
+      }
+      else
+      {
+        const double qq = fa / fc, r = fb / fc;
+        p = s * (2.0 * xm * qq * (qq - r) - (b - a) * (r - 1.0));
+        q = (qq - 1.0) * (r - 1.0) * (s - 1.0);
+      }
+      if (p > 0.0)
+      {
+        q = -q;
+      }
+      p = std::abs(p);
+      const double min1 = 3.0 * xm * q - std::abs(tol1 * q), min2 = std::abs(e * q);
+      if (2.0 * p < std::min(min1, min2))
+      {
+        e = d;
+        d = p / q;
+      }
+      else
+      {
+        d = xm;
+        e = d;
+      }
+    }
+    else
+    {
+      d = xm;
+      e = d;
+    }
+    a = b;
+    fa = fb;
+    b += std::abs(d) > tol1 ? d : std::copysign(tol1, xm);
+    fb = f(b);
+  }
+  return b;
+}
+
+/// Finds t with f(s, t) = 0 on [tMin, tMax] for one s of the intersection.
+class RootFinder
+{
+public:
+  RootFinder(const GordonSurface& surface, const SurfaceOfRevolution& revolution, double tMin,
+    double tMax)
+    : Surface(surface)
+    , Revolution(revolution)
+    , TMin(tMin)
+    , TMax(tMax)
+  {
+  }
+
+  double f(double s, double t) const
+  {
+    return Revolution.signedMeridionalDistance(Surface.point(s, t));
+  }
+
+  enum class Preference
+  {
+    NearUnitRange, ///< nearest [0, 1], then nearest `preferred` (if finite), then lowest t
+    NearPreferred  ///< nearest `preferred`
+  };
+
+  /// False when no root exists in the range (as far as the scan can see).
+  bool find(double s, double preferred, Preference preference, double& root) const
+  {
+    constexpr int Intervals = 16;
+    std::array<double, Intervals + 1> ts, fs;
+    Vec3 lower, upper;
+    for (int k = 0; k <= Intervals; ++k)
+    {
+      ts[k] = k == Intervals ? TMax : TMin + (TMax - TMin) * k / Intervals;
+      const Vec3 p = Surface.point(s, ts[k]);
+      fs[k] = Revolution.signedMeridionalDistance(p);
+      lower = k == 0 ? p : lower.cwiseMin(p);
+      upper = k == 0 ? p : upper.cwiseMax(p);
+    }
+    // A sign change of f can also be a jump (the foot point passing a contour end, where
+    // the sign flips at non-zero distance); true roots converge to |f| ~ 0, jumps do not.
+    const double size = (upper - lower).norm();
+    const double residualTolerance = 1e-7 * (size > 0.0 ? size : 1.0);
+    bool found = false;
+    auto consider = [&](double t) {
+      if (!found || better(t, root, preferred, preference))
+      {
+        root = t;
+        found = true;
+      }
+    };
+    auto fAt = [&](double t) { return f(s, t); };
+    for (int k = 0; k <= Intervals; ++k)
+    {
+      if (fs[k] == 0.0)
+      {
+        consider(ts[k]);
+        continue;
+      }
+      if (k < Intervals && fs[k + 1] != 0.0 && ((fs[k] < 0.0) != (fs[k + 1] < 0.0)))
+      {
+        const double t = brentRoot(fAt, ts[k], ts[k + 1], fs[k], fs[k + 1], 5e-14);
+        if (std::abs(fAt(t)) <= residualTolerance)
+        {
+          consider(t);
+        }
+      }
+    }
+    return found;
+  }
+
+private:
+  static double distanceToUnit(double t) { return t < 0.0 ? -t : (t > 1.0 ? t - 1.0 : 0.0); }
+
+  static bool better(double t, double incumbent, double preferred, Preference preference)
+  {
+    if (preference == Preference::NearUnitRange)
+    {
+      const double dt = distanceToUnit(t), di = distanceToUnit(incumbent);
+      if (dt != di)
+      {
+        return dt < di;
+      }
+    }
+    if (std::isfinite(preferred))
+    {
+      const double dt = std::abs(t - preferred), di = std::abs(incumbent - preferred);
+      if (dt != di)
+      {
+        return dt < di;
+      }
+    }
+    return t < incumbent;
+  }
+
+  const GordonSurface& Surface;
+  const SurfaceOfRevolution& Revolution;
+  double TMin, TMax;
+};
+} // namespace
+
+std::shared_ptr<SurfaceCurve> intersectWithRevolution(std::shared_ptr<const GordonSurface> surface,
+  const SurfaceOfRevolution& revolution, double tMin, double tMax, int samples)
+{
+  if (!surface)
+  {
+    throw GeometryError("intersection with a surface of revolution: no surface given");
+  }
+  if (!std::isfinite(tMin) || !std::isfinite(tMax) || !(tMax > tMin))
+  {
+    throw GeometryError("intersection with a surface of revolution: invalid t range [" +
+      format(tMin) + ", " + format(tMax) + "]");
+  }
+  if (samples < 2)
+  {
+    throw GeometryError("intersection with a surface of revolution needs at least 2 samples, "
+                        "got " +
+      std::to_string(samples));
+  }
+  constexpr std::size_t MaxNodes = 4096;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const RootFinder finder(*surface, revolution, tMin, tMax);
+  auto noIntersection = [&](double s) {
+    return GeometryError("intersection with a surface of revolution: the surface does not meet "
+                         "it at s = " +
+      format(s) + " for t in [" + format(tMin) + ", " + format(tMax) +
+      "] (sections too short for the extension range, or no crossing)");
+  };
+
+  // Closed sections (blade profiles through the trailing edge): s = 0 and s = 1 are one
+  // point, which must get one t so the intersection curve closes exactly.
+  bool closed = true;
+  {
+    double size = 0.0;
+    for (double t : { 0.0, 0.5, 1.0 })
+    {
+      size = std::max(size, (surface->point(0.5, t) - surface->point(0.0, t)).norm());
+    }
+    for (double t : { 0.0, 0.5, 1.0 })
+    {
+      if (!((surface->point(1.0, t) - surface->point(0.0, t)).norm() <= 1e-12 * size))
+      {
+        closed = false;
+      }
+    }
+  }
+
+  std::vector<double> sValues(samples), tValues(samples);
+  for (int k = 0; k < samples; ++k)
+  {
+    const double s = k == samples - 1 ? 1.0 : static_cast<double>(k) / (samples - 1);
+    sValues[k] = s;
+    if (k == samples - 1 && closed)
+    {
+      tValues[k] = tValues[0];
+      continue;
+    }
+    if (!finder.find(s, k > 0 ? tValues[k - 1] : nan, RootFinder::Preference::NearUnitRange,
+          tValues[k]))
+    {
+      throw noIntersection(s);
+    }
+  }
+
+  const SurfacePtr base = surface;
+  auto build = [&]() {
+    std::vector<Eigen::Vector2d> points(sValues.size());
+    for (std::size_t k = 0; k < sValues.size(); ++k)
+    {
+      points[k] = Eigen::Vector2d(sValues[k], tValues[k]);
+    }
+    return std::make_shared<SurfaceCurve>(base, std::move(points));
+  };
+  std::shared_ptr<SurfaceCurve> curve = build();
+
+  // Size of the curve for the acceptance tolerance: bounding box and radius of its nodes.
+  double scale = 0.0;
+  {
+    Vec3 lower = surface->point(sValues[0], tValues[0]), upper = lower;
+    for (std::size_t k = 0; k < sValues.size(); ++k)
+    {
+      const Vec3 p = surface->point(sValues[k], tValues[k]);
+      lower = lower.cwiseMin(p);
+      upper = upper.cwiseMax(p);
+      double axial, radius;
+      revolution.axialRadial(p, axial, radius);
+      scale = std::max(scale, radius);
+    }
+    scale = std::max(scale, (upper - lower).norm());
+    if (!(scale > 0.0))
+    {
+      scale = 1.0;
+    }
+  }
+  const double tolerance = 1e-10 * scale;
+
+  // Between nodes the curve is an interpolation in (s, t); insert exact roots where it
+  // strays from the revolution surface (checked at the middle of each node interval).
+  for (int round = 0; round < 16 && sValues.size() < MaxNodes; ++round)
+  {
+    const std::vector<double>& u = curve->nodeParameters();
+    std::vector<double> newS, newT;
+    newS.reserve(2 * sValues.size());
+    newT.reserve(2 * sValues.size());
+    bool inserted = false;
+    for (std::size_t k = 0; k < sValues.size(); ++k)
+    {
+      newS.push_back(sValues[k]);
+      newT.push_back(tValues[k]);
+      if (k + 1 == sValues.size() || sValues.size() + (newS.size() - k - 1) >= MaxNodes)
+      {
+        continue;
+      }
+      const Eigen::Vector2d mid = curve->parameters(0.5 * (u[k] + u[k + 1]));
+      if (std::abs(finder.f(mid.x(), mid.y())) <= tolerance)
+      {
+        continue;
+      }
+      double s = mid.x();
+      if (!(s > sValues[k] && s < sValues[k + 1]))
+      {
+        s = 0.5 * (sValues[k] + sValues[k + 1]);
+      }
+      if (!(s > sValues[k] && s < sValues[k + 1]))
+      {
+        continue; // the interval cannot be split further in double precision
+      }
+      double t;
+      if (!finder.find(s, mid.y(), RootFinder::Preference::NearPreferred, t))
+      {
+        throw noIntersection(s);
+      }
+      newS.push_back(s);
+      newT.push_back(t);
+      inserted = true;
+    }
+    if (!inserted)
+    {
+      break;
+    }
+    sValues = std::move(newS);
+    tValues = std::move(newT);
+    curve = build();
+  }
+  return curve;
+}
+} // namespace blockforge

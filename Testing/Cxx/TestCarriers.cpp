@@ -1,0 +1,1023 @@
+// Carrier geometry (paper section 2.2): surfaces of revolution, Gordon surfaces (eqs. 4-5)
+// with Lagrange and spline blending, curves in (s, t) space and blade/hub intersections,
+// checked against analytic surfaces.
+#include "Carriers.h"
+#include "Projection.h"
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <memory>
+#include <new>
+#include <string>
+
+using namespace blockforge;
+
+// Counting global allocation: evaluation of carriers must not touch the heap.
+namespace
+{
+std::atomic<long> AllocationCount{ 0 };
+}
+void* operator new(std::size_t size)
+{
+  ++AllocationCount;
+  if (void* p = std::malloc(size ? size : 1))
+  {
+    return p;
+  }
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept
+{
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept
+{
+  std::free(p);
+}
+
+namespace
+{
+constexpr double Pi = 3.14159265358979323846;
+
+double maxError(const Vec3& a, const Vec3& b)
+{
+  return (a - b).cwiseAbs().maxCoeff();
+}
+
+/// A curve given by a function of (t, derivative order): exact analytic sections.
+class FunctionCurve : public Curve
+{
+public:
+  using Function = std::function<Vec3(double, int)>;
+  explicit FunctionCurve(Function f)
+    : F(std::move(f))
+  {
+  }
+  Vec3 point(double t) const override { return F(t, 0); }
+  Vec3 derivative(double t, int order = 1) const override { return F(t, order); }
+
+private:
+  Function F;
+};
+
+/// Analytic surface f(s, t) with partial derivatives d^ds/ds d^dt/dt (ds, dt <= 2).
+using AnalyticSurface = std::function<Vec3(double s, double t, int ds, int dt)>;
+
+CurvePtr sCurveOf(const AnalyticSurface& f, double t)
+{
+  return std::make_shared<FunctionCurve>([f, t](double s, int k) { return f(s, t, k, 0); });
+}
+
+CurvePtr tCurveOf(const AnalyticSurface& f, double s)
+{
+  return std::make_shared<FunctionCurve>([f, s](double t, int k) { return f(s, t, 0, k); });
+}
+
+/// Polynomial surface: coordinate c is sum_ab coefficients[c][a][b] s^a t^b (a, b <= 3).
+AnalyticSurface polynomialSurface(const std::array<std::array<std::array<double, 4>, 4>, 3>& c)
+{
+  auto power = [](double x, int a, int d) {
+    // d-th derivative of x^a
+    if (d > a)
+    {
+      return 0.0;
+    }
+    double factor = 1.0;
+    for (int k = 0; k < d; ++k)
+    {
+      factor *= (a - k);
+    }
+    return factor * std::pow(x, a - d);
+  };
+  return [c, power](double s, double t, int ds, int dt) {
+    Vec3 r = Vec3::Zero();
+    for (int coord = 0; coord < 3; ++coord)
+    {
+      for (int a = 0; a < 4; ++a)
+      {
+        for (int b = 0; b < 4; ++b)
+        {
+          r[coord] += c[coord][a][b] * power(s, a, ds) * power(t, b, dt);
+        }
+      }
+    }
+    return r;
+  };
+}
+
+/// Distance of p from the line through a along unit k.
+double distanceToAxis(const Vec3& p, const Vec3& a, const Vec3& k)
+{
+  return (p - a).cross(k).norm();
+}
+
+/// Central differences of a surface's point and first derivatives against derivatives().
+void expectDerivativesMatch(const Surface& surface, double s, double t, double tolerance,
+  const std::string& what)
+{
+  const double h = 1e-5;
+  SurfaceDerivatives d, sp, sm, tp, tm;
+  surface.derivatives(s, t, d);
+  surface.derivatives(s + h, t, sp);
+  surface.derivatives(s - h, t, sm);
+  surface.derivatives(s, t + h, tp);
+  surface.derivatives(s, t - h, tm);
+  const double scale = std::max(1.0, d.P.norm());
+  EXPECT_LT(maxError(d.P, surface.point(s, t)), 1e-13 * scale) << what;
+  EXPECT_LT(maxError(d.Ps, (surface.point(s + h, t) - surface.point(s - h, t)) / (2 * h)),
+    tolerance * scale)
+    << what << " Ps at " << s << ", " << t;
+  EXPECT_LT(maxError(d.Pt, (surface.point(s, t + h) - surface.point(s, t - h)) / (2 * h)),
+    tolerance * scale)
+    << what << " Pt at " << s << ", " << t;
+  EXPECT_LT(maxError(d.Pss, (sp.Ps - sm.Ps) / (2 * h)), tolerance * scale)
+    << what << " Pss at " << s << ", " << t;
+  EXPECT_LT(maxError(d.Ptt, (tp.Pt - tm.Pt) / (2 * h)), tolerance * scale)
+    << what << " Ptt at " << s << ", " << t;
+  EXPECT_LT(maxError(d.Pst, (tp.Ps - tm.Ps) / (2 * h)), tolerance * scale)
+    << what << " Pst (d/dt Ps) at " << s << ", " << t;
+  EXPECT_LT(maxError(d.Pst, (sp.Pt - sm.Pt) / (2 * h)), tolerance * scale)
+    << what << " Pst (d/ds Pt) at " << s << ", " << t;
+}
+
+/// Tilted machine axis used by the revolution tests, with an orthonormal frame.
+struct Frame
+{
+  Vec3 a{ 0.3, -0.2, 0.5 };
+  Vec3 k = Vec3(1.0, 2.0, 2.0).normalized();
+  Vec3 e1 = k.unitOrthogonal();
+  Vec3 e2 = k.cross(e1);
+  /// Point at axial coordinate x, radius r, angle phi from e1.
+  Vec3 at(double x, double r, double phi = 0.0) const
+  {
+    return a + x * k + r * (std::cos(phi) * e1 + std::sin(phi) * e2);
+  }
+};
+
+/// Hyperbolic paraboloid blade (twisted, ruled): lines at span t, radial along x.
+/// P(s, t) = (1 - t) L0(s) + t L1(s), machine axis z.
+Vec3 twistedBlade(double s, double t)
+{
+  const Vec3 l0a(0.5, -0.1, -0.2), l0b(0.5, 0.1, 0.2);
+  const Vec3 l1a(1.0, 0.2, -0.2), l1b(1.0, -0.2, 0.3);
+  const Vec3 l0 = (1 - s) * l0a + s * l0b, l1 = (1 - s) * l1a + s * l1b;
+  return (1 - t) * l0 + t * l1;
+}
+
+std::shared_ptr<const GordonSurface> twistedBladeLoft(GordonSurface::Blending blending)
+{
+  std::vector<CurvePtr> sections;
+  std::vector<double> spans = { 0.0, 0.3, 0.7, 1.0 };
+  for (double t : spans)
+  {
+    sections.push_back(std::make_shared<LineCurve>(twistedBlade(0, t), twistedBlade(1, t)));
+  }
+  return std::make_shared<GordonSurface>(GordonSurface::fromSections(sections, spans, blending));
+}
+
+/// Hub/shroud contour in the (x, z) half-plane x > 0 about the z axis: radius r(z) linear.
+std::shared_ptr<SurfaceOfRevolution> coneAboutZ(double r0, double z0, double r1, double z1)
+{
+  return std::make_shared<SurfaceOfRevolution>(
+    std::make_shared<LineCurve>(Vec3(r0, 0, z0), Vec3(r1, 0, z1)), Vec3::Zero(), Vec3::UnitZ(),
+    -Pi / 4, Pi / 4);
+}
+
+double radiusAboutZ(const Vec3& p)
+{
+  return std::hypot(p.x(), p.y());
+}
+} // namespace
+
+// ---------------------------------------------------------------------------------------
+// Rotation
+
+TEST(RotateAboutAxis, QuarterTurnAndZeroAngle)
+{
+  const Vec3 r = rotateAboutAxis(Vec3(1, 0, 0), Vec3::Zero(), Vec3::UnitZ(), Pi / 2);
+  EXPECT_LT(maxError(r, Vec3(0, 1, 0)), 1e-16);
+  const Vec3 p(0.3, -4.0, 2.5);
+  EXPECT_EQ(rotateAboutAxis(p, Vec3(1, 2, 3), Vec3(0, 1, 0), 0.0), p);
+  // The direction is normalised: a longer vector gives the same rotation.
+  const Vec3 a = rotateAboutAxis(p, Vec3(1, 2, 3), Vec3(1, 1, 0), 0.4);
+  const Vec3 b = rotateAboutAxis(p, Vec3(1, 2, 3), Vec3(7, 7, 0), 0.4);
+  EXPECT_LT(maxError(a, b), 1e-15);
+  EXPECT_THROW(rotateAboutAxis(p, Vec3::Zero(), Vec3::Zero(), 0.1), GeometryError);
+}
+
+TEST(RotateAboutAxis, ComposesAndClosesAfterOneTurn)
+{
+  const Frame f;
+  const Vec3 p(1.1, 0.4, -0.7);
+  for (double a : { 0.3, -1.2, 2.0 })
+  {
+    for (double b : { 0.7, 1.9, -0.25 })
+    {
+      const Vec3 twice = rotateAboutAxis(rotateAboutAxis(p, f.a, f.k, a), f.a, f.k, b);
+      const Vec3 once = rotateAboutAxis(p, f.a, f.k, a + b);
+      EXPECT_LT(maxError(twice, once), 1e-14) << a << " + " << b;
+      // Radius and axial position are kept.
+      EXPECT_NEAR(distanceToAxis(once, f.a, f.k), distanceToAxis(p, f.a, f.k), 1e-15);
+      EXPECT_NEAR((once - f.a).dot(f.k), (p - f.a).dot(f.k), 1e-15);
+    }
+  }
+  for (int n : { 2, 3, 5, 7, 12, 17 })
+  {
+    Vec3 q = p;
+    for (int i = 0; i < n; ++i)
+    {
+      q = rotateAboutAxis(q, f.a, f.k, 2 * Pi / n);
+    }
+    EXPECT_LT(maxError(q, p), 1e-14) << n << " pitches";
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Surfaces of revolution
+
+TEST(SurfaceOfRevolution, CylinderPointsAtExactRadiusAndAngle)
+{
+  const Frame f;
+  const double radius = 0.8, x0 = -0.5, x1 = 1.5, a0 = 0.2, a1 = 1.5;
+  const SurfaceOfRevolution cylinder(
+    std::make_shared<LineCurve>(f.at(x0, radius), f.at(x1, radius)), f.a, f.k * 3.0, a0, a1);
+  EXPECT_LT(maxError(cylinder.axisDirection(), f.k), 1e-16);
+  double worstRadius = 0, worstAxial = 0, worstAngle = 0;
+  for (int i = 0; i <= 10; ++i)
+  {
+    for (int j = 0; j <= 10; ++j)
+    {
+      const double s = i / 10.0, t = j / 10.0;
+      const Vec3 p = cylinder.point(s, t);
+      worstRadius = std::max(worstRadius, std::abs(distanceToAxis(p, f.a, f.k) / radius - 1));
+      worstAxial = std::max(worstAxial, std::abs((p - f.a).dot(f.k) - (x0 + s * (x1 - x0))));
+      const double angle = std::atan2((p - f.a).dot(f.e2), (p - f.a).dot(f.e1));
+      worstAngle = std::max(worstAngle, std::abs(angle - (a0 + t * (a1 - a0))));
+      double axial, r;
+      cylinder.axialRadial(p, axial, r);
+      EXPECT_NEAR(r, radius, 1e-15);
+    }
+  }
+  EXPECT_LT(worstRadius, 1e-12);
+  EXPECT_LT(worstAxial, 1e-14);
+  EXPECT_LT(worstAngle, 1e-14);
+}
+
+TEST(SurfaceOfRevolution, DerivativesMatchFiniteDifferences)
+{
+  const Frame f;
+  // Straight generator (cone) and a curved B-spline contour.
+  std::vector<Vec3> points;
+  for (int i = 0; i <= 8; ++i)
+  {
+    const double x = i / 8.0;
+    points.push_back(f.at(x, 0.6 + 0.3 * std::sin(2.0 * x) + 0.1 * x * x));
+  }
+  const CurvePtr contours[] = { std::make_shared<LineCurve>(f.at(0, 0.5), f.at(1, 1.2)),
+    std::make_shared<BSplineCurve>(BSplineCurve::interpolate(points)) };
+  for (const CurvePtr& contour : contours)
+  {
+    const SurfaceOfRevolution surface(contour, f.a, f.k, -0.4, 2.1);
+    for (double s : { 0.1, 0.37, 0.8 })
+    {
+      for (double t : { 0.05, 0.5, 0.93 })
+      {
+        expectDerivativesMatch(surface, s, t, 1e-8, "revolution");
+      }
+    }
+  }
+}
+
+TEST(SurfaceOfRevolution, ConeRadiusAndSignedDistance)
+{
+  const Frame f;
+  const double x0 = -1.0, r0 = 0.5, x1 = 2.0, r1 = 1.5;
+  const SurfaceOfRevolution cone(
+    std::make_shared<LineCurve>(f.at(x0, r0), f.at(x1, r1)), f.a, f.k, 0.0, 2 * Pi);
+  const double length = std::hypot(x1 - x0, r1 - r0);
+  const double tx = (x1 - x0) / length, tr = (r1 - r0) / length;
+  double worst = 0;
+  for (int i = 0; i <= 20; ++i)
+  {
+    for (int j = 0; j <= 20; ++j)
+    {
+      const double s = i / 20.0, t = j / 20.0;
+      const double expected = r0 + s * (r1 - r0);
+      worst = std::max(worst, std::abs(distanceToAxis(cone.point(s, t), f.a, f.k) / expected - 1));
+    }
+  }
+  EXPECT_LT(worst, 1e-12);
+  // Points at (axial x, radius r) whose foot is inside the generator: the signed distance
+  // is the offset along the left normal (-tr, tx) = outward (larger radius) here.
+  for (double x : { -0.5, 0.3, 1.2 })
+  {
+    for (double offset : { -0.3, -1e-4, 0.0, 2e-7, 0.25, 0.4 })
+    {
+      const double footX = x, footR = r0 + (x - x0) / (x1 - x0) * (r1 - r0);
+      const double px = footX - tr * offset, pr = footR + tx * offset;
+      for (double phi : { 0.0, 1.0, 4.0 })
+      {
+        const Vec3 p = f.at(px, pr, phi);
+        EXPECT_NEAR(cone.signedMeridionalDistance(p), offset, 1e-12) << x << " " << offset;
+        EXPECT_NEAR(cone.contourParameter(p), (x - x0) / (x1 - x0), 1e-12);
+      }
+    }
+  }
+  // A contour running the other way flips the sign.
+  const SurfaceOfRevolution reversed(
+    std::make_shared<LineCurve>(f.at(x1, r1), f.at(x0, r0)), f.a, f.k, 0.0, 1.0);
+  EXPECT_NEAR(reversed.signedMeridionalDistance(f.at(0.5, 1.5, 2.0)),
+    -cone.signedMeridionalDistance(f.at(0.5, 1.5, 2.0)), 1e-14);
+}
+
+TEST(SurfaceOfRevolution, CylinderInsideOutside)
+{
+  // Cylinder r = 2 about the z axis, contour along +z: outside positive.
+  const SurfaceOfRevolution cylinder(std::make_shared<LineCurve>(Vec3(2, 0, 0), Vec3(2, 0, 3)),
+    Vec3::Zero(), Vec3::UnitZ(), 0.0, Pi / 3);
+  for (double r : { 0.0, 0.5, 1.999, 2.0, 2.001, 3.5 })
+  {
+    for (double z : { 0.1, 1.5, 2.9 })
+    {
+      for (double phi : { 0.0, 1.0, -2.5 })
+      {
+        const Vec3 p(r * std::cos(phi), r * std::sin(phi), z);
+        EXPECT_NEAR(cylinder.signedMeridionalDistance(p), r - 2.0, 1e-12) << r << " " << z;
+        EXPECT_NEAR(cylinder.contourParameter(p), z / 3.0, 1e-12);
+      }
+    }
+  }
+}
+
+TEST(SurfaceOfRevolution, TorusFromArcContourSignedDistance)
+{
+  // Contour: circular arc (centre c, radius a) in the meridional plane, counter-clockwise
+  // in (axial, radius): its left normal points to the centre, so inside is positive.
+  const Frame f;
+  const double cx = 0.5, cr = 2.0, a = 0.6;
+  auto meridional = [&](double angle, double rho) {
+    return f.at(cx + rho * std::cos(angle), cr + rho * std::sin(angle));
+  };
+  const auto arc = std::make_shared<ArcCurve>(
+    ArcCurve::fromCentre(meridional(-Pi / 3, a), meridional(Pi / 3, a), f.at(cx, cr)));
+  const SurfaceOfRevolution torus(arc, f.a, f.k, 0.0, Pi);
+  for (double angle : { -0.9, -0.3, 0.0, 0.4, 1.0 })
+  {
+    for (double rho : { 0.2, 0.55, 0.6, 0.61, 1.1 })
+    {
+      for (double phi : { 0.0, 2.0 })
+      {
+        const Vec3 p = f.a + (cx + rho * std::cos(angle)) * f.k +
+          (cr + rho * std::sin(angle)) * (std::cos(phi) * f.e1 + std::sin(phi) * f.e2);
+        EXPECT_NEAR(torus.signedMeridionalDistance(p), a - rho, 1e-12) << angle << " " << rho;
+        EXPECT_NEAR(torus.contourParameter(p), (angle + Pi / 3) / (2 * Pi / 3), 1e-11);
+      }
+    }
+  }
+  for (int i = 0; i <= 10; ++i)
+  {
+    const Vec3 p = torus.point(i / 10.0, 0.37);
+    EXPECT_LT(std::abs(torus.signedMeridionalDistance(p)), 1e-14);
+  }
+}
+
+TEST(SurfaceOfRevolution, InvalidInputThrows)
+{
+  const auto line = std::make_shared<LineCurve>(Vec3(1, 0, 0), Vec3(1, 0, 1));
+  EXPECT_THROW(SurfaceOfRevolution(nullptr, Vec3::Zero(), Vec3::UnitZ(), 0, 1), GeometryError);
+  EXPECT_THROW(SurfaceOfRevolution(line, Vec3::Zero(), Vec3::Zero(), 0, 1), GeometryError);
+  EXPECT_THROW(SurfaceOfRevolution(line, Vec3::Zero(), Vec3::UnitZ(), 1, 1), GeometryError);
+}
+
+// ---------------------------------------------------------------------------------------
+// Gordon surfaces: lofting
+
+TEST(GordonLoft, PassesThroughEverySectionExactly)
+{
+  // Curved, twisted B-spline sections at uneven heights z (not normalised).
+  const std::vector<double> heights = { 0.1, 0.5, 0.8, 1.6, 2.0 };
+  std::vector<CurvePtr> sections;
+  for (std::size_t j = 0; j < heights.size(); ++j)
+  {
+    std::vector<Vec3> points;
+    const double twist = 0.4 * heights[j];
+    for (int i = 0; i <= 12; ++i)
+    {
+      const double u = i / 12.0;
+      const double x = u - 0.5, y = 0.15 * std::sin(Pi * u) + 0.05 * static_cast<double>(j);
+      points.emplace_back(x * std::cos(twist) - y * std::sin(twist),
+        x * std::sin(twist) + y * std::cos(twist), heights[j]);
+    }
+    sections.push_back(std::make_shared<BSplineCurve>(BSplineCurve::interpolate(points)));
+  }
+  for (auto blending : { GordonSurface::Blending::Lagrange, GordonSurface::Blending::Spline })
+  {
+    const GordonSurface loft = GordonSurface::fromSections(sections, heights, blending);
+    ASSERT_EQ(loft.tNodes().size(), heights.size());
+    for (std::size_t j = 0; j < heights.size(); ++j)
+    {
+      EXPECT_NEAR(loft.tNodes()[j], (heights[j] - 0.1) / 1.9, 1e-16);
+      for (int i = 0; i <= 50; ++i)
+      {
+        const double s = i / 50.0;
+        // Bit for bit: the other blends are exactly 0 at the node, this one exactly 1.
+        EXPECT_EQ(loft.point(s, loft.tNodes()[j]), sections[j]->point(s)) << j << " " << s;
+      }
+    }
+    // Between sections the surface is at the interpolated height: z is linear in the
+    // normalised t, reproduced by both blendings.
+    for (double t : { -0.1, 0.13, 0.5, 0.77, 1.15 })
+    {
+      EXPECT_NEAR(loft.point(0.3, t).z(), 0.1 + 1.9 * t, 1e-13);
+    }
+    for (double s : { 0.2, 0.6 })
+    {
+      for (double t : { 0.1, 0.45, 0.9, -0.15, 1.18 })
+      {
+        expectDerivativesMatch(loft, s, t, 1e-7, "loft");
+      }
+    }
+  }
+}
+
+TEST(GordonLoft, LagrangeReproducesCubicInT)
+{
+  // P(s, t) = (s, t + 0.5 s t^2, t^3 - 2 t s + 1): linear in s (line sections), cubic in t.
+  auto exact = [](double s, double t) {
+    return Vec3(s, t + 0.5 * s * t * t, t * t * t - 2 * t * s + 1);
+  };
+  const std::vector<double> nodes = { 0.0, 0.2, 0.7, 1.0 };
+  std::vector<CurvePtr> sections;
+  for (double t : nodes)
+  {
+    sections.push_back(std::make_shared<LineCurve>(exact(0, t), exact(1, t)));
+  }
+  const GordonSurface loft =
+    GordonSurface::fromSections(sections, nodes, GordonSurface::Blending::Lagrange);
+  double worst = 0;
+  for (int i = 0; i <= 20; ++i)
+  {
+    for (int j = -4; j <= 24; ++j) // includes extrapolation to t in [-0.2, 1.2]
+    {
+      const double s = i / 20.0, t = j / 20.0;
+      worst = std::max(worst, maxError(loft.point(s, t), exact(s, t)));
+      EXPECT_EQ(loft.point(s, t), loft.extendedPoint(s, t));
+    }
+  }
+  EXPECT_LT(worst, 1e-14);
+  // Natural-spline blending reproduces surfaces linear in t, also extrapolated.
+  auto ruled = [](double s, double t) { return Vec3(s, t * (1 + s), 2 * t - s * s); };
+  std::vector<CurvePtr> ruledSections;
+  for (double t : nodes)
+  {
+    ruledSections.push_back(std::make_shared<FunctionCurve>([ruled, t](double s, int k) {
+      return k == 0 ? ruled(s, t) : (k == 1 ? Vec3(1, t, -2 * s) : Vec3(0, 0, -2));
+    }));
+  }
+  const GordonSurface spline =
+    GordonSurface::fromSections(ruledSections, nodes, GordonSurface::Blending::Spline);
+  worst = 0;
+  for (int i = 0; i <= 20; ++i)
+  {
+    for (int j = -4; j <= 24; ++j)
+    {
+      const double s = i / 20.0, t = j / 20.0;
+      worst = std::max(worst, maxError(spline.point(s, t), ruled(s, t)));
+    }
+  }
+  EXPECT_LT(worst, 1e-14);
+}
+
+TEST(GordonLoft, SplineBlendingDoesNotOscillateOnRungeData)
+{
+  // 11 equally spaced sections of z = 1 / (1 + 25 y^2), y = 2t - 1 in [-1, 1].
+  auto runge = [](double y) { return 1.0 / (1.0 + 25.0 * y * y); };
+  std::vector<CurvePtr> sections;
+  std::vector<double> nodes;
+  for (int j = 0; j <= 10; ++j)
+  {
+    const double t = j / 10.0, y = 2 * t - 1;
+    nodes.push_back(t);
+    sections.push_back(std::make_shared<LineCurve>(Vec3(0, y, runge(y)), Vec3(1, y, runge(y))));
+  }
+  double deviation[2] = { 0, 0 }, yError[2] = { 0, 0 };
+  int b = 0;
+  for (auto blending : { GordonSurface::Blending::Lagrange, GordonSurface::Blending::Spline })
+  {
+    const GordonSurface loft = GordonSurface::fromSections(sections, nodes, blending);
+    for (int j = 0; j <= 4000; ++j)
+    {
+      const double t = j / 4000.0;
+      const Vec3 p = loft.point(0.5, t);
+      deviation[b] = std::max(deviation[b], std::abs(p.z() - runge(2 * t - 1)));
+      yError[b] = std::max(yError[b], std::abs(p.y() - (2 * t - 1)));
+    }
+    ++b;
+  }
+  // Lagrange of degree 10 on equidistant nodes: the classical Runge error 1.9156.
+  EXPECT_NEAR(deviation[0], 1.9156, 1e-3);
+  // The natural cubic spline stays within about 2% (0.021974).
+  EXPECT_NEAR(deviation[1], 0.02197, 2e-4);
+  // Both reproduce the linear coordinate y.
+  EXPECT_LT(yError[0], 1e-12);
+  EXPECT_LT(yError[1], 1e-14);
+  std::printf("Runge max deviation: Lagrange %.6f, spline %.6f\n", deviation[0], deviation[1]);
+}
+
+TEST(GordonLoft, SplineBlendFunctionsAreCardinalC2AndLinearBeyondTheEnds)
+{
+  std::vector<CurvePtr> sections;
+  const std::vector<double> nodes = { 0.0, 0.15, 0.5, 0.6, 1.0 };
+  for (double t : nodes)
+  {
+    sections.push_back(std::make_shared<LineCurve>(Vec3(0, t, 0), Vec3(1, t, 0)));
+  }
+  const GordonSurface loft =
+    GordonSurface::fromSections(sections, nodes, GordonSurface::Blending::Spline);
+  double jet[3], left[3], right[3];
+  for (int j = 0; j < 5; ++j)
+  {
+    for (int k = 0; k < 5; ++k)
+    {
+      loft.blend(true, j, nodes[k], jet);
+      EXPECT_EQ(jet[0], j == k ? 1.0 : 0.0);
+      // Continuity of value, slope and curvature across the interior nodes.
+      loft.blend(true, j, nodes[k] - 1e-11, left);
+      loft.blend(true, j, nodes[k] + 1e-11, right);
+      EXPECT_NEAR(left[0], right[0], 1e-9);
+      EXPECT_NEAR(left[1], right[1], 1e-8);
+      EXPECT_NEAR(left[2], right[2], 1e-7);
+    }
+    // Natural ends: zero curvature, then straight.
+    loft.blend(true, j, 1.0 - 1e-9, left);
+    EXPECT_NEAR(left[2], 0.0, 1e-6);
+    loft.blend(true, j, 1.0, jet);
+    loft.blend(true, j, 1.2, right);
+    EXPECT_NEAR(right[0], jet[0] + 0.2 * jet[1], 1e-15);
+    EXPECT_EQ(right[2], 0.0);
+  }
+  // Partition of unity everywhere, also extrapolated.
+  for (double t : { -0.3, 0.07, 0.55, 0.99, 1.3 })
+  {
+    double sum = 0;
+    for (int j = 0; j < 5; ++j)
+    {
+      loft.blend(true, j, t, jet);
+      sum += jet[0];
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-15);
+  }
+}
+
+TEST(GordonLoft, InvalidInputThrows)
+{
+  const CurvePtr a = std::make_shared<LineCurve>(Vec3(0, 0, 0), Vec3(1, 0, 0));
+  const CurvePtr b = std::make_shared<LineCurve>(Vec3(0, 1, 0), Vec3(1, 1, 0));
+  const auto spline = GordonSurface::Blending::Spline;
+  EXPECT_THROW(GordonSurface::fromSections({ a }, { 0.0 }, spline), GeometryError);
+  EXPECT_THROW(GordonSurface::fromSections({ a, b }, { 0.0 }, spline), GeometryError);
+  EXPECT_THROW(GordonSurface::fromSections({ a, b }, { 1.0, 1.0 }, spline), GeometryError);
+  EXPECT_THROW(GordonSurface::fromSections({ a, nullptr }, { 0.0, 1.0 }, spline), GeometryError);
+  EXPECT_NO_THROW(GordonSurface::fromSections({ a, b }, { 3.0, 7.0 }, spline));
+}
+
+// ---------------------------------------------------------------------------------------
+// Gordon surfaces: networks (eq. 4)
+
+TEST(GordonNetwork, LagrangeReproducesBiquadraticAndPassesThroughAllCurves)
+{
+  std::array<std::array<std::array<double, 4>, 4>, 3> c{};
+  c[0][1][0] = 1.0;  // x = s + 0.2 t^2 + 0.1 s^2 t
+  c[0][0][2] = 0.2;
+  c[0][2][1] = 0.1;
+  c[1][0][1] = 1.0;  // y = t + 0.3 s^2 - 0.4 s t^2
+  c[1][2][0] = 0.3;
+  c[1][1][2] = -0.4;
+  c[2][2][2] = 0.5;  // z = 0.5 s^2 t^2 + s t - 0.2 s^2
+  c[2][1][1] = 1.0;
+  c[2][2][0] = -0.2;
+  const AnalyticSurface f = polynomialSurface(c);
+  const std::vector<double> sNodes = { 0.0, 0.4, 1.0 }, tNodes = { 0.1, 0.5, 0.9 };
+  std::vector<CurvePtr> sCurves, tCurves;
+  for (double t : tNodes)
+  {
+    sCurves.push_back(sCurveOf(f, t));
+  }
+  for (double s : sNodes)
+  {
+    tCurves.push_back(tCurveOf(f, s));
+  }
+  const GordonSurface gordon = GordonSurface::fromNetwork(
+    sCurves, tNodes, tCurves, sNodes, GordonSurface::Blending::Lagrange);
+  double worst = 0;
+  for (int i = 0; i <= 20; ++i)
+  {
+    for (int j = 0; j <= 20; ++j)
+    {
+      const double s = i / 20.0, t = j / 20.0;
+      worst = std::max(worst, maxError(gordon.point(s, t), f(s, t, 0, 0)));
+    }
+  }
+  EXPECT_LT(worst, 1e-14);
+  for (int k = 0; k <= 40; ++k)
+  {
+    const double u = k / 40.0;
+    for (std::size_t j = 0; j < tNodes.size(); ++j)
+    {
+      EXPECT_LT(maxError(gordon.point(u, tNodes[j]), sCurves[j]->point(u)), 1e-15);
+    }
+    for (std::size_t i = 0; i < sNodes.size(); ++i)
+    {
+      EXPECT_EQ(gordon.point(sNodes[i], u), tCurves[i]->point(u)); // bit for bit
+    }
+  }
+  for (double s : { 0.15, 0.5, 0.85 })
+  {
+    for (double t : { 0.05, 0.5, 0.95 })
+    {
+      expectDerivativesMatch(gordon, s, t, 1e-8, "Lagrange network");
+      SurfaceDerivatives d;
+      gordon.derivatives(s, t, d);
+      EXPECT_LT(maxError(d.Ps, f(s, t, 1, 0)), 1e-13);
+      EXPECT_LT(maxError(d.Pt, f(s, t, 0, 1)), 1e-13);
+      EXPECT_LT(maxError(d.Pss, f(s, t, 2, 0)), 1e-13);
+      EXPECT_LT(maxError(d.Pst, f(s, t, 1, 1)), 1e-13);
+      EXPECT_LT(maxError(d.Ptt, f(s, t, 0, 2)), 1e-13);
+    }
+  }
+}
+
+TEST(GordonNetwork, SplineReproducesTransfiniteSurface)
+{
+  // f = A(s) + B(t) + M s t: the boolean sum of any two blendings that reproduce linear
+  // functions is exact for it, whatever A and B (here not polynomial).
+  const AnalyticSurface f = [](double s, double t, int ds, int dt) -> Vec3 {
+    auto dsin = [](double w, double x, int k) {
+      const double p = std::pow(w, k);
+      switch (k % 4)
+      {
+        case 0: return p * std::sin(w * x);
+        case 1: return p * std::cos(w * x);
+        case 2: return -p * std::sin(w * x);
+        default: return -p * std::cos(w * x);
+      }
+    };
+    auto dcos = [&](double w, double x, int k) { return dsin(w, x + Pi / (2 * w), k); };
+    auto mono = [](double x, int a, int k) { // d^k x^a, a <= 3
+      double factor = 1;
+      for (int i = 0; i < k; ++i)
+      {
+        factor *= (a - i);
+      }
+      return k > a ? 0.0 : factor * std::pow(x, a - k);
+    };
+    Vec3 r = Vec3::Zero();
+    if (dt == 0)
+    {
+      r += Vec3(mono(s, 1, ds), 0.2 * dcos(2, s, ds), dsin(2, s, ds));
+    }
+    if (ds == 0)
+    {
+      r += Vec3(0.3 * dsin(3, t, dt), mono(t, 1, dt), mono(t, 3, dt));
+    }
+    r.z() += 0.5 * mono(s, 1, ds) * mono(t, 1, dt);
+    return r;
+  };
+  const std::vector<double> sNodes = { 0.0, 0.3, 0.55, 1.0 }, tNodes = { 0.0, 0.25, 0.6, 0.8, 1.0 };
+  std::vector<CurvePtr> sCurves, tCurves;
+  for (double t : tNodes)
+  {
+    sCurves.push_back(sCurveOf(f, t));
+  }
+  for (double s : sNodes)
+  {
+    tCurves.push_back(tCurveOf(f, s));
+  }
+  for (auto blending : { GordonSurface::Blending::Spline, GordonSurface::Blending::Lagrange })
+  {
+    const GordonSurface gordon =
+      GordonSurface::fromNetwork(sCurves, tNodes, tCurves, sNodes, blending);
+    double worst = 0;
+    for (int i = 0; i <= 20; ++i)
+    {
+      for (int j = 0; j <= 20; ++j)
+      {
+        const double s = i / 20.0, t = j / 20.0;
+        worst = std::max(worst, maxError(gordon.point(s, t), f(s, t, 0, 0)));
+      }
+    }
+    EXPECT_LT(worst, 1e-14);
+    for (double s : { 0.1, 0.5, 0.9 })
+    {
+      for (double t : { 0.1, 0.42, 0.9 })
+      {
+        expectDerivativesMatch(gordon, s, t, 1e-8, "spline network");
+      }
+    }
+  }
+}
+
+TEST(GordonNetwork, BilinearExtendsExactlyAndMismatchThrows)
+{
+  // Bilinear surface from straight curves: exact also beyond [0, 1] in s and t.
+  const Vec3 p00(0, 0, 0), p10(2, 0.3, 0.1), p01(0.2, 1, 0.5), p11(1.8, 1.4, -0.3);
+  auto bilinear = [&](double s, double t) {
+    return (1 - s) * (1 - t) * p00 + s * (1 - t) * p10 + (1 - s) * t * p01 + s * t * p11;
+  };
+  const std::vector<double> nodes = { 0.0, 0.5, 1.0 };
+  std::vector<CurvePtr> sCurves, tCurves;
+  for (double u : nodes)
+  {
+    sCurves.push_back(std::make_shared<LineCurve>(bilinear(0, u), bilinear(1, u)));
+    tCurves.push_back(std::make_shared<LineCurve>(bilinear(u, 0), bilinear(u, 1)));
+  }
+  for (auto blending : { GordonSurface::Blending::Spline, GordonSurface::Blending::Lagrange })
+  {
+    const GordonSurface gordon =
+      GordonSurface::fromNetwork(sCurves, nodes, tCurves, nodes, blending);
+    double worst = 0;
+    for (int i = -4; i <= 24; ++i)
+    {
+      for (int j = -4; j <= 24; ++j)
+      {
+        const double s = i / 20.0, t = j / 20.0;
+        worst = std::max(worst, maxError(gordon.point(s, t), bilinear(s, t)));
+      }
+    }
+    EXPECT_LT(worst, 1e-14);
+    expectDerivativesMatch(gordon, -0.1, 1.15, 1e-8, "extended network");
+  }
+  std::vector<CurvePtr> bad = tCurves;
+  bad[1] = std::make_shared<LineCurve>(bilinear(0.5, 0) + Vec3(0, 0, 1e-6), bilinear(0.5, 1));
+  try
+  {
+    GordonSurface::fromNetwork(sCurves, nodes, bad, nodes, GordonSurface::Blending::Spline);
+    FAIL() << "mismatched network accepted";
+  }
+  catch (const GeometryError& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("do not meet"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("mismatch 1e-06"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(GordonSurface::fromNetwork(sCurves, { 0.0, 0.5, 1.5 }, tCurves, nodes,
+                 GordonSurface::Blending::Spline),
+    GeometryError);
+}
+
+// ---------------------------------------------------------------------------------------
+// Curves in (s, t) space
+
+TEST(SurfaceCurve, LiesOnTheSurfaceWithChainRuleDerivatives)
+{
+  const auto loft = twistedBladeLoft(GordonSurface::Blending::Spline);
+  // Curved sections too: a lofted surface of B-spline arcs.
+  std::vector<CurvePtr> sections;
+  for (double z : { 0.0, 0.4, 1.0 })
+  {
+    std::vector<Vec3> points;
+    for (int i = 0; i <= 10; ++i)
+    {
+      const double u = i / 10.0;
+      points.emplace_back(std::cos(2 * u + z), std::sin(2 * u + z) * (1 + 0.2 * z), z);
+    }
+    sections.push_back(std::make_shared<BSplineCurve>(BSplineCurve::interpolate(points)));
+  }
+  const auto curved = std::make_shared<GordonSurface>(GordonSurface::fromSections(
+    sections, { 0.0, 0.4, 1.0 }, GordonSurface::Blending::Lagrange));
+  const std::vector<Eigen::Vector2d> st = { { 0.05, 0.1 }, { 0.3, 0.35 }, { 0.5, 0.3 },
+    { 0.7, 0.6 }, { 0.95, 0.9 } };
+  for (const SurfacePtr& surface : { SurfacePtr(loft), SurfacePtr(curved) })
+  {
+    const SurfaceCurve curve(surface, st);
+    const SurfaceProjector projector(surface);
+    ASSERT_EQ(curve.nodeParameters().size(), st.size());
+    for (std::size_t k = 0; k < st.size(); ++k)
+    {
+      EXPECT_LT((curve.parameters(curve.nodeParameters()[k]) - st[k]).norm(), 1e-15);
+    }
+    double worst = 0;
+    for (int i = 0; i <= 100; ++i)
+    {
+      const Vec3 p = curve.point(i / 100.0);
+      worst = std::max(worst, projector.project(p).distance);
+    }
+    EXPECT_LT(worst, 1e-9);
+    const double h = 1e-5;
+    for (double u : { 0.1, 0.45, 0.8 })
+    {
+      EXPECT_LT(maxError(curve.derivative(u, 1),
+                  (curve.point(u + h) - curve.point(u - h)) / (2 * h)),
+        1e-8);
+      EXPECT_LT(maxError(curve.derivative(u, 2),
+                  (curve.derivative(u + h, 1) - curve.derivative(u - h, 1)) / (2 * h)),
+        1e-6);
+    }
+  }
+  // Two points: a straight line in parameter space.
+  const SurfaceCurve line(loft, { { 0.1, 0.2 }, { 0.9, 0.6 } });
+  EXPECT_LT((line.parameters(0.25) - Eigen::Vector2d(0.3, 0.3)).norm(), 1e-15);
+  EXPECT_THROW(SurfaceCurve(loft, { { 0.1, 0.2 } }), GeometryError);
+  EXPECT_THROW(SurfaceCurve(nullptr, st), GeometryError);
+  EXPECT_THROW(SurfaceCurve(loft, { { 0.1, 0.2 }, { 0.1, 0.2 } }), GeometryError);
+}
+
+// ---------------------------------------------------------------------------------------
+// Blade with hub and shroud
+
+TEST(IntersectWithRevolution, TwistedBladeWithCylindersAndCone)
+{
+  for (auto blending : { GordonSurface::Blending::Spline, GordonSurface::Blending::Lagrange })
+  {
+    const auto blade = twistedBladeLoft(blending);
+    struct Case
+    {
+      std::shared_ptr<SurfaceOfRevolution> revolution;
+      std::function<double(double)> radiusAtZ; // expected radius of the surface at z
+      const char* name;
+      int extrapolation; // -1 below the first section, 0 inside, +1 beyond the last
+    };
+    const Case cases[] = {
+      { coneAboutZ(0.75, -1, 0.75, 1), [](double) { return 0.75; }, "cylinder r=0.75", 0 },
+      { coneAboutZ(0.42, -1, 0.42, 1), [](double) { return 0.42; }, "hub cylinder r=0.42", -1 },
+      { coneAboutZ(1.1, -1, 1.1, 1), [](double) { return 1.1; }, "shroud cylinder r=1.1", 1 },
+      { coneAboutZ(0.55, -1, 0.75, 1), [](double z) { return 0.65 + 0.1 * z; }, "cone", 0 },
+    };
+    for (const Case& c : cases)
+    {
+      const auto curve = intersectWithRevolution(blade, *c.revolution);
+      double worstRadius = 0, worstOnBlade = 0, tLow = 1e9, tHigh = -1e9;
+      for (int i = 0; i <= 2000; ++i)
+      {
+        const double u = i / 2000.0;
+        const Vec3 p = curve->point(u);
+        const Eigen::Vector2d st = curve->parameters(u);
+        const double expected = c.radiusAtZ(p.z());
+        worstRadius = std::max(worstRadius, std::abs(radiusAboutZ(p) / expected - 1));
+        // The blade is ruled, so its extension is the analytic hyperbolic paraboloid.
+        worstOnBlade = std::max(worstOnBlade, maxError(p, twistedBlade(st.x(), st.y())));
+        tLow = std::min(tLow, st.y());
+        tHigh = std::max(tHigh, st.y());
+      }
+      EXPECT_LT(worstRadius, 1e-9) << c.name;
+      EXPECT_LT(worstOnBlade, 1e-14) << c.name;
+      EXPECT_NEAR(curve->parameters(0).x(), 0.0, 1e-15);
+      EXPECT_NEAR(curve->parameters(1).x(), 1.0, 1e-15);
+      if (c.extrapolation < 0)
+      {
+        EXPECT_LT(tHigh, 0.0) << c.name;
+      }
+      else if (c.extrapolation > 0)
+      {
+        EXPECT_GT(tLow, 1.0) << c.name;
+      }
+      else
+      {
+        EXPECT_GT(tLow, 0.0) << c.name;
+        EXPECT_LT(tHigh, 1.0) << c.name;
+      }
+      std::printf("%s: %zu nodes, t in [%.4f, %.4f], radius error %.2e\n", c.name,
+        curve->parameterPoints().size(), tLow, tHigh, worstRadius);
+    }
+  }
+}
+
+TEST(IntersectWithRevolution, ClosedTwistedSectionsShortOfTheHub)
+{
+  // Elliptic closed profiles (starting and ending at the trailing edge), stacked radially
+  // along x from 0.5 to 1.1 with twist and lean; hub r = 0.45 (below the first section:
+  // extrapolation) and a conical shroud crossing the last sections.
+  std::vector<CurvePtr> sections;
+  std::vector<double> spans;
+  for (int j = 0; j < 4; ++j)
+  {
+    const double x = 0.5 + 0.2 * j, twist = 0.3 * j, lean = 0.03 * j * j;
+    std::vector<Vec3> points;
+    for (int i = 0; i <= 32; ++i)
+    {
+      const double phi = 2 * Pi * i / 32.0;
+      const double chordwise = 0.2 * std::cos(phi), thickness = 0.04 * std::sin(phi);
+      points.emplace_back(x, lean + chordwise * std::sin(twist) + thickness * std::cos(twist),
+        chordwise * std::cos(twist) - thickness * std::sin(twist));
+    }
+    points.back() = points.front(); // closed exactly
+    sections.push_back(std::make_shared<BSplineCurve>(BSplineCurve::interpolate(points)));
+    spans.push_back(x);
+  }
+  const auto blade = std::make_shared<GordonSurface>(
+    GordonSurface::fromSections(sections, spans, GordonSurface::Blending::Spline));
+  const SurfaceProjector projector(blade, 64, 32);
+
+  struct Case
+  {
+    std::shared_ptr<SurfaceOfRevolution> revolution;
+    double r0, z0, r1, z1;
+    bool inside; // within the sections: check against the projection onto the blade
+  };
+  const Case cases[] = {
+    { coneAboutZ(0.45, -1, 0.45, 1), 0.45, -1, 0.45, 1, false },
+    { coneAboutZ(0.62, -1, 0.62, 1), 0.62, -1, 0.62, 1, true },
+    { coneAboutZ(0.9, -1, 1.15, 1), 0.9, -1, 1.15, 1, true },
+  };
+  for (const Case& c : cases)
+  {
+    const auto curve = intersectWithRevolution(blade, *c.revolution);
+    EXPECT_EQ(curve->point(0.0), curve->point(1.0)) << "closes at the trailing edge";
+    double worstRadius = 0, worstOnBlade = 0, tLow = 1e9;
+    for (int i = 0; i <= 3000; ++i)
+    {
+      const Vec3 p = curve->point(i / 3000.0);
+      const double expected = c.r0 + (p.z() - c.z0) / (c.z1 - c.z0) * (c.r1 - c.r0);
+      worstRadius = std::max(worstRadius, std::abs(radiusAboutZ(p) / expected - 1));
+      tLow = std::min(tLow, curve->parameters(i / 3000.0).y());
+      if (c.inside && i % 30 == 0)
+      {
+        worstOnBlade = std::max(worstOnBlade, projector.project(p).distance);
+      }
+    }
+    EXPECT_LT(worstRadius, 1e-9);
+    if (c.inside)
+    {
+      EXPECT_LT(worstOnBlade, 1e-9);
+    }
+    else
+    {
+      EXPECT_LT(tLow, -0.05); // the blade was extended below its first section
+    }
+    std::printf("closed blade, r0 = %.2f: %zu nodes, radius error %.2e, t min %.4f\n", c.r0,
+      curve->parameterPoints().size(), worstRadius, tLow);
+  }
+}
+
+TEST(IntersectWithRevolution, NoIntersectionThrowsNamingS)
+{
+  const auto blade = twistedBladeLoft(GordonSurface::Blending::Spline);
+  const auto farAway = coneAboutZ(5.0, -1, 5.0, 1);
+  try
+  {
+    intersectWithRevolution(blade, *farAway);
+    FAIL() << "no intersection expected";
+  }
+  catch (const GeometryError& e)
+  {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("s = 0 "), std::string::npos) << message;
+    EXPECT_NE(message.find("[-0.5, 1.5]"), std::string::npos) << message;
+  }
+  // The extension range matters: r = 0.38 needs t down to -0.37.
+  const auto hub = coneAboutZ(0.38, -1, 0.38, 1);
+  EXPECT_THROW(intersectWithRevolution(blade, *hub, -0.2, 1.2), GeometryError);
+  EXPECT_NO_THROW(intersectWithRevolution(blade, *hub, -0.8, 1.2));
+  EXPECT_THROW(intersectWithRevolution(blade, *hub, 1.0, 0.0), GeometryError);
+  EXPECT_THROW(intersectWithRevolution(nullptr, *hub), GeometryError);
+}
+
+// ---------------------------------------------------------------------------------------
+TEST(Carriers, EvaluationDoesNotAllocate)
+{
+  const auto blade = twistedBladeLoft(GordonSurface::Blending::Spline);
+  const auto lagrange = twistedBladeLoft(GordonSurface::Blending::Lagrange);
+  const auto cone = coneAboutZ(0.55, -1, 0.75, 1);
+  const auto hub = intersectWithRevolution(blade, *cone);
+  std::vector<CurvePtr> sCurves, tCurves;
+  const std::vector<double> nodes = { 0.0, 0.5, 1.0 };
+  for (double u : nodes)
+  {
+    sCurves.push_back(std::make_shared<LineCurve>(twistedBlade(0, u), twistedBlade(1, u)));
+    tCurves.push_back(std::make_shared<LineCurve>(twistedBlade(u, 0), twistedBlade(u, 1)));
+  }
+  const GordonSurface network =
+    GordonSurface::fromNetwork(sCurves, nodes, tCurves, nodes, GordonSurface::Blending::Spline);
+  SurfaceDerivatives d;
+  double sink = cone->signedMeridionalDistance(Vec3(1, 1, 0)); // warms up the scratch
+  {
+    const long start = AllocationCount.load();
+    const auto probe = std::make_shared<int>(1); // the counter does see allocations
+    EXPECT_GT(AllocationCount.load() - start, 0);
+    sink += *probe;
+  }
+  const long before = AllocationCount.load();
+  for (int i = 0; i < 200; ++i)
+  {
+    const double s = i / 199.0, t = 1.4 * s - 0.2;
+    sink += blade->point(s, t).x() + lagrange->point(s, t).y() + network.point(s, t).z();
+    blade->derivatives(s, t, d);
+    sink += d.Ptt.x();
+    network.derivatives(s, t, d);
+    sink += d.Pst.y();
+    cone->derivatives(s, t, d);
+    sink += cone->point(s, t).z() + d.Pt.x();
+    sink += cone->signedMeridionalDistance(blade->point(s, t));
+    sink += hub->point(s).x() + hub->derivative(s, 2).y();
+    sink += rotateAboutAxis(Vec3(s, t, 1), Vec3::Zero(), Vec3::UnitZ(), t).x();
+  }
+  EXPECT_EQ(AllocationCount.load() - before, 0);
+  EXPECT_TRUE(std::isfinite(sink));
+}
