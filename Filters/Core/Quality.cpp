@@ -341,6 +341,45 @@ inline ShapeSums<T> shapeKernel(
   return sums;
 }
 
+/**
+ * Scaled Jacobian of a cell with collapsed edges (a wedge or prism written as a hex).
+ * Verdict gives such cells 1e30, which says nothing and ruins colour maps and means, so
+ * the grid pass uses the Verdict corner formula on the corners whose three edges all
+ * have length, plus the centre Jacobian when its vectors have length: a right wedge gets
+ * 1, an inverted one a negative value. 0 when no corner is measurable.
+ */
+double collapsedCellScaledJacobian(const P3 (&c)[8])
+{
+  // Verdict's corner order: the three neighbours of each corner, right-handed.
+  static const int neighbours[8][3] = { { 1, 3, 4 }, { 2, 0, 5 }, { 3, 1, 6 }, { 0, 2, 7 },
+    { 7, 5, 0 }, { 4, 6, 1 }, { 5, 7, 2 }, { 6, 4, 3 } };
+  double smallest = verdictMax;
+  bool measured = false;
+  for (int v = 0; v < 8; ++v)
+  {
+    const P3 a = c[neighbours[v][0]] - c[v];
+    const P3 b = c[neighbours[v][1]] - c[v];
+    const P3 d = c[neighbours[v][2]] - c[v];
+    const double a2 = dot(a, a), b2 = dot(b, b), d2 = dot(d, d);
+    if (a2 <= verdictMin || b2 <= verdictMin || d2 <= verdictMin)
+    {
+      continue;
+    }
+    smallest = std::min(smallest, dot(a, cross(b, d)) / std::sqrt(a2 * b2 * d2));
+    measured = true;
+  }
+  const P3 xi = (c[1] - c[0]) + (c[2] - c[3]) + (c[5] - c[4]) + (c[6] - c[7]);
+  const P3 eta = (c[3] - c[0]) + (c[2] - c[1]) + (c[7] - c[4]) + (c[6] - c[5]);
+  const P3 zeta = (c[4] - c[0]) + (c[5] - c[1]) + (c[6] - c[2]) + (c[7] - c[3]);
+  const double xi2 = dot(xi, xi), eta2 = dot(eta, eta), zeta2 = dot(zeta, zeta);
+  if (xi2 > verdictMin && eta2 > verdictMin && zeta2 > verdictMin)
+  {
+    smallest = std::min(smallest, dot(xi, cross(eta, zeta)) / std::sqrt(xi2 * eta2 * zeta2));
+    measured = true;
+  }
+  return measured ? smallest : 0.0;
+}
+
 /// Face angles of a cell with collapsed edges: each face loses its collapsed edges and
 /// the angles are taken between the remaining consecutive edges (a triangle for one
 /// collapsed edge); faces left with fewer than 3 edges have no angles.
@@ -1236,6 +1275,15 @@ private:
       quality_.minAngle[cell + l] = shape.minAngle;
       quality_.maxAngle[cell + l] = shape.maxAngle;
       quality_.scaledJacobian[cell + l] = shape.scaledJacobian;
+      if (shape.scaledJacobian == verdictMax)
+      {
+        P3 corners[8];
+        for (int v = 0; v < 8; ++v)
+        {
+          corners[v] = laneOf(c[v], l);
+        }
+        quality_.scaledJacobian[cell + l] = collapsedCellScaledJacobian(corners);
+      }
       quality_.aspectRatio[cell + l] = shape.aspectRatio;
     }
 

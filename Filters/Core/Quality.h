@@ -93,9 +93,11 @@ struct CellQualityArrays
  * with no area (collapsed edges of wedge/prism blocks) contribute nothing, and a block
  * boundary face is paired only when exactly one other face has the same corners.
  * Degenerate cells never give NaN: angles of collapsed faces are skipped (a cell with no
- * valid face gets MinAngle 0, MaxAngle 180), AspectRatio and ScaledJacobian follow
- * Verdict's convention of 1e30 (a collapsed edge makes the scaled Jacobian 1e30, as in
- * vtkMeshQuality).
+ * valid face gets MinAngle 0, MaxAngle 180), AspectRatio follows Verdict's convention of
+ * 1e30. The ScaledJacobian of a cell with a collapsed edge (where Verdict and
+ * vtkMeshQuality give 1e30) is the Verdict corner formula over the corners whose three
+ * edges have length, plus the centre: a wedge gets the sine of its smallest corner angle,
+ * an inverted one a negative value. hexScaledJacobian() stays Verdict-exact.
  */
 std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBlock>& blocks,
   const std::function<void(double)>& progress = {});
