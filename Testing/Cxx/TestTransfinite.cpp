@@ -384,16 +384,10 @@ TEST(TransfiniteBlock, WedgeWithCollapsedFaceGivesValidCells)
       for (int i = 0; i < b.ni - 1; ++i)
       {
         const double sj = quality[0].scaledJacobian[i + (b.ni - 1) * (j + (b.nj - 1) * k)];
-        EXPECT_GE(sj, 0.0);
-        if (i == 0)
-        {
-          EXPECT_EQ(sj, 1e30); // collapsed edge: Verdict's value
-        }
-        else
-        {
-          EXPECT_GT(sj, 0.5);
-          EXPECT_LE(sj, 1.0);
-        }
+        // Cells at the collapsed edge (i == 0) are wedges: measured on their own
+        // corners, not Verdict's 1e30.
+        EXPECT_GT(sj, i == 0 ? 0.3 : 0.5);
+        EXPECT_LE(sj, 1.0);
       }
     }
   }
