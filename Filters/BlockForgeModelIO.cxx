@@ -1,16 +1,166 @@
 #include "BlockForgeModelIO.h"
 
 #include "../Model/ModelDocument.h"
+#include "../Model/Template.h"
 
+#include <vtkCellArray.h>
+#include <vtkCompositeDataSet.h>
+#include <vtkDataArray.h>
 #include <vtkDataObject.h>
 #include <vtkFieldData.h>
+#include <vtkIdList.h>
+#include <vtkInformation.h>
+#include <vtkMultiBlockDataSet.h>
 #include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
 #include <vtkStringArray.h>
+
+#include <cmath>
+#include <stdexcept>
 
 namespace blockforge
 {
 namespace vtkglue
 {
+namespace
+{
+std::string blockName(vtkMultiBlockDataSet* parent, unsigned int index)
+{
+  if (parent->HasMetaData(index))
+  {
+    vtkInformation* meta = parent->GetMetaData(index);
+    if (meta->Has(vtkCompositeDataSet::NAME()))
+    {
+      return meta->Get(vtkCompositeDataSet::NAME());
+    }
+  }
+  return "Block " + std::to_string(index);
+}
+
+/// The points of a polyline (of all its line cells in order; the points when it has none).
+model::InputCurve readCurve(vtkPolyData* polyData, const std::string& name)
+{
+  model::InputCurve curve;
+  curve.name = name;
+  vtkPoints* points = polyData->GetPoints();
+  if (!points)
+  {
+    return curve;
+  }
+  auto add = [&](vtkIdType id) {
+    double p[3];
+    points->GetPoint(id, p);
+    curve.points.emplace_back(p[0], p[1], p[2]);
+  };
+  vtkCellArray* lines = polyData->GetLines();
+  if (lines && lines->GetNumberOfCells() > 0)
+  {
+    vtkNew<vtkIdList> ids;
+    for (lines->InitTraversal(); lines->GetNextCell(ids);)
+    {
+      for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k)
+      {
+        // consecutive cells of one polyline share their joint point: keep it once
+        if (k == 0 && !curve.points.empty())
+        {
+          double p[3];
+          points->GetPoint(ids->GetId(0), p);
+          if (curve.points.back() == Vec3(p[0], p[1], p[2]))
+          {
+            continue;
+          }
+        }
+        add(ids->GetId(k));
+      }
+    }
+  }
+  else
+  {
+    for (vtkIdType id = 0; id < points->GetNumberOfPoints(); ++id)
+    {
+      add(id);
+    }
+  }
+  if (vtkDataArray* span = polyData->GetFieldData()->GetArray("SpanFraction"))
+  {
+    if (span->GetNumberOfTuples() > 0)
+    {
+      curve.span = span->GetComponent(0, 0);
+    }
+  }
+  return curve;
+}
+} // namespace
+
+void readTemplateInputs(vtkDataObject* input, model::TemplateInputs& inputs)
+{
+  auto* root = vtkMultiBlockDataSet::SafeDownCast(input);
+  if (!root)
+  {
+    throw std::runtime_error(std::string("the input must be a multiblock of point sets (the "
+                                         "output of a TurboPointSetsReader), not a ") +
+      (input ? input->GetClassName() : "null object"));
+  }
+  inputs = model::TemplateInputs();
+  for (unsigned int b = 0; b < root->GetNumberOfBlocks(); ++b)
+  {
+    model::InputPointSet set;
+    set.name = blockName(root, b);
+    vtkDataObject* block = root->GetBlock(b);
+    if (auto* polyData = vtkPolyData::SafeDownCast(block))
+    {
+      set.curves.push_back(readCurve(polyData, set.name));
+    }
+    else if (auto* list = vtkMultiBlockDataSet::SafeDownCast(block))
+    {
+      set.isList = true;
+      for (unsigned int k = 0; k < list->GetNumberOfBlocks(); ++k)
+      {
+        if (auto* curve = vtkPolyData::SafeDownCast(list->GetBlock(k)))
+        {
+          set.curves.push_back(readCurve(curve, blockName(list, k)));
+        }
+        else
+        {
+          set.curves.emplace_back(); // an empty curve: reported if the template uses it
+          set.curves.back().name = blockName(list, k);
+        }
+      }
+    }
+    inputs.pointSets.push_back(set);
+  }
+  vtkFieldData* fields = root->GetFieldData();
+  if (vtkDataArray* axis = fields ? fields->GetArray("Axis") : nullptr)
+  {
+    if (axis->GetNumberOfTuples() * axis->GetNumberOfComponents() >= 3)
+    {
+      Vec3 direction;
+      for (int c = 0; c < 3; ++c)
+      {
+        direction[c] = axis->GetNumberOfComponents() >= 3 ? axis->GetComponent(0, c)
+                                                          : axis->GetComponent(c, 0);
+      }
+      if (direction.allFinite() && direction.norm() > 0.0)
+      {
+        inputs.hasMachine = true;
+        inputs.axis = direction.normalized();
+      }
+    }
+  }
+  if (vtkDataArray* count = fields ? fields->GetArray("BladeCount") : nullptr)
+  {
+    if (count->GetNumberOfTuples() > 0)
+    {
+      const double value = count->GetComponent(0, 0);
+      if (std::isfinite(value) && value >= 1.0 && value == std::floor(value))
+      {
+        inputs.bladeCount = static_cast<int>(value);
+      }
+    }
+  }
+}
+
 void attachModel(vtkFieldData* fieldData, const std::string& document)
 {
   vtkNew<vtkStringArray> array;
@@ -38,6 +188,7 @@ std::string findModelDocument(vtkDataObject* object)
 } // namespace vtkglue
 } // namespace blockforge
 
+#include "../Core/Quality.h"
 #include "../Model/Mesher.h"
 
 #include <vtkCellData.h>
@@ -72,6 +223,8 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
     vtkNew<vtkDoubleArray> coordinates;
     coordinates->SetNumberOfComponents(3);
     coordinates->SetNumberOfTuples(nodeCount);
+    // Fresh memory faulted in one go is much cheaper than page by page on some VMs.
+    prepareOutputMemory(coordinates->GetPointer(0), sizeof(double) * 3 * nodeCount);
     mesher.meshBlock(b, coordinates->GetPointer(0));
 
     vtkNew<vtkPoints> points;

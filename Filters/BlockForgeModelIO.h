@@ -15,8 +15,21 @@ class vtkFieldData;
 
 namespace blockforge
 {
+namespace model
+{
+struct TemplateInputs;
+}
 namespace vtkglue
 {
+/**
+ * The point sets of a filter input for a template (format 2 `inputs:`): every named block
+ * of the root multiblock that is a vtkPolyData becomes one curve (points in polyline
+ * order), every named multiblock of polydata a list of curves (with their "SpanFraction"),
+ * a null block an empty set; the root's field data "Axis" and "BladeCount" give the
+ * machine. Throws std::runtime_error when the input is not a multiblock.
+ */
+void readTemplateInputs(vtkDataObject* input, model::TemplateInputs& inputs);
+
 /// Stores the model document in `fieldData` (replacing an older one).
 void attachModel(vtkFieldData* fieldData, const std::string& document);
 /// The model document carried by `object`'s field data, or "" if none.

@@ -34,33 +34,6 @@ const char* const MeasureNames[6] = { "MinAngle", "MaxAngle", "NonOrthogonality"
   "AspectRatio", "ScaledJacobian" };
 const char* const ClassLabels[5] = { "0-20", "20-40", "40-60", "60-80", "80-90" };
 
-std::vector<double>& measure(blockforge::CellQualityArrays& quality, int index)
-{
-  switch (index)
-  {
-    case 0:
-      return quality.minAngle;
-    case 1:
-      return quality.maxAngle;
-    case 2:
-      return quality.nonOrthogonality;
-    case 3:
-      return quality.skewness;
-    case 4:
-      return quality.aspectRatio;
-    default:
-      return quality.scaledJacobian;
-  }
-}
-
-vtkSmartPointer<vtkDoubleArray> toVtkArray(const char* name, const std::vector<double>& values)
-{
-  auto array = vtkSmartPointer<vtkDoubleArray>::New();
-  array->SetName(name);
-  array->SetNumberOfTuples(static_cast<vtkIdType>(values.size()));
-  std::copy(values.begin(), values.end(), array->GetPointer(0));
-  return array;
-}
 } // namespace
 
 vtkGridQuality::vtkGridQuality()
@@ -144,11 +117,43 @@ int vtkGridQuality::RequestData(
     grids.push_back(grid);
   }
 
-  std::vector<blockforge::CellQualityArrays> quality;
+  // The measures are written straight into the output arrays: no copy, and the fresh
+  // memory is prepared in one go rather than faulted page by page.
+  std::vector<vtkSmartPointer<vtkStructuredGrid>> measuredGrids;
+  std::vector<std::array<vtkSmartPointer<vtkDoubleArray>, 6>> measureArrays(grids.size());
+  std::vector<blockforge::CellQualityPointers> outputs(grids.size());
+  for (size_t b = 0; b < grids.size(); ++b)
+  {
+    auto measured = vtkSmartPointer<vtkStructuredGrid>::New();
+    measured->ShallowCopy(grids[b]);
+    const vtkIdType cells = measured->GetNumberOfCells();
+    for (int m = 0; m < 6; ++m)
+    {
+      auto array = vtkSmartPointer<vtkDoubleArray>::New();
+      array->SetName(MeasureNames[m]);
+      array->SetNumberOfTuples(cells);
+      blockforge::prepareOutputMemory(array->GetPointer(0), sizeof(double) * cells);
+      measured->GetCellData()->AddArray(array);
+      measureArrays[b][m] = array;
+    }
+    outputs[b] = { measureArrays[b][0]->GetPointer(0), measureArrays[b][1]->GetPointer(0),
+      measureArrays[b][2]->GetPointer(0), measureArrays[b][3]->GetPointer(0),
+      measureArrays[b][4]->GetPointer(0), measureArrays[b][5]->GetPointer(0) };
+    // The mesher already labels its blocks; other inputs get the leaf ordinal.
+    if (!measured->GetCellData()->GetArray("BlockId"))
+    {
+      vtkNew<vtkIntArray> blockId;
+      blockId->SetName("BlockId");
+      blockId->SetNumberOfTuples(cells);
+      blockId->FillValue(static_cast<int>(b));
+      measured->GetCellData()->AddArray(blockId);
+    }
+    measuredGrids.push_back(measured);
+  }
   try
   {
-    quality = blockforge::computeGridQuality(
-      blocks, [this](double fraction) { this->UpdateProgress(0.9 * fraction); });
+    blockforge::computeGridQuality(
+      blocks, outputs, [this](double fraction) { this->UpdateProgress(0.9 * fraction); });
   }
   catch (const std::exception& error)
   {
@@ -162,33 +167,26 @@ int vtkGridQuality::RequestData(
   minimum.fill(std::numeric_limits<double>::max());
   maximum.fill(std::numeric_limits<double>::lowest());
   double cellCount = 0.0;
-  {
-    const auto classes = blockforge::minAngleClasses(quality);
-    std::copy(classes.begin(), classes.end(), classCounts.begin());
-  }
-  std::vector<vtkSmartPointer<vtkStructuredGrid>> measuredGrids;
   for (size_t b = 0; b < grids.size(); ++b)
   {
-    auto measured = vtkSmartPointer<vtkStructuredGrid>::New();
-    measured->ShallowCopy(grids[b]);
+    const vtkIdType cells = measureArrays[b][0]->GetNumberOfTuples();
     for (int m = 0; m < 6; ++m)
     {
-      const std::vector<double>& values = measure(quality[b], m);
-      for (double value : values)
+      const double* values = measureArrays[b][m]->GetPointer(0);
+      for (vtkIdType c = 0; c < cells; ++c)
       {
-        minimum[m] = std::min(minimum[m], value);
-        maximum[m] = std::max(maximum[m], value);
-        sum[m] += value;
+        minimum[m] = std::min(minimum[m], values[c]);
+        maximum[m] = std::max(maximum[m], values[c]);
+        sum[m] += values[c];
       }
-      measured->GetCellData()->AddArray(toVtkArray(MeasureNames[m], values));
     }
-    cellCount += static_cast<double>(quality[b].minAngle.size());
-    vtkNew<vtkIntArray> blockId;
-    blockId->SetName("BlockId");
-    blockId->SetNumberOfTuples(measured->GetNumberOfCells());
-    blockId->FillValue(static_cast<int>(b));
-    measured->GetCellData()->AddArray(blockId);
-    measuredGrids.push_back(measured);
+    const auto blockClasses = blockforge::minAngleClasses(
+      measureArrays[b][0]->GetPointer(0), static_cast<std::size_t>(cells));
+    for (int c = 0; c < 5; ++c)
+    {
+      classCounts[c] += static_cast<double>(blockClasses[c]);
+    }
+    cellCount += static_cast<double>(cells);
   }
 
   // Second traversal, same order as the first: put each measured grid in its leaf.

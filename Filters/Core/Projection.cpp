@@ -656,7 +656,12 @@ double adaptiveLength(const Curve& curve, double a, double b, double whole, doub
   const double left = gaussSpeed(curve, a, m);
   const double right = gaussSpeed(curve, m, b);
   const double halves = left + right;
-  if (depth >= 30 || std::abs(halves - whole) <= tolerance || !(m > a && m < b))
+  // The halved tolerance is floored at what rounding of the speed allows: curves whose
+  // speed is only known to rounding (curves on Gordon surfaces) would otherwise refine
+  // to the depth limit everywhere.
+  const double achievable = 1e-13 * std::abs(halves);
+  if (depth >= 24 || std::abs(halves - whole) <= std::max(tolerance, achievable) ||
+    !(m > a && m < b))
   {
     return halves;
   }

@@ -1101,6 +1101,16 @@ void reserveResultArrays(
     prefault(ranges[first].begin, spanEnd);
     first = last;
   }
+  // Sized only now, so that the zero fill touches prefaulted pages.
+  for (std::size_t n = 0; n < views.size(); ++n)
+  {
+    CellQualityArrays& q = quality[n];
+    for (std::vector<double>* values : { &q.minAngle, &q.maxAngle, &q.nonOrthogonality, &q.skewness,
+           &q.aspectRatio, &q.scaledJacobian })
+    {
+      values->resize(views[n].cellCount);
+    }
+  }
 }
 
 /// Points in structure-of-arrays form (a node plane, a layer of cell centres), so that
@@ -1160,7 +1170,7 @@ void edgeLengths(
 class BlockPass
 {
 public:
-  BlockPass(const BlockView& view, CellQualityArrays& quality, std::vector<double>& scratch)
+  BlockPass(const BlockView& view, const CellQualityPointers& quality, std::vector<double>& scratch)
     : view_(view)
     , quality_(quality)
     , plane_(static_cast<long>(view.ni) * view.nj)
@@ -1196,8 +1206,8 @@ public:
     {
       centres_[n] = { take(layerCells_), take(layerCells_), take(layerCells_) };
     }
-    minCosine2_ = quality.nonOrthogonality.data();
-    maxSkewness_ = quality.skewness.data();
+    minCosine2_ = quality.nonOrthogonality;
+    maxSkewness_ = quality.skewness;
   }
 
   /// Shape measures of every cell of layer k and the faces below and beside them.
@@ -1347,7 +1357,7 @@ private:
   }
 
   const BlockView& view_;
-  CellQualityArrays& quality_;
+  const CellQualityPointers& quality_;
   const long plane_, layerCells_;
   CoordinateArrays planes_[2];
   EdgeLengths iEdges_[2], jEdges_[2], kEdges_;
@@ -1360,7 +1370,7 @@ private:
 /// Block-boundary faces: interfaces are measured with the other cell's centre, true
 /// boundaries with OpenFOAM's boundary skewness only.
 void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
-  const InterfaceTable& interfaces, CellQualityArrays& quality)
+  const InterfaceTable& interfaces, const CellQualityPointers& quality)
 {
   const BlockView& view = views[blockIndex];
   for (int side = 0; side < 6; ++side)
@@ -1415,21 +1425,21 @@ void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
 }
 
 void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
-  const InterfaceTable& interfaces, CellQualityArrays& quality, std::vector<double>& scratch,
-  ProgressReporter& progress)
+  const InterfaceTable& interfaces, const CellQualityPointers& quality,
+  std::vector<double>& scratch, ProgressReporter& progress)
 {
   const BlockView& view = views[blockIndex];
   const long cellCount = view.cellCount;
-  quality.minAngle.assign(cellCount, 0.0);
-  quality.maxAngle.assign(cellCount, 0.0);
-  quality.nonOrthogonality.assign(cellCount, 1.0); // signed squared cosine until the end
-  quality.skewness.assign(cellCount, 0.0);
-  quality.aspectRatio.assign(cellCount, 0.0);
-  quality.scaledJacobian.assign(cellCount, 0.0);
   if (cellCount == 0)
   {
     return;
   }
+  std::fill_n(quality.minAngle, cellCount, 0.0);
+  std::fill_n(quality.maxAngle, cellCount, 0.0);
+  std::fill_n(quality.nonOrthogonality, cellCount, 1.0); // signed squared cosine until the end
+  std::fill_n(quality.skewness, cellCount, 0.0);
+  std::fill_n(quality.aspectRatio, cellCount, 0.0);
+  std::fill_n(quality.scaledJacobian, cellCount, 0.0);
   BlockPass pass(view, quality, scratch);
   for (int k = 0; k < view.ck; ++k)
   {
@@ -1437,8 +1447,9 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
     progress.advance(static_cast<double>(view.ci) * view.cj);
   }
   boundaryFaces(views, blockIndex, interfaces, quality);
-  for (double& value : quality.nonOrthogonality)
+  for (long cell = 0; cell < cellCount; ++cell)
   {
+    double& value = quality.nonOrthogonality[cell];
     value = angleFromCosine(std::copysign(std::sqrt(std::abs(value)), value));
   }
 }
@@ -1541,12 +1552,13 @@ double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea, const
   return boundarySkewness(toP3(ownerCentre), toP3(faceArea), toP3(faceCentre), q);
 }
 
-std::vector<CellQualityArrays> computeGridQuality(
-  const std::vector<StructuredBlock>& blocks, const std::function<void(double)>& progress)
+namespace
+{
+std::vector<BlockView> blockViews(const std::vector<StructuredBlock>& blocks, double& totalCells)
 {
   std::vector<BlockView> views;
   views.reserve(blocks.size());
-  double totalCells = 0.0;
+  totalCells = 0.0;
   for (std::size_t n = 0; n < blocks.size(); ++n)
   {
     const StructuredBlock& block = blocks[n];
@@ -1562,19 +1574,71 @@ std::vector<CellQualityArrays> computeGridQuality(
     }
     totalCells += static_cast<double>(views.back().cellCount);
   }
+  return views;
+}
 
+void evaluateBlocks(const std::vector<BlockView>& views, double totalCells,
+  const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress)
+{
   ProgressReporter reporter(progress, totalCells);
   reporter.start();
   const InterfaceTable interfaces = matchBlockInterfaces(views);
-  std::vector<CellQualityArrays> quality(blocks.size());
-  reserveResultArrays(quality, views);
   std::vector<double> scratch;
-  for (std::size_t n = 0; n < blocks.size(); ++n)
+  for (std::size_t n = 0; n < views.size(); ++n)
   {
-    evaluateBlock(views, static_cast<int>(n), interfaces, quality[n], scratch, reporter);
+    evaluateBlock(views, static_cast<int>(n), interfaces, outputs[n], scratch, reporter);
   }
   reporter.finish();
+}
+} // namespace
+
+std::vector<CellQualityArrays> computeGridQuality(
+  const std::vector<StructuredBlock>& blocks, const std::function<void(double)>& progress)
+{
+  double totalCells = 0.0;
+  const std::vector<BlockView> views = blockViews(blocks, totalCells);
+  std::vector<CellQualityArrays> quality(blocks.size());
+  reserveResultArrays(quality, views);
+  std::vector<CellQualityPointers> outputs(blocks.size());
+  for (std::size_t n = 0; n < blocks.size(); ++n)
+  {
+    CellQualityArrays& q = quality[n];
+    outputs[n] = { q.minAngle.data(), q.maxAngle.data(), q.nonOrthogonality.data(),
+      q.skewness.data(), q.aspectRatio.data(), q.scaledJacobian.data() };
+  }
+  evaluateBlocks(views, totalCells, outputs, progress);
   return quality;
+}
+
+void computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress)
+{
+  if (outputs.size() != blocks.size())
+  {
+    throw GeometryError("grid quality: " + std::to_string(outputs.size()) +
+      " output buffers for " + std::to_string(blocks.size()) + " blocks");
+  }
+  double totalCells = 0.0;
+  const std::vector<BlockView> views = blockViews(blocks, totalCells);
+  evaluateBlocks(views, totalCells, outputs, progress);
+}
+
+void prepareOutputMemory(void* begin, std::size_t bytes)
+{
+  const auto start = reinterpret_cast<std::uintptr_t>(begin);
+  prefault(start, start + bytes);
+}
+
+std::array<long long, 5> minAngleClasses(const double* minAngles, std::size_t count)
+{
+  std::array<long long, 5> counts{};
+  for (std::size_t c = 0; c < count; ++c)
+  {
+    // Comparisons rather than a cast so that a NaN cannot index out of range.
+    const double angle = minAngles[c];
+    ++counts[(angle >= 20.0) + (angle >= 40.0) + (angle >= 60.0) + (angle >= 80.0)];
+  }
+  return counts;
 }
 
 std::array<long long, 5> minAngleClasses(const std::vector<CellQualityArrays>& quality)
@@ -1582,11 +1646,10 @@ std::array<long long, 5> minAngleClasses(const std::vector<CellQualityArrays>& q
   std::array<long long, 5> counts{};
   for (const CellQualityArrays& block : quality)
   {
-    for (double angle : block.minAngle)
+    const auto blockCounts = minAngleClasses(block.minAngle.data(), block.minAngle.size());
+    for (int c = 0; c < 5; ++c)
     {
-      // Comparisons rather than a cast so that a NaN cannot index out of range.
-      const int bin = (angle >= 20.0) + (angle >= 40.0) + (angle >= 60.0) + (angle >= 80.0);
-      ++counts[bin];
+      counts[c] += blockCounts[c];
     }
   }
   return counts;

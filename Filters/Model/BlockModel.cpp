@@ -28,6 +28,54 @@ int BlockModel::findBlock(const std::string& blockName) const
   return -1;
 }
 
+int BlockModel::findCarrier(const std::string& carrierName) const
+{
+  for (std::size_t i = 0; i < carriers.size(); ++i)
+  {
+    if (carriers[i].name == carrierName)
+    {
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+int BlockModel::requiredFormat() const
+{
+  if (machine.defined || !carriers.empty() || !surfaceFaces.empty())
+  {
+    return 2;
+  }
+  for (const Vertex& vertex : vertices)
+  {
+    if (vertex.constraint.carrier >= 0 || vertex.constraint.periodicSource >= 0)
+    {
+      return 2;
+    }
+  }
+  for (const Edge& edge : edges)
+  {
+    if (edge.kind != Edge::Kind::Line && edge.kind != Edge::Kind::Arc &&
+      edge.kind != Edge::Kind::Spline)
+    {
+      return 2;
+    }
+  }
+  for (const Patch& patch : patches)
+  {
+    if (patch.pitches != 0)
+    {
+      return 2;
+    }
+  }
+  return 1;
+}
+
+double Machine::pitch() const
+{
+  return bladeCount > 0 ? 2.0 * 3.14159265358979323846 / bladeCount : 0.0;
+}
+
 int BlockModel::findEdge(int a, int b) const
 {
   for (std::size_t i = 0; i < edges.size(); ++i)

@@ -12,6 +12,8 @@
 #include "../Core/Distribution.h"
 #include "../Core/Types.h"
 
+#include <Eigen/Core>
+
 #include <array>
 #include <map>
 #include <string>
@@ -28,10 +30,92 @@ struct SourceLocation
   int line = 0; ///< 1-based, 0 when unknown
 };
 
+/**
+ * The machine (format 2): axis of rotation and blade count, from the filter input (the
+ * reader's Axis and BladeCount) or the template's `machine:` section. Periodic vertices,
+ * edges and patches rotate about this axis by whole pitches.
+ */
+struct Machine
+{
+  bool defined = false;
+  Vec3 axisPoint = Vec3::Zero();
+  Vec3 axis = Vec3::UnitZ(); ///< unit vector
+  int bladeCount = 0;        ///< 0: unknown (pitch undefined)
+  /// 2 pi / bladeCount, 0 when unknown.
+  double pitch() const;
+};
+
+/**
+ * A carrier (paper Fig. 3, Ec/Sc): a curve or surface built from point data or from other
+ * carriers. Carriers are stored with their complete definition (input points with 17
+ * digits in the model document), so every stage rebuilds the same geometry bit for bit.
+ */
+struct Carrier
+{
+  enum class Kind
+  {
+    Interpolate,  ///< curve: B-spline through `points` (degree, parameter method)
+    Revolve,      ///< surface: refs[0] (a curve) swept about axis, t -> angleStart..angleEnd
+    Gordon,       ///< surface: lofted through section curves refs at t = nodes (eqs. 4-5)
+    Network,      ///< surface: Gordon through s-curves refs at t = nodes and t-curves
+                  ///< crossRefs at s = crossNodes
+    Coons,        ///< surface: Coons patch (eq. 3) from refs = bottom, right, top, left
+    SurfaceCurve, ///< curve: through parameterPoints in the (s, t) space of surface refs[0]
+    Intersect     ///< curve: surface refs[0] (Gordon) cut by revolution surface refs[1]
+  };
+  enum class Blending
+  {
+    Spline,
+    Lagrange
+  };
+  std::string name;
+  Kind kind = Kind::Interpolate;
+  std::vector<Vec3> points;
+  int degree = 3;
+  /// 0 uniform, 1 chord length, 2 centripetal (ParameterMethod order).
+  int parameterMethod = 1;
+  std::vector<int> refs;
+  std::vector<int> crossRefs;
+  std::vector<double> nodes;
+  std::vector<double> crossNodes;
+  Blending blending = Blending::Spline;
+  /// Gordon/Network: every section is a closed loop (s = 0 and s = 1 coincide); checked.
+  bool closed = false;
+  Vec3 axisPoint = Vec3::Zero();
+  Vec3 axis = Vec3::UnitZ();
+  double angleStart = 0.0, angleEnd = 0.0;
+  std::vector<Eigen::Vector2d> parameterPoints;
+  double rangeMin = -0.5, rangeMax = 1.5; ///< Intersect: t range searched on refs[0]
+  int samples = 64;                       ///< Intersect: s samples
+  SourceLocation where;
+
+  bool isSurface() const
+  {
+    return kind == Kind::Revolve || kind == Kind::Gordon || kind == Kind::Network ||
+      kind == Kind::Coons;
+  }
+};
+
+/**
+ * How a vertex is attached (paper Fig. 5). A vertex with a carrier is a control point:
+ * the optimizer may move it along the carrier by changing (s, t); its position is always
+ * carrier(s, t). A periodic vertex is the rotation of another vertex by `pitches` machine
+ * pitches; if it also has a carrier, these are the image's parameters (the source's with
+ * the periodic offset).
+ */
+struct VertexConstraint
+{
+  int carrier = -1; ///< -1: not attached
+  double s = 0.0, t = 0.0;
+  int periodicSource = -1; ///< -1: not periodic
+  int pitches = 0;
+};
+
 struct Vertex
 {
   std::string name;
   Vec3 position = Vec3::Zero();
+  VertexConstraint constraint;
   SourceLocation where;
 };
 
@@ -42,7 +126,11 @@ struct Edge
   {
     Line,
     Arc,   ///< circular arc, from `centre` or through `through`
-    Spline ///< cubic B-spline interpolating from, points..., to
+    Spline,    ///< cubic B-spline interpolating from, points..., to
+    OnCurve,   ///< the piece of curve carrier `carrier` between the ends' parameters
+    OnSurface, ///< straight in the (s, t) space of surface carrier `carrier`
+    Project,   ///< straight line from -> to with its nodes projected onto `carrier`
+    Periodic   ///< the nodes of edge `source` rotated by `pitches` machine pitches
   };
   std::string name;
   Kind kind = Kind::Line;
@@ -51,6 +139,13 @@ struct Edge
   Vec3 arcCentre = Vec3::Zero();
   Vec3 arcThrough = Vec3::Zero();
   std::vector<Vec3> splinePoints; ///< interior points, from `from` towards `to`
+  int carrier = -1; ///< OnCurve, OnSurface, Project
+  /// OnCurve: [u_from, u_to]; OnSurface: [s_from, t_from, s_to, t_to]; empty: taken from
+  /// the end vertices (their constraint on this carrier, else their projection). Values
+  /// outside [0, 1] wrap around a closed carrier.
+  std::vector<double> at;
+  int source = -1; ///< Periodic: index of the edge this one is the image of
+  int pitches = 0; ///< Periodic
   SourceLocation where;
 };
 
@@ -87,12 +182,24 @@ struct Patch
   Vec3 periodicAxisPoint = Vec3::Zero();
   Vec3 periodicAxis = Vec3::UnitZ();
   double periodicAngle = 0.0; ///< radians, right-hand rule about periodicAxis
+  int pitches = 0; ///< format 2: the angle is `pitches` machine pitches (0: given as angle)
+  SourceLocation where;
+};
+
+/// Block faces whose grids lie on a surface carrier (format 2 `faces:` section).
+struct SurfaceFaces
+{
+  std::string name;
+  int carrier = -1;
+  std::vector<BlockFace> faces;
   SourceLocation where;
 };
 
 struct BlockModel
 {
-  static constexpr int FormatVersion = 1;
+  /// Newest model document format; documents of models without format-2 entities are
+  /// still written as format 1.
+  static constexpr int FormatVersion = 2;
   std::string name;
   std::string sourceFile;
   /// Parameter values after overrides, in definition order.
@@ -101,9 +208,15 @@ struct BlockModel
   std::vector<Edge> edges;
   std::vector<Block> blocks;
   std::vector<Patch> patches;
+  Machine machine;
+  std::vector<Carrier> carriers;
+  std::vector<SurfaceFaces> surfaceFaces;
 
   int findVertex(const std::string& name) const; ///< -1 if absent
   int findBlock(const std::string& name) const;  ///< -1 if absent
+  int findCarrier(const std::string& name) const; ///< -1 if absent
+  /// 2 when the model uses carriers, constraints, surface faces or a machine, else 1.
+  int requiredFormat() const;
   /// Index into `edges` of the edge joining a and b in either direction, -1 if straight.
   int findEdge(int a, int b) const;
 };

@@ -4,6 +4,7 @@
 #include "../Core/Curve.h"
 #include "../Core/Projection.h"
 #include "../Core/Transfinite.h"
+#include "CarrierGeometry.h"
 #include "ModelSyntax.h"
 
 #include <Eigen/Geometry>
@@ -83,14 +84,151 @@ struct NamedCurve
 {
   CurvePtr curve;
   std::shared_ptr<const ArcLength> arcLength; ///< splines only: arcs are arc-length already
+  std::shared_ptr<const ArcLengthTable> lengthTable; ///< curves on carriers
   double length = 0.0;
+  int projectOnto = -1; ///< Project: the nodes of the straight line are projected onto it
 };
 
-NamedCurve buildNamedCurve(const BlockModel& model, const Edge& edge)
+/// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.
+double carrierTolerance(const CarrierGeometry& geometry, int carrier, double size)
+{
+  return 1e-9 * std::max(size, geometry.size(carrier));
+}
+
+/// Parameter(s) of an edge end on the edge's carrier: from `at`, else from the vertex.
+Eigen::Vector2d edgeEndParameters(const BlockModel& model, const CarrierGeometry& geometry,
+  const Edge& edge, int end, double size)
+{
+  const int vertex = end == 0 ? edge.from : edge.to;
+  const bool surface = edge.kind != Edge::Kind::OnCurve;
+  const std::size_t per = surface ? 2 : 1;
+  if (edge.at.size() == 2 * per)
+  {
+    Eigen::Vector2d st(edge.at[end * per], surface ? edge.at[end * per + 1] : 0.0);
+    const double distance =
+      (geometry.point(edge.carrier, st[0], st[1]) - model.vertices[vertex].position).norm();
+    if (distance > carrierTolerance(geometry, edge.carrier, size))
+    {
+      throw GeometryError("'at' puts its " + std::string(end == 0 ? "first" : "second") +
+        " end " + shortNumber(distance) + " away from vertex '" + model.vertices[vertex].name +
+        "'");
+    }
+    return st;
+  }
+  double s = 0.0, t = 0.0, distance = 0.0;
+  geometry.vertexParameters(model, vertex, edge.carrier, s, t, distance);
+  if (distance > carrierTolerance(geometry, edge.carrier, size))
+  {
+    throw GeometryError("vertex '" + model.vertices[vertex].name + "' is not on carrier '" +
+      model.carriers[edge.carrier].name + "' (" + shortNumber(distance) +
+      " away); attach it to the carrier");
+  }
+  return Eigen::Vector2d(s, t);
+}
+
+NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::vector<NamedCurve>& previous, const Edge& edge, double size)
 {
   const Vec3& start = model.vertices[edge.from].position;
   const Vec3& end = model.vertices[edge.to].position;
   NamedCurve named;
+  const int carrierCount = static_cast<int>(model.carriers.size());
+  if ((edge.kind == Edge::Kind::OnCurve || edge.kind == Edge::Kind::OnSurface ||
+        edge.kind == Edge::Kind::Project) &&
+    (edge.carrier < 0 || edge.carrier >= carrierCount))
+  {
+    throw GeometryError("refers to a carrier that does not exist");
+  }
+  switch (edge.kind)
+  {
+    case Edge::Kind::OnCurve:
+    {
+      if (geometry.isSurface(edge.carrier))
+      {
+        throw GeometryError("carrier '" + model.carriers[edge.carrier].name +
+          "' is a surface; on_curve needs a curve");
+      }
+      const double u0 = edgeEndParameters(model, geometry, edge, 0, size)[0];
+      const double u1 = edgeEndParameters(model, geometry, edge, 1, size)[0];
+      if (u0 == u1)
+      {
+        throw GeometryError("both ends are at the same curve parameter");
+      }
+      named.curve = std::make_shared<SubCurve>(
+        geometry.curve(edge.carrier), u0, u1, geometry.closedS(edge.carrier));
+      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve);
+      named.length = named.lengthTable->totalLength();
+      break;
+    }
+    case Edge::Kind::OnSurface:
+    {
+      if (!geometry.isSurface(edge.carrier))
+      {
+        throw GeometryError("carrier '" + model.carriers[edge.carrier].name +
+          "' is a curve; on_surface needs a surface");
+      }
+      const Eigen::Vector2d a = edgeEndParameters(model, geometry, edge, 0, size);
+      const Eigen::Vector2d b = edgeEndParameters(model, geometry, edge, 1, size);
+      named.curve = std::make_shared<ParameterLineCurve>(geometry.surface(edge.carrier), a, b,
+        geometry.closedS(edge.carrier), geometry.closedT(edge.carrier),
+        geometry.extendsT(edge.carrier));
+      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve);
+      named.length = named.lengthTable->totalLength();
+      break;
+    }
+    case Edge::Kind::Project:
+    {
+      named.curve = std::make_shared<LineCurve>(start, end);
+      named.length = (end - start).norm();
+      named.projectOnto = edge.carrier;
+      for (int k = 0; k < 2; ++k)
+      {
+        const int vertex = k == 0 ? edge.from : edge.to;
+        double s = 0.0, t = 0.0, distance = 0.0;
+        geometry.vertexParameters(model, vertex, edge.carrier, s, t, distance);
+        if (distance > carrierTolerance(geometry, edge.carrier, size))
+        {
+          throw GeometryError("vertex '" + model.vertices[vertex].name + "' is not on carrier '" +
+            model.carriers[edge.carrier].name + "' (" + shortNumber(distance) +
+            " away); the ends of a projected edge must lie on it");
+        }
+      }
+      break;
+    }
+    case Edge::Kind::Periodic:
+    {
+      const int self = static_cast<int>(&edge - model.edges.data());
+      if (edge.source < 0 || edge.source >= self)
+      {
+        throw GeometryError("the source of a periodic edge must be an edge defined before it");
+      }
+      if (!model.machine.defined || model.machine.bladeCount <= 0)
+      {
+        throw GeometryError("a periodic edge needs the machine's blade count");
+      }
+      const Edge& source = model.edges[edge.source];
+      const double angle = edge.pitches * model.machine.pitch();
+      const double tolerance = 1e-9 * size;
+      for (int k = 0; k < 2; ++k)
+      {
+        const Vertex& image = model.vertices[k == 0 ? edge.from : edge.to];
+        const Vertex& original = model.vertices[k == 0 ? source.from : source.to];
+        const Vec3 rotated = rotateAboutAxis(
+          original.position, model.machine.axisPoint, model.machine.axis, angle);
+        const double miss = (rotated - image.position).norm();
+        if (miss > tolerance)
+        {
+          throw GeometryError("vertex '" + image.name + "' is not the image of '" +
+            original.name + "' of source edge '" + source.name + "' rotated by " +
+            std::to_string(edge.pitches) + " pitch(es) (off by " + shortNumber(miss) + ")");
+        }
+      }
+      named.length = previous[edge.source].length;
+      break;
+    }
+    default:
+      break;
+  }
   switch (edge.kind)
   {
     case Edge::Kind::Line:
@@ -118,6 +256,8 @@ NamedCurve buildNamedCurve(const BlockModel& model, const Edge& edge)
       named.length = named.arcLength->totalLength();
       break;
     }
+    default:
+      break;
   }
   if (!std::isfinite(named.length) || !(named.length > 0.0))
   {
@@ -127,14 +267,15 @@ NamedCurve buildNamedCurve(const BlockModel& model, const Edge& edge)
 }
 
 /// Curves of all named edges; GeometryError becomes a TemplateError naming the edge.
-std::vector<NamedCurve> buildNamedCurves(const BlockModel& model)
+std::vector<NamedCurve> buildNamedCurves(const BlockModel& model, const CarrierGeometry& geometry)
 {
   std::vector<NamedCurve> curves;
+  const double size = modelSize(model);
   for (const Edge& edge : model.edges)
   {
     try
     {
-      curves.push_back(buildNamedCurve(model, edge));
+      curves.push_back(buildNamedCurve(model, geometry, curves, edge, size));
     }
     catch (const GeometryError& error)
     {
@@ -894,13 +1035,17 @@ void faceFromEdges(const BlockModel& model, const Topology& topology, int block,
 }
 
 void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& curves,
-  UniqueEdge& edge)
+  const CarrierGeometry& geometry, UniqueEdge& edge)
 {
   const Vec3& start = model.vertices[edge.a].position;
   const Vec3& end = model.vertices[edge.b].position;
   const int n = edge.nodeCount;
   edge.xyz.resize(3 * n);
   const NamedCurve* named = edge.named >= 0 ? &curves[edge.named] : nullptr;
+  if (named && model.edges[edge.named].kind == Edge::Kind::Periodic)
+  {
+    return; // rotated from its source edge afterwards
+  }
   // The named edge may run b -> a; its curve is evaluated at the mirrored fraction.
   const bool curveReversed = named && model.edges[edge.named].from != edge.a;
   for (int i = 0; i < n; ++i)
@@ -914,15 +1059,23 @@ void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& cu
     {
       point = end;
     }
-    else if (!named || model.edges[edge.named].kind == Edge::Kind::Line)
+    else if (!named || model.edges[edge.named].kind == Edge::Kind::Line ||
+      model.edges[edge.named].kind == Edge::Kind::Project)
     {
       point = (1.0 - edge.params[i]) * start + edge.params[i] * end;
+      if (named && named->projectOnto >= 0)
+      {
+        double s = 0.0, t = 0.0, distance = 0.0;
+        geometry.project(named->projectOnto, point, s, t, distance);
+        point = geometry.point(named->projectOnto, s, t);
+      }
     }
     else
     {
       const double fraction = curveReversed ? 1.0 - edge.params[i] : edge.params[i];
-      const double t =
-        named->arcLength ? named->arcLength->parameterAtFraction(fraction) : fraction;
+      const double t = named->lengthTable ? named->lengthTable->parameterAtFraction(fraction)
+        : named->arcLength                ? named->arcLength->parameterAtFraction(fraction)
+                                          : fraction;
       point = named->curve->point(t);
     }
     for (int c = 0; c < 3; ++c)
@@ -931,17 +1084,515 @@ void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& cu
     }
   }
 }
+
+std::map<std::pair<int, int>, int> edgeLookup(const Topology& topology)
+{
+  std::map<std::pair<int, int>, int> lookup;
+  for (std::size_t e = 0; e < topology.edges.size(); ++e)
+  {
+    lookup.emplace(std::make_pair(topology.edges[e].a, topology.edges[e].b), static_cast<int>(e));
+  }
+  return lookup;
+}
+
+int findUniqueEdge(const std::map<std::pair<int, int>, int>& lookup, int a, int b)
+{
+  const auto found = lookup.find(std::make_pair(std::min(a, b), std::max(a, b)));
+  return found == lookup.end() ? -1 : found->second;
+}
+
+/**
+ * Makes unique edge `image` (running imageFrom -> imageTo) the rotation of unique edge
+ * `source` (running sourceFrom -> sourceTo): interior nodes rotated, end nodes the vertices
+ * themselves. The node parameters of both must agree (the same grading).
+ */
+void rotateEdgeNodes(const BlockModel& model, Topology& topology, int source, int sourceFrom,
+  int image, int imageFrom, const Vec3& axisPoint, const Vec3& axis, double angle,
+  const SourceLocation& where, const std::string& entityText)
+{
+  const UniqueEdge& from = topology.edges[source];
+  UniqueEdge& to = topology.edges[image];
+  const int n = to.nodeCount;
+  if (from.nodeCount != n)
+  {
+    fail(where, entityText,
+      "edge " + edgeText(model, to.a, to.b) + " has " + std::to_string(n - 1) +
+        " cells but its periodic source " + edgeText(model, from.a, from.b) + " has " +
+        std::to_string(from.nodeCount - 1));
+  }
+  const bool sourceForward = sourceFrom == from.a;
+  const bool imageForward = imageFrom == to.a;
+  double difference = 0.0;
+  for (int i = 0; i < n; ++i)
+  {
+    const int along = imageForward ? i : n - 1 - i; // index along imageFrom -> imageTo
+    const int sourceIndex = sourceForward ? along : n - 1 - along;
+    const double sourceParam =
+      sourceForward ? from.params[sourceIndex] : 1.0 - from.params[sourceIndex];
+    const double imageParam = imageForward ? to.params[i] : 1.0 - to.params[i];
+    difference = std::max(difference, std::abs(sourceParam - imageParam));
+    if (i == 0 || i == n - 1)
+    {
+      const Vec3& vertex = model.vertices[i == 0 ? to.a : to.b].position;
+      std::copy_n(vertex.data(), 3, &to.xyz[3 * i]);
+      continue;
+    }
+    const Vec3 p(from.xyz[3 * sourceIndex], from.xyz[3 * sourceIndex + 1], from.xyz[3 * sourceIndex + 2]);
+    const Vec3 q = rotateAboutAxis(p, axisPoint, axis, angle);
+    std::copy_n(q.data(), 3, &to.xyz[3 * i]);
+  }
+  if (difference > 1e-12)
+  {
+    fail(where, entityText,
+      "edge " + edgeText(model, to.a, to.b) + " places its nodes differently from its periodic "
+      "source " + edgeText(model, from.a, from.b) + " (by up to " + shortNumber(difference) +
+        " of the edge length); give both the same grading");
+  }
+}
+
+/// Named periodic edges: rotated copies of their source edges.
+void computePeriodicEdges(const BlockModel& model, Topology& topology)
+{
+  const auto lookup = edgeLookup(topology);
+  for (std::size_t e = 0; e < topology.edges.size(); ++e)
+  {
+    const UniqueEdge& edge = topology.edges[e];
+    if (edge.named < 0 || model.edges[edge.named].kind != Edge::Kind::Periodic)
+    {
+      continue;
+    }
+    const Edge& named = model.edges[edge.named];
+    const Edge& source = model.edges[named.source];
+    const int sourceEdge = findUniqueEdge(lookup, source.from, source.to);
+    if (sourceEdge < 0)
+    {
+      fail(named.where, entity("edge", named.name),
+        "its source edge '" + source.name + "' is not an edge of any block");
+    }
+    rotateEdgeNodes(model, topology, sourceEdge, source.from, static_cast<int>(e), named.from,
+      model.machine.axisPoint, model.machine.axis, named.pitches * model.machine.pitch(),
+      named.where, entity("edge", named.name));
+  }
+}
+
+/// A face of a periodic patch whose grid is the rotation of a face of its partner.
+struct PeriodicImage
+{
+  int source = -1, image = -1; ///< unique faces
+  FaceTransform transform;     ///< image owner (a, b) -> source owner (a, b)
+  Vec3 axisPoint, axis;
+  double angle = 0.0;
+  int patch = -1;              ///< the patch the source face belongs to
+};
+
+/**
+ * For every periodic pair, the faces of the later patch are images of the faces of the
+ * earlier one (rotated by the earlier patch's angle).
+ */
+std::vector<PeriodicImage> periodicImages(const BlockModel& model, const Topology& topology, double size)
+{
+  std::vector<PeriodicImage> images;
+  const double tolerance = 1e-9 * size;
+  const int count = static_cast<int>(model.patches.size());
+  for (int p = 0; p < count; ++p)
+  {
+    const Patch& patch = model.patches[p];
+    if (patch.type != "periodic")
+    {
+      continue;
+    }
+    int partner = -1;
+    for (int q = 0; q < count; ++q)
+    {
+      if (model.patches[q].name == patch.periodicPartner)
+      {
+        partner = q;
+      }
+    }
+    if (partner <= p)
+    {
+      continue; // the pair is handled from its first patch
+    }
+    const std::string entityText = entity("patch", model.patches[partner].name);
+    for (const BlockFace& face : patch.faces)
+    {
+      const int source = topology.blocks[face.block].face[face.face];
+      const UniqueFace& from = topology.faces[source];
+      std::array<Vec3, 4> rotated;
+      for (int c = 0; c < 4; ++c)
+      {
+        rotated[c] = rotateAboutAxis(model.vertices[from.ownerIds[c]].position,
+          patch.periodicAxisPoint, patch.periodicAxis.normalized(), patch.periodicAngle);
+      }
+      bool found = false;
+      for (const BlockFace& other : model.patches[partner].faces)
+      {
+        const int image = topology.blocks[other.block].face[other.face];
+        const UniqueFace& to = topology.faces[image];
+        for (int code = 0; code < 8 && !found; ++code)
+        {
+          const FaceTransform transform{ code };
+          bool same = true;
+          for (int c = 0; c < 4 && same; ++c)
+          {
+            same = (rotated[transform.mapCorner(c)] - model.vertices[to.ownerIds[c]].position)
+                     .norm() <= tolerance;
+          }
+          const int mappedA = transform.swap() ? to.nb : to.na;
+          const int mappedB = transform.swap() ? to.na : to.nb;
+          if (same && mappedA == from.na && mappedB == from.nb)
+          {
+            PeriodicImage entry;
+            entry.source = source;
+            entry.image = image;
+            entry.transform = transform;
+            entry.axisPoint = patch.periodicAxisPoint;
+            entry.axis = patch.periodicAxis.normalized();
+            entry.angle = patch.periodicAngle;
+            entry.patch = p;
+            images.push_back(entry);
+            found = true;
+          }
+        }
+        if (found)
+        {
+          break;
+        }
+      }
+      if (!found)
+      {
+        fail(model.patches[partner].where, entityText,
+          "no face matches the rotation of face " + faceText(model, face.block, face.face) +
+            " of periodic partner '" + patch.name + "' node for node");
+      }
+    }
+  }
+  return images;
+}
+
+/// The edges of every periodic image face: rotations of the source face's edges.
+void computePeriodicPatchEdges(const BlockModel& model, Topology& topology,
+  const std::vector<PeriodicImage>& images)
+{
+  const auto lookup = edgeLookup(topology);
+  for (const PeriodicImage& entry : images)
+  {
+    const UniqueFace& from = topology.faces[entry.source];
+    const UniqueFace& to = topology.faces[entry.image];
+    for (int k = 0; k < 4; ++k)
+    {
+      const int g0 = to.ownerIds[k], g1 = to.ownerIds[(k + 1) % 4];
+      const int f0 = from.ownerIds[entry.transform.mapCorner(k)];
+      const int f1 = from.ownerIds[entry.transform.mapCorner((k + 1) % 4)];
+      if (g0 == g1 || f0 == f1)
+      {
+        continue; // collapsed
+      }
+      const int image = findUniqueEdge(lookup, g0, g1);
+      const int source = findUniqueEdge(lookup, f0, f1);
+      if (image < 0 || source < 0 || image == source)
+      {
+        continue;
+      }
+      const Patch& patch = model.patches[entry.patch];
+      rotateEdgeNodes(model, topology, source, f0, image, g0, entry.axisPoint, entry.axis,
+        entry.angle, patch.where, entity("patch", patch.name));
+    }
+  }
+}
+
+/// Copies the boundary nodes of a face grid from its block's edges (bit for bit).
+void copyFaceBoundary(const BlockModel& model, const Topology& topology, int block, int face,
+  int na, int nb, std::vector<double>& grid);
+
+/// Grid of a face that lies on a surface: TFI in the surface's (s, t) space, boundary
+/// nodes kept from the edges, interior nodes evaluated on the surface.
+void surfaceFace(const BlockModel& model, const Topology& topology, const CarrierGeometry& geometry,
+  int carrier, int block, int face, std::vector<double>& out)
+{
+  const std::array<int, 4> edges = faceEdges(face);
+  const LocalEdge bottom = localEdge(model, topology, block, edges[0]);
+  const LocalEdge top = localEdge(model, topology, block, edges[1]);
+  const LocalEdge left = localEdge(model, topology, block, edges[2]);
+  const LocalEdge right = localEdge(model, topology, block, edges[3]);
+  const int na = bottom.count, nb = left.count;
+  // The boundary loop: bottom (a up), right (b up), top (a down), left (b down).
+  std::vector<Vec3> loop;
+  auto node = [](const LocalEdge& edge, int i) {
+    const double* p = edge.xyz() + 3 * i;
+    return Vec3(p[0], p[1], p[2]);
+  };
+  for (int a = 0; a < na; ++a)
+    loop.push_back(node(bottom, a));
+  for (int b = 1; b < nb; ++b)
+    loop.push_back(node(right, b));
+  for (int a = na - 2; a >= 0; --a)
+    loop.push_back(node(top, a));
+  for (int b = nb - 2; b >= 1; --b)
+    loop.push_back(node(left, b));
+  const int loopSize = static_cast<int>(loop.size());
+  std::vector<Eigen::Vector2d> st(loopSize);
+  for (int k = 0; k < loopSize; ++k)
+  {
+    double s = 0.0, t = 0.0, distance = 0.0;
+    geometry.project(carrier, loop[k], s, t, distance);
+    st[k] = Eigen::Vector2d(s, t);
+  }
+  // Unwrap across the seam of closed directions.
+  const bool closed[2] = { geometry.closedS(carrier), geometry.closedT(carrier) };
+  for (int k = 1; k < loopSize; ++k)
+  {
+    for (int d = 0; d < 2; ++d)
+    {
+      if (!closed[d])
+        continue;
+      while (st[k][d] - st[k - 1][d] > 0.5)
+        st[k][d] -= 1.0;
+      while (st[k][d] - st[k - 1][d] < -0.5)
+        st[k][d] += 1.0;
+    }
+  }
+  auto fill = [&](int count, auto index) {
+    std::vector<double> xyz(3 * count);
+    for (int i = 0; i < count; ++i)
+    {
+      const Eigen::Vector2d& p = st[index(i) % loopSize];
+      xyz[3 * i] = p[0];
+      xyz[3 * i + 1] = p[1];
+      xyz[3 * i + 2] = 0.0;
+    }
+    return xyz;
+  };
+  const std::vector<double> pb = fill(na, [&](int a) { return a; });
+  const std::vector<double> pr = fill(nb, [&](int b) { return (na - 1) + b; });
+  const std::vector<double> pt = fill(na, [&](int a) { return (na - 1) + (nb - 1) + (na - 1 - a); });
+  const std::vector<double> pl =
+    fill(nb, [&](int b) { return 2 * (na - 1) + (nb - 1) + (nb - 1 - b); });
+  std::vector<double> parameters(3 * static_cast<std::size_t>(na) * nb);
+  transfiniteFace(EdgeNodes{ pb.data(), bottom.params(), na }, EdgeNodes{ pt.data(), top.params(), na },
+    EdgeNodes{ pl.data(), left.params(), nb }, EdgeNodes{ pr.data(), right.params(), nb },
+    parameters.data());
+  out.resize(parameters.size());
+  for (int b = 1; b + 1 < nb; ++b)
+  {
+    for (int a = 1; a + 1 < na; ++a)
+    {
+      const std::size_t i = static_cast<std::size_t>(b) * na + a;
+      const Vec3 p = geometry.point(carrier, parameters[3 * i], parameters[3 * i + 1]);
+      std::copy_n(p.data(), 3, &out[3 * i]);
+    }
+  }
+  copyFaceBoundary(model, topology, block, face, na, nb, out);
+}
+
+void copyFaceBoundary(const BlockModel& model, const Topology& topology, int block, int face,
+  int na, int nb, std::vector<double>& grid)
+{
+  const std::array<int, 4> edges = faceEdges(face);
+  const LocalEdge bottom = localEdge(model, topology, block, edges[0]);
+  const LocalEdge top = localEdge(model, topology, block, edges[1]);
+  const LocalEdge left = localEdge(model, topology, block, edges[2]);
+  const LocalEdge right = localEdge(model, topology, block, edges[3]);
+  for (int a = 0; a < na; ++a)
+  {
+    std::copy_n(bottom.xyz() + 3 * a, 3, &grid[3 * static_cast<std::size_t>(a)]);
+    std::copy_n(top.xyz() + 3 * a, 3, &grid[3 * (static_cast<std::size_t>(nb - 1) * na + a)]);
+  }
+  for (int b = 0; b < nb; ++b)
+  {
+    std::copy_n(left.xyz() + 3 * b, 3, &grid[3 * (static_cast<std::size_t>(b) * na)]);
+    std::copy_n(right.xyz() + 3 * b, 3, &grid[3 * (static_cast<std::size_t>(b) * na + na - 1)]);
+  }
+}
+
+/// Grid of a periodic image face: the source face's nodes rotated; boundary from its edges.
+void periodicFace(const BlockModel& model, const Topology& topology, const PeriodicImage& entry,
+  std::vector<double>& out)
+{
+  const UniqueFace& from = topology.faces[entry.source];
+  const UniqueFace& to = topology.faces[entry.image];
+  out.resize(3 * static_cast<std::size_t>(to.na) * to.nb);
+  for (int b = 0; b < to.nb; ++b)
+  {
+    for (int a = 0; a < to.na; ++a)
+    {
+      int sa = 0, sb = 0;
+      entry.transform.map(a, b, from.na, from.nb, sa, sb);
+      const double* p = &from.xyz[3 * (static_cast<std::size_t>(sb) * from.na + sa)];
+      const Vec3 q = rotateAboutAxis(Vec3(p[0], p[1], p[2]), entry.axisPoint, entry.axis, entry.angle);
+      std::copy_n(q.data(), 3, &out[3 * (static_cast<std::size_t>(b) * to.na + a)]);
+    }
+  }
+  const FaceUse& owner = to.uses.front();
+  copyFaceBoundary(model, topology, owner.block, owner.face, to.na, to.nb, out);
+}
+
+/// Unique face -> surface carrier of the model's surface face sets.
+std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const Topology& topology)
+{
+  std::map<int, int> carriers;
+  for (const SurfaceFaces& set : model.surfaceFaces)
+  {
+    for (const BlockFace& face : set.faces)
+    {
+      const int unique = topology.blocks[face.block].face[face.face];
+      if (unique >= 0)
+      {
+        carriers[unique] = set.carrier;
+      }
+    }
+  }
+  return carriers;
+}
+
+// -------------------------------------------------------------------- carrier checks
+/**
+ * Format 2 checks: carriers build; closed Gordon surfaces are closed; every control point
+ * lies on its carrier; periodic vertices are rotations of their sources; surface faces
+ * name surfaces and their corners lie on them.
+ */
+void checkCarriers(const BlockModel& model, const CarrierGeometry& geometry, double size)
+{
+  const int carrierCount = static_cast<int>(model.carriers.size());
+  for (const Carrier& carrier : model.carriers)
+  {
+    if ((carrier.kind == Carrier::Kind::Gordon || carrier.kind == Carrier::Kind::Network) &&
+      carrier.closed)
+    {
+      for (std::size_t k = 0; k < carrier.refs.size(); ++k)
+      {
+        const int ref = carrier.refs[k];
+        const CurvePtr& curve = geometry.curve(ref);
+        const double gap = (curve->point(0.0) - curve->point(1.0)).norm();
+        if (gap > 1e-9 * std::max(size, geometry.size(ref)))
+        {
+          fail(carrier.where, entity("carrier", carrier.name),
+            "the surface is not closed: section " + std::to_string(k + 1) + " ('" +
+              model.carriers[ref].name + "') has its ends " + shortNumber(gap) + " apart");
+        }
+      }
+    }
+  }
+  for (const Vertex& vertex : model.vertices)
+  {
+    const std::string entityText = entity("vertex", vertex.name);
+    const VertexConstraint& constraint = vertex.constraint;
+    if (constraint.carrier >= 0)
+    {
+      if (constraint.carrier >= carrierCount)
+      {
+        fail(vertex.where, entityText, "is attached to a carrier that does not exist");
+      }
+      const bool surface = geometry.isSurface(constraint.carrier);
+      const int c = constraint.carrier;
+      const bool inRange = constraint.s >= 0.0 && constraint.s <= 1.0 &&
+        (!surface || (constraint.t >= geometry.tMin(c) && constraint.t <= geometry.tMax(c)));
+      if (!std::isfinite(constraint.s) || !std::isfinite(constraint.t) || !inRange)
+      {
+        fail(vertex.where, entityText,
+          "its carrier parameters (" + shortNumber(constraint.s) + ", " +
+            shortNumber(constraint.t) + ") are outside the carrier's range");
+      }
+      const Vec3 onCarrier = geometry.point(constraint.carrier, constraint.s, constraint.t);
+      const double distance = (onCarrier - vertex.position).norm();
+      if (!(distance <= carrierTolerance(geometry, constraint.carrier, size)))
+      {
+        fail(vertex.where, entityText,
+          "the control point is " + shortNumber(distance) + " away from its carrier '" +
+            model.carriers[constraint.carrier].name + "' at " +
+            (surface ? "(s, t) = (" + shortNumber(constraint.s) + ", " +
+                  shortNumber(constraint.t) + ")"
+                     : "u = " + shortNumber(constraint.s)) +
+            "; a control point must lie on its carrier");
+      }
+    }
+    if (constraint.periodicSource >= 0)
+    {
+      const int source = constraint.periodicSource;
+      if (source >= static_cast<int>(model.vertices.size()) ||
+        source == static_cast<int>(&vertex - model.vertices.data()))
+      {
+        fail(vertex.where, entityText, "is periodic with a vertex that does not exist");
+      }
+      if (!model.machine.defined || model.machine.bladeCount <= 0)
+      {
+        fail(vertex.where, entityText, "a periodic vertex needs the machine's blade count");
+      }
+      const Vec3 image = rotateAboutAxis(model.vertices[source].position, model.machine.axisPoint,
+        model.machine.axis, constraint.pitches * model.machine.pitch());
+      const double miss = (image - vertex.position).norm();
+      if (!(miss <= 1e-9 * size))
+      {
+        fail(vertex.where, entityText,
+          "is not the periodic image of vertex '" + model.vertices[source].name + "' (" +
+            std::to_string(constraint.pitches) + " pitch(es) about the machine axis): off by " +
+            shortNumber(miss));
+      }
+    }
+  }
+}
+
+void checkSurfaceFaces(const BlockModel& model, const CarrierGeometry& geometry,
+  const Topology& topology, double size)
+{
+  const int carrierCount = static_cast<int>(model.carriers.size());
+  for (const SurfaceFaces& set : model.surfaceFaces)
+  {
+    const std::string entityText = entity("face set", set.name);
+    if (set.carrier < 0 || set.carrier >= carrierCount || !geometry.isSurface(set.carrier))
+    {
+      fail(set.where, entityText, "needs a surface carrier");
+    }
+    for (const BlockFace& face : set.faces)
+    {
+      if (face.block < 0 || face.block >= static_cast<int>(model.blocks.size()) || face.face < 0 ||
+        face.face > 5)
+      {
+        fail(set.where, entityText, "refers to a face that does not exist");
+      }
+      if (topology.blocks[face.block].face[face.face] < 0)
+      {
+        fail(set.where, entityText,
+          "face " + faceText(model, face.block, face.face) + " is collapsed to a line or a point");
+      }
+      for (int corner : faceVertexIds(model.blocks[face.block], face.face))
+      {
+        double s = 0.0, t = 0.0, distance = 0.0;
+        geometry.vertexParameters(model, corner, set.carrier, s, t, distance);
+        if (distance > carrierTolerance(geometry, set.carrier, size))
+        {
+          fail(set.where, entityText,
+            "corner '" + model.vertices[corner].name + "' of face " +
+              faceText(model, face.block, face.face) + " is " + shortNumber(distance) +
+              " away from surface '" + model.carriers[set.carrier].name + "'");
+        }
+      }
+    }
+  }
+}
+} // namespace
+
+namespace
+{
+void checkModelWith(const BlockModel& model, const CarrierGeometry& geometry)
+{
+  const double size = modelSize(model);
+  checkCarriers(model, geometry, size);
+  const std::vector<NamedCurve> curves = buildNamedCurves(model, geometry);
+  const Topology topology = buildTopology(model, curves, baseNodeCounts(model), false);
+  checkNamedEdgesUsed(model, topology);
+  checkSurfaceFaces(model, geometry, topology, size);
+  checkOrientation(model, size);
+  checkPatches(model, topology, size);
+  periodicImages(model, topology, size); // the rotated copies must match node for node
+}
 } // namespace
 
 void checkModel(const BlockModel& model)
 {
   checkBasics(model);
-  const std::vector<NamedCurve> curves = buildNamedCurves(model);
-  const Topology topology = buildTopology(model, curves, baseNodeCounts(model), false);
-  checkNamedEdgesUsed(model, topology);
-  const double size = modelSize(model);
-  checkOrientation(model, size);
-  checkPatches(model, topology, size);
+  const CarrierGeometry geometry(model);
+  checkModelWith(model, geometry);
 }
 
 struct MultiBlockMesher::Impl
@@ -949,6 +1600,7 @@ struct MultiBlockMesher::Impl
   BlockModel Model; // a copy: the mesher may outlive the caller's model
   double Multiplier = 1.0;
   int Cap = 0;
+  CarrierGeometry Geometry;
   std::vector<NamedCurve> Curves;
   Topology Topo;
   bool Ready = false;
@@ -979,10 +1631,12 @@ MultiBlockMesher::MultiBlockMesher(const BlockModel& model, double densityMultip
       "the density multiplier must be a positive number, got " +
         formatNumber(densityMultiplier));
   }
-  checkModel(model);
+  checkBasics(model);
   P->Model = model;
   P->Multiplier = densityMultiplier;
-  P->Curves = buildNamedCurves(P->Model);
+  P->Geometry = CarrierGeometry(P->Model);
+  checkModelWith(P->Model, P->Geometry);
+  P->Curves = buildNamedCurves(P->Model, P->Geometry);
 }
 
 MultiBlockMesher::~MultiBlockMesher() = default;
@@ -1003,22 +1657,51 @@ void MultiBlockMesher::computeBoundaries()
   }
   const bool countsChanged = nodes != baseNodeCounts(model);
   P->Topo = buildTopology(model, P->Curves, nodes, countsChanged);
-  for (UniqueEdge& edge : P->Topo.edges)
+  Topology& topology = P->Topo;
+  for (UniqueEdge& edge : topology.edges)
   {
-    computeEdgeNodes(model, P->Curves, edge);
+    computeEdgeNodes(model, P->Curves, P->Geometry, edge);
   }
-  for (UniqueFace& face : P->Topo.faces)
+  // Periodic copies: named periodic edges, then the edges and faces of every periodic
+  // patch's partner, rotated node for node from the first patch of the pair.
+  computePeriodicEdges(model, topology);
+  const std::vector<PeriodicImage> images = periodicImages(model, topology, modelSize(model));
+  computePeriodicPatchEdges(model, topology, images);
+  std::map<int, const PeriodicImage*> imageOf;
+  for (const PeriodicImage& entry : images)
   {
+    imageOf[entry.image] = &entry;
+  }
+  const std::map<int, int> onSurface = surfaceFaceCarriers(model, topology);
+  for (std::size_t f = 0; f < topology.faces.size(); ++f)
+  {
+    UniqueFace& face = topology.faces[f];
     const FaceUse& owner = face.uses.front();
+    if (imageOf.count(static_cast<int>(f)))
+    {
+      continue;
+    }
     try
     {
-      faceFromEdges(model, P->Topo, owner.block, owner.face, face.xyz);
+      const auto surface = onSurface.find(static_cast<int>(f));
+      if (surface != onSurface.end())
+      {
+        surfaceFace(model, topology, P->Geometry, surface->second, owner.block, owner.face, face.xyz);
+      }
+      else
+      {
+        faceFromEdges(model, topology, owner.block, owner.face, face.xyz);
+      }
     }
     catch (const GeometryError& error)
     {
       fail(model.blocks[owner.block].where, blockEntity(model, owner.block),
         "face " + faceText(model, owner.block, owner.face) + ": " + error.what());
     }
+  }
+  for (const PeriodicImage& entry : images)
+  {
+    periodicFace(model, topology, entry, topology.faces[entry.image].xyz);
   }
   P->Ready = true;
 }

@@ -3,6 +3,7 @@
 #include "ModelSyntax.h"
 #include "Template.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace blockforge
@@ -94,8 +95,8 @@ public:
     }
     // Checked after the version: a newer document may well have keys this build lacks.
     syntax::checkKeys(sections,
-      { "blockforge_model", "name", "source", "parameters", "vertices", "edges", "blocks",
-        "patches" },
+      { "blockforge_model", "name", "source", "parameters", "machine", "carriers", "vertices",
+        "edges", "blocks", "faces", "patches" },
       "", Report);
     if (const MapEntry* name = syntax::findEntry(sections, "name"))
     {
@@ -114,9 +115,33 @@ public:
           number(entry.value, entry.line, entity("parameter", entry.key), "value"));
       }
     }
+    if (const MapEntry* machine = syntax::findEntry(sections, "machine"))
+    {
+      readMachine(*machine);
+    }
+    const std::vector<YAML::Node> carriers = list(sections, "carriers");
+    for (const YAML::Node& node : carriers)
+    {
+      // Names first: carriers may refer to carriers listed after them.
+      Carrier carrier;
+      entries(node, "carrier", CarrierKeys, carrier.name, carrier.where);
+      if (Model.findCarrier(carrier.name) >= 0)
+      {
+        fail(syntax::lineOf(node), entity("carrier", carrier.name), "defined twice");
+      }
+      Model.carriers.push_back(carrier);
+    }
+    for (std::size_t c = 0; c < carriers.size(); ++c)
+    {
+      readCarrier(carriers[c], Model.carriers[c]);
+    }
     for (const YAML::Node& node : list(sections, "vertices"))
     {
       readVertex(node);
+    }
+    for (Vertex& vertex : Model.vertices)
+    {
+      resolvePeriodicSource(vertex);
     }
     for (const YAML::Node& node : list(sections, "edges"))
     {
@@ -125,6 +150,10 @@ public:
     for (const YAML::Node& node : list(sections, "blocks"))
     {
       readBlock(node);
+    }
+    for (const YAML::Node& node : list(sections, "faces"))
+    {
+      readFaces(node);
     }
     for (const YAML::Node& node : list(sections, "patches"))
     {
@@ -263,7 +292,8 @@ private:
   void readVertex(const YAML::Node& node)
   {
     Vertex vertex;
-    const auto keys = entries(node, "vertex", { "position" }, vertex.name, vertex.where);
+    const auto keys = entries(
+      node, "vertex", { "position", "on", "at", "periodic", "pitches" }, vertex.name, vertex.where);
     const std::string entityText = entity("vertex", vertex.name);
     if (Model.findVertex(vertex.name) >= 0)
     {
@@ -271,14 +301,33 @@ private:
     }
     const MapEntry& position = required(keys, "position", node, entityText);
     vertex.position = vector3(position.value, position.line, entityText, "position");
+    if (const MapEntry* on = syntax::findEntry(keys, "on"))
+    {
+      vertex.constraint.carrier = carrierRef(on->value, on->line, entityText);
+      const MapEntry& at = required(keys, "at", node, entityText);
+      if (!at.value.IsSequence() || at.value.size() != 2)
+      {
+        fail(at.line, entityText, "'at' expects [s, t]");
+      }
+      vertex.constraint.s = number(at.value[0], at.line, entityText, "at");
+      vertex.constraint.t = number(at.value[1], at.line, entityText, "at");
+    }
+    if (const MapEntry* periodic = syntax::findEntry(keys, "periodic"))
+    {
+      PeriodicSources.push_back(text(periodic->value, periodic->line, entityText, "periodic"));
+      const MapEntry& pitches = required(keys, "pitches", node, entityText);
+      vertex.constraint.pitches = integer(pitches.value, pitches.line, entityText, "pitches");
+      vertex.constraint.periodicSource = -2; // resolved once every vertex is known
+    }
     Model.vertices.push_back(vertex);
   }
 
   void readEdge(const YAML::Node& node)
   {
     Edge edge;
-    const auto keys = entries(
-      node, "edge", { "kind", "from", "to", "centre", "through", "points" }, edge.name, edge.where);
+    const auto keys = entries(node, "edge",
+      { "kind", "from", "to", "centre", "through", "points", "carrier", "at", "source", "pitches" },
+      edge.name, edge.where);
     const std::string entityText = entity("edge", edge.name);
     const MapEntry& kind = required(keys, "kind", node, entityText);
     const std::string kindName = text(kind.value, kind.line, entityText, "kind");
@@ -322,9 +371,49 @@ private:
         edge.splinePoints.push_back(vector3(point, points.line, entityText, "point"));
       }
     }
+    else if (kindName == "on_curve" || kindName == "on_surface" || kindName == "project")
+    {
+      edge.kind = kindName == "on_curve" ? Edge::Kind::OnCurve
+        : kindName == "on_surface"       ? Edge::Kind::OnSurface
+                                         : Edge::Kind::Project;
+      const MapEntry& carrier = required(keys, "carrier", node, entityText);
+      edge.carrier = carrierRef(carrier.value, carrier.line, entityText);
+      if (const MapEntry* at = syntax::findEntry(keys, "at"))
+      {
+        if (!at->value.IsSequence())
+        {
+          fail(at->line, entityText, "'at' must be a list of numbers");
+        }
+        for (const YAML::Node& value : at->value)
+        {
+          edge.at.push_back(number(value, at->line, entityText, "at"));
+        }
+      }
+    }
+    else if (kindName == "periodic")
+    {
+      edge.kind = Edge::Kind::Periodic;
+      const MapEntry& source = required(keys, "source", node, entityText);
+      const std::string sourceName = text(source.value, source.line, entityText, "source");
+      for (std::size_t e = 0; e < Model.edges.size(); ++e)
+      {
+        if (Model.edges[e].name == sourceName)
+        {
+          edge.source = static_cast<int>(e);
+        }
+      }
+      if (edge.source < 0)
+      {
+        fail(source.line, entityText, "unknown source edge '" + sourceName + "'");
+      }
+      const MapEntry& pitches = required(keys, "pitches", node, entityText);
+      edge.pitches = integer(pitches.value, pitches.line, entityText, "pitches");
+    }
     else
     {
-      fail(kind.line, entityText, "unknown edge kind '" + kindName + "' (line, arc, spline)");
+      fail(kind.line, entityText,
+        "unknown edge kind '" + kindName +
+          "' (line, arc, spline, on_curve, on_surface, project, periodic)");
     }
     Model.edges.push_back(edge);
   }
@@ -378,7 +467,7 @@ private:
   {
     Patch patch;
     const auto keys = entries(node, "patch",
-      { "type", "faces", "partner", "axis", "origin", "angle" }, patch.name, patch.where);
+      { "type", "faces", "partner", "axis", "origin", "angle", "pitches" }, patch.name, patch.where);
     const std::string entityText = entity("patch", patch.name);
     const MapEntry& type = required(keys, "type", node, entityText);
     patch.type = text(type.value, type.line, entityText, "type");
@@ -419,8 +508,239 @@ private:
     {
       patch.periodicAngle = number(angle->value, angle->line, entityText, "angle");
     }
+    if (const MapEntry* pitches = syntax::findEntry(keys, "pitches"))
+    {
+      patch.pitches = integer(pitches->value, pitches->line, entityText, "pitches");
+    }
     Model.patches.push_back(patch);
   }
+
+  BlockFace blockFaceRef(const YAML::Node& face, int line, const std::string& entityText) const
+  {
+    const std::string name = text(face, line, entityText, "face");
+    const std::size_t dot = name.rfind('.');
+    BlockFace blockFace;
+    if (dot != std::string::npos)
+    {
+      blockFace.block = Model.findBlock(name.substr(0, dot));
+      blockFace.face = faceFromName(name.substr(dot + 1));
+    }
+    if (blockFace.block < 0 || blockFace.face < 0)
+    {
+      fail(here(face, line), entityText, "unknown face '" + name + "'");
+    }
+    return blockFace;
+  }
+
+  void readFaces(const YAML::Node& node)
+  {
+    SurfaceFaces set;
+    const auto keys = entries(node, "face set", { "on_surface", "faces" }, set.name, set.where);
+    const std::string entityText = entity("face set", set.name);
+    const MapEntry& surface = required(keys, "on_surface", node, entityText);
+    set.carrier = carrierRef(surface.value, surface.line, entityText);
+    const MapEntry& faces = required(keys, "faces", node, entityText);
+    if (!faces.value.IsSequence())
+    {
+      fail(faces.line, entityText, "'faces' must be a list of block.face");
+    }
+    for (const YAML::Node& face : faces.value)
+    {
+      set.faces.push_back(blockFaceRef(face, faces.line, entityText));
+    }
+    Model.surfaceFaces.push_back(set);
+  }
+
+  void readMachine(const MapEntry& machine)
+  {
+    const std::string entityText = "machine";
+    const auto keys =
+      syntax::mapEntries(machine.value, machine.line, entityText, "the machine", Report);
+    syntax::checkKeys(keys, { "axis", "origin", "blade_count" }, entityText, Report);
+    Model.machine.defined = true;
+    const MapEntry& axis = required(keys, "axis", machine.value, entityText);
+    Model.machine.axis = vector3(axis.value, axis.line, entityText, "axis");
+    const MapEntry& origin = required(keys, "origin", machine.value, entityText);
+    Model.machine.axisPoint = vector3(origin.value, origin.line, entityText, "origin");
+    const MapEntry& count = required(keys, "blade_count", machine.value, entityText);
+    Model.machine.bladeCount = integer(count.value, count.line, entityText, "blade_count");
+  }
+
+  int carrierRef(const YAML::Node& node, int line, const std::string& entityText) const
+  {
+    const std::string name = text(node, line, entityText, "carrier");
+    const int index = Model.findCarrier(name);
+    if (index < 0)
+    {
+      fail(here(node, line), entityText, "unknown carrier '" + name + "'");
+    }
+    return index;
+  }
+
+  std::vector<int> carrierRefs(const std::vector<MapEntry>& keys, const std::string& key,
+    const YAML::Node& node, const std::string& entityText) const
+  {
+    std::vector<int> refs;
+    const MapEntry* found = syntax::findEntry(keys, key);
+    if (!found)
+    {
+      return refs;
+    }
+    if (!found->value.IsSequence())
+    {
+      fail(found->line, entityText, "'" + key + "' must be a list of carriers");
+    }
+    for (const YAML::Node& item : found->value)
+    {
+      refs.push_back(carrierRef(item, found->line, entityText));
+    }
+    (void)node;
+    return refs;
+  }
+
+  std::vector<double> numbers(const std::vector<MapEntry>& keys, const std::string& key,
+    const std::string& entityText) const
+  {
+    std::vector<double> values;
+    const MapEntry* found = syntax::findEntry(keys, key);
+    if (!found)
+    {
+      return values;
+    }
+    if (!found->value.IsSequence())
+    {
+      fail(found->line, entityText, "'" + key + "' must be a list of numbers");
+    }
+    for (const YAML::Node& item : found->value)
+    {
+      values.push_back(number(item, found->line, entityText, key));
+    }
+    return values;
+  }
+
+  void readCarrier(const YAML::Node& node, Carrier& carrier)
+  {
+    std::string name;
+    SourceLocation where;
+    const auto keys = entries(node, "carrier", CarrierKeys, name, where);
+    const std::string entityText = entity("carrier", name);
+    const MapEntry& kind = required(keys, "kind", node, entityText);
+    const std::string kindName = text(kind.value, kind.line, entityText, "kind");
+    static const char* const kinds[] = { "interpolate", "revolve", "gordon", "network", "coons",
+      "surface_curve", "intersect" };
+    int found = -1;
+    for (int k = 0; k < 7; ++k)
+    {
+      if (kindName == kinds[k])
+      {
+        found = k;
+      }
+    }
+    if (found < 0)
+    {
+      fail(kind.line, entityText, "unknown carrier kind '" + kindName + "'");
+    }
+    carrier.kind = static_cast<Carrier::Kind>(found);
+    if (const MapEntry* points = syntax::findEntry(keys, "points"))
+    {
+      if (!points->value.IsSequence())
+      {
+        fail(points->line, entityText, "'points' must be a list");
+      }
+      for (const YAML::Node& point : points->value)
+      {
+        if (carrier.kind == Carrier::Kind::SurfaceCurve)
+        {
+          if (!point.IsSequence() || point.size() != 2)
+          {
+            fail(points->line, entityText, "'points' of a surface curve are [s, t] pairs");
+          }
+          carrier.parameterPoints.emplace_back(number(point[0], points->line, entityText, "s"),
+            number(point[1], points->line, entityText, "t"));
+        }
+        else
+        {
+          carrier.points.push_back(vector3(point, points->line, entityText, "point"));
+        }
+      }
+    }
+    if (const MapEntry* degree = syntax::findEntry(keys, "degree"))
+    {
+      carrier.degree = integer(degree->value, degree->line, entityText, "degree");
+    }
+    if (const MapEntry* method = syntax::findEntry(keys, "parameters"))
+    {
+      const std::string value = text(method->value, method->line, entityText, "parameters");
+      carrier.parameterMethod = value == "uniform" ? 0 : value == "centripetal" ? 2 : 1;
+      if (value != "uniform" && value != "centripetal" && value != "chord")
+      {
+        fail(method->line, entityText, "unknown parameters '" + value + "'");
+      }
+    }
+    carrier.refs = carrierRefs(keys, "refs", node, entityText);
+    carrier.crossRefs = carrierRefs(keys, "cross_refs", node, entityText);
+    carrier.nodes = numbers(keys, "at", entityText);
+    carrier.crossNodes = numbers(keys, "cross_at", entityText);
+    if (const MapEntry* blending = syntax::findEntry(keys, "blending"))
+    {
+      const std::string value = text(blending->value, blending->line, entityText, "blending");
+      if (value != "spline" && value != "lagrange")
+      {
+        fail(blending->line, entityText, "unknown blending '" + value + "'");
+      }
+      carrier.blending =
+        value == "lagrange" ? Carrier::Blending::Lagrange : Carrier::Blending::Spline;
+    }
+    if (const MapEntry* closed = syntax::findEntry(keys, "closed"))
+    {
+      carrier.closed = text(closed->value, closed->line, entityText, "closed") == "true";
+    }
+    if (const MapEntry* axis = syntax::findEntry(keys, "axis"))
+    {
+      carrier.axis = vector3(axis->value, axis->line, entityText, "axis");
+    }
+    if (const MapEntry* origin = syntax::findEntry(keys, "origin"))
+    {
+      carrier.axisPoint = vector3(origin->value, origin->line, entityText, "origin");
+    }
+    const std::vector<double> angle = numbers(keys, "angle", entityText);
+    if (angle.size() == 2)
+    {
+      carrier.angleStart = angle[0];
+      carrier.angleEnd = angle[1];
+    }
+    const std::vector<double> range = numbers(keys, "range", entityText);
+    if (range.size() == 2)
+    {
+      carrier.rangeMin = range[0];
+      carrier.rangeMax = range[1];
+    }
+    if (const MapEntry* samples = syntax::findEntry(keys, "samples"))
+    {
+      carrier.samples = integer(samples->value, samples->line, entityText, "samples");
+    }
+  }
+
+  void resolvePeriodicSource(Vertex& vertex)
+  {
+    if (vertex.constraint.periodicSource != -2)
+    {
+      return;
+    }
+    const std::string& sourceName = PeriodicSources[NextPeriodic++];
+    vertex.constraint.periodicSource = Model.findVertex(sourceName);
+    if (vertex.constraint.periodicSource < 0)
+    {
+      fail(vertex.where.line, entity("vertex", vertex.name),
+        "unknown periodic source vertex '" + sourceName + "'");
+    }
+  }
+
+  const std::vector<std::string> CarrierKeys = { "kind", "points", "degree", "parameters",
+    "refs", "cross_refs", "at", "cross_at", "blending", "closed", "axis", "origin", "angle",
+    "range", "samples" };
+  std::vector<std::string> PeriodicSources;
+  std::size_t NextPeriodic = 0;
 
   const std::string& Text;
   syntax::Reporter Report;
@@ -433,7 +753,7 @@ std::string writeModelDocument(const BlockModel& model)
   YAML::Emitter out;
   out << YAML::Comment("BlockForge block model: resolved numbers, written by BlockForge");
   out << YAML::BeginMap;
-  out << YAML::Key << "blockforge_model" << YAML::Value << BlockModel::FormatVersion;
+  out << YAML::Key << "blockforge_model" << YAML::Value << model.requiredFormat();
   out << YAML::Key << "name" << YAML::Value << model.name;
   out << YAML::Key << "source" << YAML::Value << model.sourceFile;
 
@@ -444,13 +764,137 @@ std::string writeModelDocument(const BlockModel& model)
   }
   out << YAML::EndMap;
 
+  const int carrierCount = static_cast<int>(model.carriers.size());
+  auto carrierName = [&](int index, const std::string& user) -> const std::string& {
+    if (index < 0 || index >= carrierCount)
+    {
+      throw TemplateError(DocumentFile, 0, user,
+        "refers to carrier #" + std::to_string(index) + ", which does not exist");
+    }
+    return model.carriers[index].name;
+  };
+  if (model.machine.defined)
+  {
+    out << YAML::Key << "machine" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "axis" << YAML::Value;
+    emitVector(out, model.machine.axis);
+    out << YAML::Key << "origin" << YAML::Value;
+    emitVector(out, model.machine.axisPoint);
+    out << YAML::Key << "blade_count" << YAML::Value << model.machine.bladeCount;
+    out << YAML::EndMap;
+  }
+  if (!model.carriers.empty())
+  {
+    static const char* const kinds[] = { "interpolate", "revolve", "gordon", "network", "coons",
+      "surface_curve", "intersect" };
+    static const char* const methods[] = { "uniform", "chord", "centripetal" };
+    out << YAML::Key << "carriers" << YAML::Value << YAML::BeginSeq;
+    for (const Carrier& carrier : model.carriers)
+    {
+      const std::string user = entity("carrier", carrier.name);
+      auto refList = [&](const char* key, const std::vector<int>& refs) {
+        if (refs.empty())
+        {
+          return;
+        }
+        out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+        for (int ref : refs)
+        {
+          out << carrierName(ref, user);
+        }
+        out << YAML::EndSeq;
+      };
+      auto numberList = [&](const char* key, const std::vector<double>& values) {
+        out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+        for (double value : values)
+        {
+          out << formatNumber(value);
+        }
+        out << YAML::EndSeq;
+      };
+      out << YAML::BeginMap;
+      out << YAML::Key << "name" << YAML::Value << carrier.name;
+      out << YAML::Key << "kind" << YAML::Value << kinds[static_cast<int>(carrier.kind)];
+      switch (carrier.kind)
+      {
+        case Carrier::Kind::Interpolate:
+          out << YAML::Key << "degree" << YAML::Value << carrier.degree;
+          out << YAML::Key << "parameters" << YAML::Value
+              << methods[std::max(0, std::min(2, carrier.parameterMethod))];
+          out << YAML::Key << "points" << YAML::Value << YAML::BeginSeq;
+          for (const Vec3& point : carrier.points)
+          {
+            emitVector(out, point);
+          }
+          out << YAML::EndSeq;
+          break;
+        case Carrier::Kind::Revolve:
+          refList("refs", carrier.refs);
+          out << YAML::Key << "axis" << YAML::Value;
+          emitVector(out, carrier.axis);
+          out << YAML::Key << "origin" << YAML::Value;
+          emitVector(out, carrier.axisPoint);
+          numberList("angle", { carrier.angleStart, carrier.angleEnd });
+          break;
+        case Carrier::Kind::Gordon:
+        case Carrier::Kind::Network:
+          refList("refs", carrier.refs);
+          numberList("at", carrier.nodes);
+          if (carrier.kind == Carrier::Kind::Network)
+          {
+            refList("cross_refs", carrier.crossRefs);
+            numberList("cross_at", carrier.crossNodes);
+          }
+          out << YAML::Key << "blending" << YAML::Value
+              << (carrier.blending == Carrier::Blending::Lagrange ? "lagrange" : "spline");
+          out << YAML::Key << "closed" << YAML::Value << (carrier.closed ? "true" : "false");
+          break;
+        case Carrier::Kind::Coons:
+          refList("refs", carrier.refs);
+          break;
+        case Carrier::Kind::SurfaceCurve:
+          refList("refs", carrier.refs);
+          out << YAML::Key << "points" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+          for (const Eigen::Vector2d& st : carrier.parameterPoints)
+          {
+            out << YAML::Flow << YAML::BeginSeq << formatNumber(st[0]) << formatNumber(st[1])
+                << YAML::EndSeq;
+          }
+          out << YAML::EndSeq;
+          break;
+        case Carrier::Kind::Intersect:
+          refList("refs", carrier.refs);
+          numberList("range", { carrier.rangeMin, carrier.rangeMax });
+          out << YAML::Key << "samples" << YAML::Value << carrier.samples;
+          break;
+      }
+      emitWhere(out, carrier.where, model);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
+
   out << YAML::Key << "vertices" << YAML::Value << YAML::BeginSeq;
   for (const Vertex& vertex : model.vertices)
   {
+    const std::string user = entity("vertex", vertex.name);
     out << YAML::Flow << YAML::BeginMap;
     out << YAML::Key << "name" << YAML::Value << vertex.name;
     out << YAML::Key << "position" << YAML::Value;
     emitVector(out, vertex.position);
+    if (vertex.constraint.carrier >= 0)
+    {
+      out << YAML::Key << "on" << YAML::Value << carrierName(vertex.constraint.carrier, user);
+      out << YAML::Key << "at" << YAML::Value << YAML::Flow << YAML::BeginSeq
+          << formatNumber(vertex.constraint.s) << formatNumber(vertex.constraint.t)
+          << YAML::EndSeq;
+    }
+    if (vertex.constraint.periodicSource >= 0)
+    {
+      out << YAML::Key << "periodic" << YAML::Value
+          << vertexName(model, vertex.constraint.periodicSource, user);
+      out << YAML::Key << "pitches" << YAML::Value << vertex.constraint.pitches;
+    }
     emitWhere(out, vertex.where, model);
     out << YAML::EndMap;
   }
@@ -462,9 +906,9 @@ std::string writeModelDocument(const BlockModel& model)
     const std::string user = entity("edge", edge.name);
     out << YAML::Flow << YAML::BeginMap;
     out << YAML::Key << "name" << YAML::Value << edge.name;
-    out << YAML::Key << "kind" << YAML::Value
-        << (edge.kind == Edge::Kind::Line ? "line"
-                                          : edge.kind == Edge::Kind::Arc ? "arc" : "spline");
+    static const char* const edgeKinds[] = { "line", "arc", "spline", "on_curve", "on_surface",
+      "project", "periodic" };
+    out << YAML::Key << "kind" << YAML::Value << edgeKinds[static_cast<int>(edge.kind)];
     out << YAML::Key << "from" << YAML::Value << vertexName(model, edge.from, user);
     out << YAML::Key << "to" << YAML::Value << vertexName(model, edge.to, user);
     if (edge.kind == Edge::Kind::Arc)
@@ -480,6 +924,29 @@ std::string writeModelDocument(const BlockModel& model)
         emitVector(out, point);
       }
       out << YAML::EndSeq;
+    }
+    if (edge.kind == Edge::Kind::OnCurve || edge.kind == Edge::Kind::OnSurface ||
+      edge.kind == Edge::Kind::Project)
+    {
+      out << YAML::Key << "carrier" << YAML::Value << carrierName(edge.carrier, user);
+      if (!edge.at.empty())
+      {
+        out << YAML::Key << "at" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+        for (double value : edge.at)
+        {
+          out << formatNumber(value);
+        }
+        out << YAML::EndSeq;
+      }
+    }
+    if (edge.kind == Edge::Kind::Periodic)
+    {
+      if (edge.source < 0 || edge.source >= static_cast<int>(model.edges.size()))
+      {
+        throw TemplateError(DocumentFile, 0, user, "refers to an edge that does not exist");
+      }
+      out << YAML::Key << "source" << YAML::Value << model.edges[edge.source].name;
+      out << YAML::Key << "pitches" << YAML::Value << edge.pitches;
     }
     emitWhere(out, edge.where, model);
     out << YAML::EndMap;
@@ -515,6 +982,32 @@ std::string writeModelDocument(const BlockModel& model)
   }
   out << YAML::EndSeq;
 
+  if (!model.surfaceFaces.empty())
+  {
+    out << YAML::Key << "faces" << YAML::Value << YAML::BeginSeq;
+    for (const SurfaceFaces& set : model.surfaceFaces)
+    {
+      const std::string user = entity("face set", set.name);
+      out << YAML::BeginMap;
+      out << YAML::Key << "name" << YAML::Value << set.name;
+      out << YAML::Key << "on_surface" << YAML::Value << carrierName(set.carrier, user);
+      out << YAML::Key << "faces" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      for (const BlockFace& face : set.faces)
+      {
+        if (face.block < 0 || face.block >= static_cast<int>(model.blocks.size()))
+        {
+          throw TemplateError(DocumentFile, 0, user,
+            "refers to block #" + std::to_string(face.block) + ", which does not exist");
+        }
+        out << model.blocks[face.block].name + "." + faceName(face.face);
+      }
+      out << YAML::EndSeq;
+      emitWhere(out, set.where, model);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
+
   out << YAML::Key << "patches" << YAML::Value << YAML::BeginSeq;
   for (const Patch& patch : model.patches)
   {
@@ -540,6 +1033,10 @@ std::string writeModelDocument(const BlockModel& model)
       out << YAML::Key << "origin" << YAML::Value;
       emitVector(out, patch.periodicAxisPoint);
       out << YAML::Key << "angle" << YAML::Value << formatNumber(patch.periodicAngle);
+      if (patch.pitches != 0)
+      {
+        out << YAML::Key << "pitches" << YAML::Value << patch.pitches;
+      }
     }
     emitWhere(out, patch.where, model);
     out << YAML::EndMap;

@@ -1,5 +1,6 @@
 #include "Template.h"
 
+#include "CarrierGeometry.h"
 #include "Mesher.h"
 #include "ModelSyntax.h"
 
@@ -7,10 +8,16 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <array>
 #include <cerrno>
+#include <limits>
+#include <locale>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -53,7 +60,7 @@ using syntax::lineOf;
 using syntax::MapEntry;
 
 /// The newest template format this build reads.
-constexpr int TemplateFormatVersion = 1;
+constexpr int TemplateFormatVersion = 2;
 constexpr double Pi = 3.14159265358979323846;
 /// Cells per block direction; keeps node arrays well inside int range.
 constexpr double MaxCellsPerDirection = 1.0e6;
@@ -73,9 +80,26 @@ class ExpressionEvaluator
 public:
   ExpressionEvaluator()
   {
+    // '.' joins a vertex name and an attribute: le_hub.radius (format 2 queries).
+    Parser.DefineNameChars(
+      "0123456789_abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ.");
     Parser.DefineConst("pi", Pi);
     Parser.DefineConst("deg", Pi / 180.0);
   }
+
+  /// Called with every `name.attribute` token of an expression before it is evaluated
+  /// (resolves vertices defined further down the template).
+  std::function<void(const std::string& name, const std::string& attribute)> OnReference;
+  /// Names that are not available, with the reason (shown instead of "unknown name").
+  std::map<std::string, std::string> Unavailable;
+
+  /// Defines a query value such as `le_hub.radius` (not listed among the parameters).
+  void defineQuery(const std::string& name, double value)
+  {
+    Parser.DefineConst(name, value);
+    Queries.insert(name);
+  }
+  bool hasQuery(const std::string& name) const { return Queries.count(name) != 0; }
 
   /// Names that parameters must not take: the constants and muParser's functions.
   static bool isReserved(const std::string& name)
@@ -105,6 +129,13 @@ public:
         "'; inside [x, y, z] lists put an expression containing commas in quotes, "
         "e.g. \"min(a, b)\"" };
     }
+    if (OnReference)
+    {
+      for (const auto& reference : dottedNames(expanded))
+      {
+        OnReference(reference.first, reference.second);
+      }
+    }
     double value = 0.0;
     try
     {
@@ -120,6 +151,21 @@ public:
     catch (const mu::ParserError& error)
     {
       const std::string token = error.GetToken();
+      const auto unavailable = Unavailable.find(token);
+      if (error.GetCode() == mu::ecUNASSIGNABLE_TOKEN && unavailable != Unavailable.end())
+      {
+        throw ExpressionError{ "'" + token + "' in '" + expression + "' is not available: " +
+          unavailable->second };
+      }
+      const std::size_t dot = token.find('.');
+      if (error.GetCode() == mu::ecUNASSIGNABLE_TOKEN && dot != std::string::npos &&
+        syntax::isIdentifier(token.substr(0, dot)))
+      {
+        throw ExpressionError{ "unknown name '" + token + "' in '" + expression +
+          "'; vertex queries are written vertex.attribute with the attributes x, y, z, "
+          "axial, radius, theta (about the machine axis) and s, t (parameters of a vertex "
+          "on a carrier), for vertices defined in this template (format 2)" };
+      }
       if (error.GetCode() == mu::ecUNASSIGNABLE_TOKEN && syntax::isIdentifier(token))
       {
         std::string message = "unknown name '" + token + "' in '" + expression + "'";
@@ -222,6 +268,42 @@ public:
     return out;
   }
 
+  /// The `name.attribute` tokens of an expression (names start with a letter or '_').
+  static std::vector<std::pair<std::string, std::string>> dottedNames(const std::string& text)
+  {
+    std::vector<std::pair<std::string, std::string>> names;
+    auto isStart = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; };
+    auto isChar = [&](char c) { return isStart(c) || (c >= '0' && c <= '9'); };
+    std::size_t i = 0;
+    const std::size_t n = text.size();
+    while (i < n)
+    {
+      if (isStart(text[i]) && (i == 0 || !(isChar(text[i - 1]) || text[i - 1] == '.')))
+      {
+        std::size_t j = i;
+        while (j < n && isChar(text[j]))
+        {
+          ++j;
+        }
+        if (j < n && text[j] == '.')
+        {
+          std::size_t k = j + 1;
+          while (k < n && isChar(text[k]))
+          {
+            ++k;
+          }
+          names.emplace_back(text.substr(i, j - i), text.substr(j + 1, k - j - 1));
+          i = k;
+          continue;
+        }
+        i = j;
+        continue;
+      }
+      ++i;
+    }
+    return names;
+  }
+
 private:
   static bool parenthesesBalance(const std::string& text)
   {
@@ -239,6 +321,7 @@ private:
 
   mu::Parser Parser;
   std::vector<std::string> Names;
+  std::set<std::string> Queries;
 };
 
 /// The trailing `# comment` of a line, ignoring '#' inside quotes or glued to a word.
@@ -270,6 +353,16 @@ std::string trailingComment(const std::string& line)
   return "";
 }
 
+/// Short form of a number for messages.
+std::string shortNumber(double value)
+{
+  std::ostringstream text;
+  text.imbue(std::locale::classic());
+  text.precision(6);
+  text << value;
+  return text.str();
+}
+
 std::string fileStem(const std::string& path)
 {
   std::string base = path.substr(path.find_last_of("/\\") + 1);
@@ -282,9 +375,10 @@ class TemplateReader
 {
 public:
   TemplateReader(const std::string& text, const std::string& file,
-    const ParameterOverrides& overrides)
+    const ParameterOverrides& overrides, const TemplateInputs* inputs)
     : Text(text)
     , Overrides(overrides)
+    , Inputs(inputs)
   {
     Report.file = file;
   }
@@ -292,19 +386,30 @@ public:
   BlockModel readModel()
   {
     readHeader();
+    readMachineAndInputs();
     readParameters();
     Model.name = Name.empty() ? fileStem(Report.file) : Name;
     Model.sourceFile = Report.file;
-    readVertices();
+    if (Version >= 2)
+    {
+      readCarriersAndVertices();
+    }
+    else
+    {
+      readVertices();
+    }
     readEdges();
     readBlocks();
+    readFaces();
     readPatches();
     return std::move(Model);
   }
 
   std::vector<ParameterInfo> readParameterInfos()
   {
+    InfoOnly = true;
     readHeader();
+    readMachineAndInputs();
     readParameters();
     return std::move(Infos);
   }
@@ -416,6 +521,10 @@ private:
       }
       fail(lineOrFallback(node, line), entityText, what);
     }
+    if (Version >= 2)
+    {
+      ensureVertex(index);
+    }
     return index;
   }
 
@@ -450,14 +559,14 @@ private:
     }
     Sections = syntax::mapEntries(root, 1, "", "the template", Report);
     syntax::checkKeys(Sections,
-      { "blockforge", "name", "description", "parameters", "vertices", "edges", "blocks",
-        "patches" },
+      { "blockforge", "name", "description", "inputs", "machine", "parameters", "carriers",
+        "vertices", "edges", "blocks", "faces", "patches" },
       "", Report);
     const MapEntry* version = syntax::findEntry(Sections, "blockforge");
     if (!version)
     {
-      fail(1, "", "missing 'blockforge: " + std::to_string(TemplateFormatVersion) +
-          "' (the template format version) at the top of the template");
+      fail(1, "", "missing 'blockforge: 1' (or 'blockforge: 2' for templates with inputs "
+                  "and carriers): the template format version, at the top of the template");
     }
     double versionNumber = 0.0;
     if (!version->value.IsScalar() ||
@@ -473,6 +582,19 @@ private:
         "this template needs BlockForge template format " + version->value.Scalar() +
           " but this BlockForge reads format " + std::to_string(TemplateFormatVersion) +
           " and older; please update BlockForge");
+    }
+    Version = static_cast<int>(versionNumber);
+    if (Version < 2)
+    {
+      for (const char* key : { "inputs", "machine", "carriers", "faces" })
+      {
+        if (const MapEntry* entry = syntax::findEntry(Sections, key))
+        {
+          fail(entry->line, "",
+            std::string("the '") + key + "' section needs template format 2: write "
+            "'blockforge: 2' at the top");
+        }
+      }
     }
     if (const MapEntry* nameEntry = syntax::findEntry(Sections, "name"))
     {
@@ -545,6 +667,13 @@ private:
           "'" + entry.key + "' is a built-in constant or function of expressions; choose "
                             "another name");
       }
+      if (Version >= 2 && isMachineName(entry.key))
+      {
+        fail(entry.line, entityText,
+          "'" + entry.key + "' is a machine value (blade_count, pitch, axis_x, axis_y, "
+                            "axis_z come from the input or the 'machine' section); choose "
+                            "another name");
+      }
       ParameterInfo info;
       info.name = entry.key;
       if (entry.value.IsScalar())
@@ -562,6 +691,26 @@ private:
         catch (const ExpressionError& error)
         {
           fail(entry.line, entityText, "override: " + error.message);
+        }
+      }
+      else if (InfoOnly && Version >= 2)
+      {
+        // Listing parameters without the filter input: values that need the machine
+        // (blade_count, pitch) are unknown here.
+        try
+        {
+          value = number(entry.value, entry.line, entityText, "");
+        }
+        catch (const TemplateError&)
+        {
+          value = std::numeric_limits<double>::quiet_NaN();
+          Evaluator.Unavailable[entry.key] = "it depends on machine values of the input";
+          info.value = value;
+          info.comment = entry.line >= 1 && entry.line <= static_cast<int>(lines.size())
+            ? trailingComment(lines[entry.line - 1])
+            : std::string();
+          Infos.push_back(std::move(info));
+          continue;
         }
       }
       else
@@ -670,6 +819,11 @@ private:
     {
       checkEntityName(entry, "edge");
       const std::string entityText = entity("edge", entry.key);
+      if (isEdgeV2(entry))
+      {
+        readEdgeV2(entry, entityText);
+        continue;
+      }
       if (!entry.value.IsMap())
       {
         fail(entry.line, entityText,
@@ -897,8 +1051,8 @@ private:
       }
       const auto keys =
         syntax::mapEntries(entry.value, entry.line, entityText, "the patch", Report);
-      syntax::checkKeys(
-        keys, { "type", "faces", "partner", "axis", "origin", "angle" }, entityText, Report);
+      syntax::checkKeys(keys, { "type", "faces", "partner", "axis", "origin", "angle", "pitches" },
+        entityText, Report);
       Patch patch;
       patch.name = entry.key;
       patch.where = where(entry.line);
@@ -926,7 +1080,7 @@ private:
       }
       const bool periodic = patch.type == "periodic";
       bool rotation = false;
-      for (const char* key : { "partner", "axis", "origin", "angle" })
+      for (const char* key : { "partner", "axis", "origin", "angle", "pitches" })
       {
         const MapEntry* found = syntax::findEntry(keys, key);
         if (found && !periodic)
@@ -951,6 +1105,34 @@ private:
       if (const MapEntry* origin = syntax::findEntry(keys, "origin"))
       {
         patch.periodicAxisPoint = vector3(origin->value, origin->line, entityText, "origin");
+      }
+      if (const MapEntry* pitches = syntax::findEntry(keys, "pitches"))
+      {
+        if (Version < 2)
+        {
+          fail(pitches->line, entityText, "'pitches' needs template format 2");
+        }
+        if (syntax::findEntry(keys, "angle") || syntax::findEntry(keys, "axis") ||
+          syntax::findEntry(keys, "origin"))
+        {
+          fail(pitches->line, entityText,
+            "give either 'pitches' (about the machine axis) or 'angle' with 'axis' and 'origin'");
+        }
+        const double value = number(pitches->value, pitches->line, entityText, "pitches");
+        if (value != std::floor(value) || value == 0.0 || std::abs(value) > 100000)
+        {
+          fail(pitches->line, entityText, "pitches must be a whole number other than 0");
+        }
+        if (Model.machine.bladeCount <= 0)
+        {
+          fail(pitches->line, entityText,
+            "periodic pitches need the blade count: " + Evaluator.Unavailable["pitch"]);
+        }
+        patch.pitches = static_cast<int>(value);
+        patch.periodicAngle = patch.pitches * Model.machine.pitch();
+        patch.periodicAxis = Model.machine.axis;
+        patch.periodicAxisPoint = Model.machine.axisPoint;
+        rotation = true;
       }
       if (const MapEntry* angle = syntax::findEntry(keys, "angle"))
       {
@@ -1087,11 +1269,1715 @@ private:
       patch.periodicAxis = other.periodicAxis;
       patch.periodicAxisPoint = other.periodicAxisPoint;
       patch.periodicAngle = -other.periodicAngle;
+      patch.pitches = -other.pitches;
     }
+  }
+
+  // ===================================================================== format 2
+  struct BoundInput
+  {
+    const InputPointSet* set = nullptr;
+    int line = 0;
+  };
+  // --- machine and inputs -------------------------------------------------------
+  static bool isMachineName(const std::string& text)
+  {
+    return text == "blade_count" || text == "pitch" || text == "axis_x" || text == "axis_y" ||
+      text == "axis_z";
+  }
+
+  /// Unit vector perpendicular to the machine axis from which theta is measured: the
+  /// x axis projected (the y axis when the machine axis is close to x).
+  Vec3 referenceDirection() const
+  {
+    const Vec3& axis = Model.machine.axis;
+    const Vec3 guess = std::abs(axis.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+    return (guess - guess.dot(axis) * axis).normalized();
+  }
+
+  void cylindrical(const Vec3& p, double& axial, double& radius, double& theta) const
+  {
+    const Vec3& axis = Model.machine.axis;
+    const Vec3 q = p - Model.machine.axisPoint;
+    axial = q.dot(axis);
+    const Vec3 radial = q - axial * axis;
+    radius = radial.norm();
+    const Vec3 e1 = referenceDirection();
+    const Vec3 e2 = axis.cross(e1);
+    theta = std::atan2(radial.dot(e2), radial.dot(e1));
+  }
+
+  Vec3 fromCylindrical(double axial, double radius, double theta) const
+  {
+    const Vec3& axis = Model.machine.axis;
+    const Vec3 e1 = referenceDirection();
+    const Vec3 e2 = axis.cross(e1);
+    return Model.machine.axisPoint + axial * axis +
+      radius * (std::cos(theta) * e1 + std::sin(theta) * e2);
+  }
+
+  void readMachineAndInputs()
+  {
+    if (Version < 2)
+    {
+      return;
+    }
+    Machine& machine = Model.machine;
+    machine.defined = true;
+    double bladeCount = 0.0;
+    if (const MapEntry* section = this->section("machine"))
+    {
+      const std::string entityText = "machine";
+      const auto keys =
+        syntax::mapEntries(section->value, section->line, entityText, "the machine section", Report);
+      syntax::checkKeys(keys, { "axis", "origin", "blade_count" }, entityText, Report);
+      if (const MapEntry* axis = syntax::findEntry(keys, "axis"))
+      {
+        machine.axis = vector3(axis->value, axis->line, entityText, "axis");
+        if (!(machine.axis.norm() > 0.0))
+        {
+          fail(axis->line, entityText, "the machine axis must not be zero");
+        }
+        machine.axis.normalize();
+      }
+      if (const MapEntry* origin = syntax::findEntry(keys, "origin"))
+      {
+        machine.axisPoint = vector3(origin->value, origin->line, entityText, "origin");
+      }
+      if (const MapEntry* count = syntax::findEntry(keys, "blade_count"))
+      {
+        bladeCount = number(count->value, count->line, entityText, "blade_count");
+        if (bladeCount != std::floor(bladeCount) || bladeCount < 1 || bladeCount > 100000)
+        {
+          fail(count->line, entityText, "blade_count must be a whole number from 1 to 100000");
+        }
+      }
+    }
+    if (Inputs && Inputs->hasMachine)
+    {
+      machine.axis = Inputs->axis.normalized();
+      machine.axisPoint = Inputs->axisPoint;
+    }
+    if (Inputs && Inputs->bladeCount > 0)
+    {
+      bladeCount = Inputs->bladeCount;
+    }
+    machine.bladeCount = static_cast<int>(bladeCount);
+    Evaluator.define("axis_x", machine.axis.x());
+    Evaluator.define("axis_y", machine.axis.y());
+    Evaluator.define("axis_z", machine.axis.z());
+    if (machine.bladeCount > 0)
+    {
+      Evaluator.define("blade_count", machine.bladeCount);
+      Evaluator.define("pitch", machine.pitch());
+    }
+    else
+    {
+      const std::string why = "the blade count is unknown: " +
+        (Inputs ? Inputs->origin + " gives none (set BladeCount on the reader)"
+                : std::string("there is no filter input")) +
+        " and the template has no 'machine: {blade_count: n}'";
+      Evaluator.Unavailable["blade_count"] = why;
+      Evaluator.Unavailable["pitch"] = why;
+    }
+
+    const MapEntry* inputs = section("inputs");
+    if (!inputs)
+    {
+      return;
+    }
+    for (const MapEntry& entry :
+      syntax::mapEntries(inputs->value, inputs->line, "", "the inputs section", Report, "input"))
+    {
+      const std::string entityText = entity("input", entry.key);
+      if (!syntax::isEntityName(entry.key))
+      {
+        fail(entry.line, entityText,
+          "names may contain letters, digits, '_' and '-' and must start with a letter or '_'");
+      }
+      const std::string setName = name(entry.value, entry.line, entityText, "point set");
+      if (!Inputs)
+      {
+        if (InfoOnly)
+        {
+          continue;
+        }
+        fail(entry.line, entityText,
+          "this template reads the point set '" + setName +
+            "' from a filter input: apply it with the BlockTemplate filter to the output of "
+            "a TurboPointSetsReader (BlockTemplateSource has no input)");
+      }
+      const InputPointSet* found = nullptr;
+      std::vector<std::string> available;
+      for (const InputPointSet& set : Inputs->pointSets)
+      {
+        available.push_back(set.name);
+        if (set.name == setName)
+        {
+          found = &set;
+        }
+      }
+      if (!found)
+      {
+        const std::string suggestion = syntax::closestName(setName, available);
+        fail(lineOrFallback(entry.value, entry.line), entityText,
+          Inputs->origin + " has no point set '" + setName + "'" +
+            (suggestion.empty() ? std::string() : " (did you mean '" + suggestion + "'?)") +
+            "; it has: " + syntax::joinNames(available));
+      }
+      bool empty = found->curves.empty();
+      for (const InputCurve& curve : found->curves)
+      {
+        empty = empty || curve.points.empty();
+      }
+      if (empty)
+      {
+        fail(lineOrFallback(entry.value, entry.line), entityText,
+          "the point set '" + setName + "' of " + Inputs->origin + " is empty");
+      }
+      BoundInputs[entry.key] = BoundInput{ found, entry.line };
+    }
+  }
+
+  std::vector<std::string> inputNames() const
+  {
+    std::vector<std::string> names;
+    for (const auto& bound : BoundInputs)
+    {
+      names.push_back(bound.first);
+    }
+    return names;
+  }
+
+  std::vector<std::string> carrierNames() const
+  {
+    std::vector<std::string> names;
+    for (std::size_t c = 0; c < CarrierEntries.size(); ++c)
+    {
+      names.push_back(Model.carriers[c].name);
+    }
+    return names;
+  }
+
+  // --- resolution order ---------------------------------------------------------
+  std::string resolvingChain(const std::string& last) const
+  {
+    std::string chain;
+    for (const std::string& item : Resolving)
+    {
+      chain += item + " -> ";
+    }
+    return chain + last;
+  }
+
+  void readCarriersAndVertices()
+  {
+    if (const MapEntry* carriers = section("carriers"))
+    {
+      for (const MapEntry& entry : syntax::mapEntries(
+             carriers->value, carriers->line, "", "the carriers section", Report, "carrier"))
+      {
+        checkEntityName(entry, "carrier");
+        Carrier carrier;
+        carrier.name = entry.key;
+        carrier.where = where(entry.line);
+        Model.carriers.push_back(carrier);
+        CarrierEntries.push_back(entry);
+      }
+    }
+    CarrierState.assign(CarrierEntries.size(), 0);
+    const MapEntry* vertices = section("vertices");
+    if (!vertices || vertices->value.IsNull())
+    {
+      fail(vertices ? vertices->line : 1, "", "the template has no 'vertices' section");
+    }
+    for (const MapEntry& entry : syntax::mapEntries(
+           vertices->value, vertices->line, "", "the vertices section", Report, "vertex"))
+    {
+      checkEntityName(entry, "vertex");
+      Vertex vertex;
+      vertex.name = entry.key;
+      vertex.where = where(entry.line);
+      vertex.position = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+      Model.vertices.push_back(vertex);
+      VertexEntries.push_back(entry);
+    }
+    VertexState.assign(VertexEntries.size(), 0);
+    Evaluator.OnReference = [this](const std::string& vertexName, const std::string&) {
+      const int index = Model.findVertex(vertexName);
+      if (index >= 0)
+      {
+        ensureVertex(index);
+      }
+    };
+    for (std::size_t v = 0; v < VertexEntries.size(); ++v)
+    {
+      ensureVertex(static_cast<int>(v));
+    }
+    for (std::size_t c = 0; c < CarrierEntries.size(); ++c)
+    {
+      ensureCarrier(static_cast<int>(c));
+    }
+  }
+
+  void ensureVertex(int index)
+  {
+    if (index < 0 || index >= static_cast<int>(VertexState.size()) || VertexState[index] == 2)
+    {
+      return;
+    }
+    const MapEntry& entry = VertexEntries[index];
+    const std::string entityText = entity("vertex", entry.key);
+    if (VertexState[index] == 1)
+    {
+      fail(entry.line, entityText,
+        "is defined in terms of itself: " + resolvingChain("vertex '" + entry.key + "'"));
+    }
+    VertexState[index] = 1;
+    Resolving.push_back("vertex '" + entry.key + "'");
+    Vertex vertex = Model.vertices[index];
+    readVertexV2(entry, entityText, vertex);
+    if (!vertex.position.allFinite())
+    {
+      fail(entry.line, entityText, "the position is not finite");
+    }
+    Model.vertices[index] = vertex;
+    Resolving.pop_back();
+    VertexState[index] = 2;
+    defineVertexQueries(vertex);
+  }
+
+  void defineVertexQueries(const Vertex& vertex)
+  {
+    if (!syntax::isIdentifier(vertex.name))
+    {
+      return; // names with '-' cannot appear in expressions
+    }
+    double axial = 0.0, radius = 0.0, theta = 0.0;
+    cylindrical(vertex.position, axial, radius, theta);
+    const std::string& n = vertex.name;
+    Evaluator.defineQuery(n + ".x", vertex.position.x());
+    Evaluator.defineQuery(n + ".y", vertex.position.y());
+    Evaluator.defineQuery(n + ".z", vertex.position.z());
+    Evaluator.defineQuery(n + ".axial", axial);
+    Evaluator.defineQuery(n + ".radius", radius);
+    Evaluator.defineQuery(n + ".theta", theta);
+    if (vertex.constraint.carrier >= 0)
+    {
+      Evaluator.defineQuery(n + ".s", vertex.constraint.s);
+      Evaluator.defineQuery(n + ".t", vertex.constraint.t);
+    }
+    else
+    {
+      const std::string why = "vertex '" + n + "' is not attached to a carrier, so it has no "
+                                               "parameters s, t";
+      Evaluator.Unavailable[n + ".s"] = why;
+      Evaluator.Unavailable[n + ".t"] = why;
+    }
+  }
+
+  void ensureCarrier(int index)
+  {
+    if (index >= static_cast<int>(CarrierState.size()) || CarrierState[index] == 2)
+    {
+      return; // hidden carriers are complete when created
+    }
+    const MapEntry& entry = CarrierEntries[index];
+    const std::string entityText = entity("carrier", entry.key);
+    if (CarrierState[index] == 1)
+    {
+      fail(entry.line, entityText,
+        "is defined in terms of itself: " + resolvingChain("carrier '" + entry.key + "'"));
+    }
+    CarrierState[index] = 1;
+    Resolving.push_back("carrier '" + entry.key + "'");
+    Carrier carrier = Model.carriers[index];
+    readCarrier(entry, entityText, index, carrier);
+    Model.carriers[index] = carrier;
+    Geometry.build(Model, index);
+    Resolving.pop_back();
+    CarrierState[index] = 2;
+  }
+
+  /// A carrier named in the template (declared or hidden), resolved; -1 if there is none.
+  int findCarrierIndex(const std::string& carrierName)
+  {
+    const int index = Model.findCarrier(carrierName);
+    if (index >= 0)
+    {
+      ensureCarrier(index);
+    }
+    return index;
+  }
+
+  enum class Want
+  {
+    Curve,
+    Surface,
+    Any
+  };
+
+  int carrierRef(const YAML::Node& node, int line, const std::string& entityText,
+    const std::string& what, Want want)
+  {
+    const int here = lineOrFallback(node, line);
+    const std::string carrierName = name(node, line, entityText, what);
+    const int index = Model.findCarrier(carrierName);
+    if (index < 0)
+    {
+      std::string message = what + ": unknown carrier '" + carrierName + "'";
+      const std::string suggestion = syntax::closestName(carrierName, carrierNames());
+      if (!suggestion.empty())
+      {
+        message += " (did you mean '" + suggestion + "'?)";
+      }
+      if (BoundInputs.count(carrierName))
+      {
+        message += "; '" + carrierName + "' is an input point set: make a carrier of it, "
+                   "e.g. {interpolate: " + carrierName + "}";
+      }
+      fail(here, entityText, message + "; carriers: " + syntax::joinNames(carrierNames()));
+    }
+    ensureCarrier(index);
+    const bool surface = Model.carriers[index].isSurface();
+    if (want == Want::Curve && surface)
+    {
+      fail(here, entityText, what + ": '" + carrierName + "' is a surface, a curve is needed");
+    }
+    if (want == Want::Surface && !surface)
+    {
+      fail(here, entityText, what + ": '" + carrierName + "' is a curve, a surface is needed");
+    }
+    return index;
+  }
+
+  /// Adds a fully defined carrier (sections of a Gordon surface, meridional contours).
+  int addHiddenCarrier(Carrier carrier)
+  {
+    const int existing = Model.findCarrier(carrier.name);
+    if (existing >= 0)
+    {
+      fail(carrier.where.line, entity("carrier", carrier.name),
+        "the name is taken: carriers may not use names with a '.'");
+    }
+    Model.carriers.push_back(carrier);
+    const int index = static_cast<int>(Model.carriers.size()) - 1;
+    Geometry.build(Model, index);
+    return index;
+  }
+  // --- carriers -------------------------------------------------------------------
+  /// A list of points [[x, y, z], ...] written in the template.
+  std::vector<Vec3> pointList(const YAML::Node& node, int line, const std::string& entityText,
+    const std::string& what)
+  {
+    std::vector<Vec3> points;
+    for (std::size_t p = 0; p < node.size(); ++p)
+    {
+      points.push_back(vector3(node[p], line, entityText, what + " point " + std::to_string(p + 1)));
+    }
+    return points;
+  }
+
+  /// Input points without consecutive duplicates (exports often repeat a point where
+  /// two pieces of a contour meet; interpolation needs distinct consecutive points).
+  static std::vector<Vec3> withoutDuplicates(const std::vector<Vec3>& points)
+  {
+    Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
+    for (const Vec3& p : points)
+    {
+      low = low.cwiseMin(p);
+      high = high.cwiseMax(p);
+    }
+    const double tolerance = 1e-12 * (points.empty() ? 0.0 : (high - low).norm());
+    std::vector<Vec3> kept;
+    for (const Vec3& p : points)
+    {
+      if (kept.empty() || (p - kept.back()).norm() > tolerance)
+      {
+        kept.push_back(p);
+      }
+    }
+    return kept;
+  }
+
+  const BoundInput& inputRef(const std::string& inputName, int line, const std::string& entityText,
+    const std::string& what)
+  {
+    const auto found = BoundInputs.find(inputName);
+    if (found == BoundInputs.end())
+    {
+      std::string message = what + ": '" + inputName + "' is neither a carrier nor an input";
+      std::vector<std::string> names = inputNames();
+      for (const std::string& carrierName : carrierNames())
+      {
+        names.push_back(carrierName);
+      }
+      const std::string suggestion = syntax::closestName(inputName, names);
+      if (!suggestion.empty())
+      {
+        message += " (did you mean '" + suggestion + "'?)";
+      }
+      fail(line, entityText,
+        message + "; inputs: " + syntax::joinNames(inputNames()) +
+          "; carriers: " + syntax::joinNames(carrierNames()));
+    }
+    return found->second;
+  }
+
+  /// `degree` and `parameters` of an interpolation.
+  void readInterpolationOptions(const std::vector<MapEntry>& keys, const std::string& entityText,
+    Carrier& carrier)
+  {
+    if (const MapEntry* degree = syntax::findEntry(keys, "degree"))
+    {
+      const double value = number(degree->value, degree->line, entityText, "degree");
+      if (value != std::floor(value) || value < 1 || value > 15)
+      {
+        fail(degree->line, entityText, "degree must be a whole number from 1 to 15");
+      }
+      carrier.degree = static_cast<int>(value);
+    }
+    if (const MapEntry* method = syntax::findEntry(keys, "parameters"))
+    {
+      const std::string text = name(method->value, method->line, entityText, "parameters");
+      if (text == "uniform")
+      {
+        carrier.parameterMethod = 0;
+      }
+      else if (text == "chord")
+      {
+        carrier.parameterMethod = 1;
+      }
+      else if (text == "centripetal")
+      {
+        carrier.parameterMethod = 2;
+      }
+      else
+      {
+        fail(method->line, entityText,
+          "parameters: expected uniform, chord or centripetal, got '" + text + "'");
+      }
+    }
+  }
+
+  bool flag(const std::vector<MapEntry>& keys, const std::string& key, bool fallback,
+    const std::string& entityText)
+  {
+    const MapEntry* entry = syntax::findEntry(keys, key);
+    if (!entry)
+    {
+      return fallback;
+    }
+    if (entry->value.IsScalar())
+    {
+      const std::string& text = entry->value.Scalar();
+      if (text == "true" || text == "yes" || text == "on")
+      {
+        return true;
+      }
+      if (text == "false" || text == "no" || text == "off")
+      {
+        return false;
+      }
+    }
+    fail(entry->line, entityText, key + ": expected true or false");
+  }
+
+  /// Meridional image of a point: its (axial, radius) placed in the half-plane theta = 0.
+  Vec3 meridional(const Vec3& p, const Vec3& axisPoint, const Vec3& axis) const
+  {
+    const Vec3 q = p - axisPoint;
+    const double axial = q.dot(axis);
+    const double radius = (q - axial * axis).norm();
+    const Vec3 guess = std::abs(axis.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+    const Vec3 e1 = (guess - guess.dot(axis) * axis).normalized();
+    return axisPoint + axial * axis + radius * e1;
+  }
+
+  /// Parameters of a Gordon surface's sections: `at`, else the input's span fractions,
+  /// else uniform.
+  std::vector<double> sectionParameters(const MapEntry* at, std::size_t count,
+    const std::vector<double>& spans, const std::string& entityText)
+  {
+    std::vector<double> nodes;
+    if (at)
+    {
+      if (!at->value.IsSequence() || at->value.size() != count)
+      {
+        fail(at->line, entityText,
+          "'at' needs one parameter per section (" + std::to_string(count) + ")");
+      }
+      for (std::size_t k = 0; k < count; ++k)
+      {
+        nodes.push_back(number(at->value[k], at->line, entityText, "at " + std::to_string(k + 1)));
+        if (k > 0 && !(nodes[k] > nodes[k - 1]))
+        {
+          fail(at->line, entityText, "the section parameters 'at' must increase strictly");
+        }
+      }
+      return nodes;
+    }
+    bool useSpans = spans.size() == count;
+    for (std::size_t k = 0; useSpans && k < count; ++k)
+    {
+      useSpans = std::isfinite(spans[k]) && (k == 0 || spans[k] > spans[k - 1]);
+    }
+    if (useSpans)
+    {
+      return spans;
+    }
+    for (std::size_t k = 0; k < count; ++k)
+    {
+      nodes.push_back(count > 1 ? static_cast<double>(k) / (count - 1) : 0.0);
+    }
+    return nodes;
+  }
+
+  void readCarrier(const MapEntry& entry, const std::string& entityText, int index, Carrier& carrier)
+  {
+    static const std::vector<std::string> kinds = { "interpolate", "revolve", "gordon",
+      "network", "coons", "surface_curve", "intersect" };
+    if (!entry.value.IsMap())
+    {
+      fail(entry.line, entityText,
+        "expected a mapping with one of: " + syntax::joinNames(kinds) +
+          " (e.g. {interpolate: hub} or {revolve: hub_line, axis: machine})");
+    }
+    const auto keys = syntax::mapEntries(entry.value, entry.line, entityText, "the carrier", Report);
+    const MapEntry* kind = nullptr;
+    for (const MapEntry& key : keys)
+    {
+      if (std::find(kinds.begin(), kinds.end(), key.key) != kinds.end())
+      {
+        if (kind)
+        {
+          fail(key.line, entityText,
+            "give one kind only, not both '" + kind->key + "' and '" + key.key + "'");
+        }
+        kind = &key;
+      }
+    }
+    if (!kind)
+    {
+      fail(entry.line, entityText, "needs one of: " + syntax::joinNames(kinds));
+    }
+    const int here = lineOrFallback(kind->value, kind->line);
+    // The name this carrier's own name resolves to in arguments: never itself.
+    auto otherCarrier = [&](const std::string& text) {
+      const int found = Model.findCarrier(text);
+      return found == index ? -1 : found;
+    };
+
+    if (kind->key == "interpolate")
+    {
+      syntax::checkKeys(keys, { "interpolate", "degree", "parameters" }, entityText, Report);
+      carrier.kind = Carrier::Kind::Interpolate;
+      readInterpolationOptions(keys, entityText, carrier);
+      if (kind->value.IsSequence())
+      {
+        carrier.points = pointList(kind->value, here, entityText, "interpolate");
+      }
+      else
+      {
+        const std::string setName = name(kind->value, kind->line, entityText, "interpolate");
+        const BoundInput& input = inputRef(setName, here, entityText, "interpolate");
+        if (input.set->isList)
+        {
+          fail(here, entityText,
+            "interpolate: input '" + setName + "' is a list of " +
+              std::to_string(input.set->curves.size()) +
+              " curves; interpolate takes one curve (use gordon for sections)");
+        }
+        carrier.points = withoutDuplicates(input.set->curves.front().points);
+      }
+      if (carrier.points.size() < 2)
+      {
+        fail(here, entityText, "interpolate needs at least 2 points");
+      }
+      return;
+    }
+
+    if (kind->key == "revolve")
+    {
+      syntax::checkKeys(keys,
+        { "revolve", "axis", "origin", "angle", "meridional", "degree", "parameters" },
+        entityText, Report);
+      carrier.kind = Carrier::Kind::Revolve;
+      carrier.axis = Model.machine.axis;
+      carrier.axisPoint = Model.machine.axisPoint;
+      const MapEntry* axis = syntax::findEntry(keys, "axis");
+      const MapEntry* origin = syntax::findEntry(keys, "origin");
+      if (axis && !(axis->value.IsScalar() && axis->value.Scalar() == "machine"))
+      {
+        carrier.axis = vector3(axis->value, axis->line, entityText, "axis");
+        if (!(carrier.axis.norm() > 0.0))
+        {
+          fail(axis->line, entityText, "the axis must not be zero");
+        }
+        carrier.axis.normalize();
+        carrier.axisPoint = Vec3::Zero();
+      }
+      if (origin)
+      {
+        if (!axis || axis->value.IsScalar())
+        {
+          fail(origin->line, entityText, "'origin' goes with an explicit 'axis: [x, y, z]'");
+        }
+        carrier.axisPoint = vector3(origin->value, origin->line, entityText, "origin");
+      }
+      carrier.angleStart = -Pi;
+      carrier.angleEnd = Pi;
+      if (const MapEntry* angle = syntax::findEntry(keys, "angle"))
+      {
+        if (!angle->value.IsSequence() || angle->value.size() != 2)
+        {
+          fail(angle->line, entityText, "'angle' expects the range [a0, a1] (radians; 30deg)");
+        }
+        carrier.angleStart = number(angle->value[0], angle->line, entityText, "angle a0");
+        carrier.angleEnd = number(angle->value[1], angle->line, entityText, "angle a1");
+        if (!(carrier.angleEnd > carrier.angleStart) ||
+          carrier.angleEnd - carrier.angleStart > 2.0 * Pi * (1.0 + 1e-12))
+        {
+          fail(angle->line, entityText,
+            "the angle range [a0, a1] needs a0 < a1 and at most one turn (2 pi)");
+        }
+      }
+      const bool toMeridian = flag(keys, "meridional", true, entityText);
+      const std::string source = name(kind->value, kind->line, entityText, "revolve");
+      Carrier contour;
+      contour.name = carrier.name + ".contour";
+      contour.where = carrier.where;
+      contour.kind = Carrier::Kind::Interpolate;
+      const int curve = otherCarrier(source);
+      if (curve >= 0)
+      {
+        const int ref = carrierRef(kind->value, kind->line, entityText, "revolve", Want::Curve);
+        const Carrier& base = Model.carriers[ref];
+        if (!toMeridian || base.kind != Carrier::Kind::Interpolate)
+        {
+          if (syntax::findEntry(keys, "degree") || syntax::findEntry(keys, "parameters"))
+          {
+            fail(entry.line, entityText,
+              "'degree' and 'parameters' apply when revolve interpolates points");
+          }
+          carrier.refs = { ref };
+          return;
+        }
+        contour.degree = base.degree;
+        contour.parameterMethod = base.parameterMethod;
+        contour.points = base.points;
+      }
+      else
+      {
+        const BoundInput& input = inputRef(source, here, entityText, "revolve");
+        if (input.set->isList)
+        {
+          fail(here, entityText, "revolve: input '" + source + "' is a list of curves; a "
+                                 "contour is one curve");
+        }
+        contour.points = withoutDuplicates(input.set->curves.front().points);
+      }
+      readInterpolationOptions(keys, entityText, contour);
+      if (toMeridian)
+      {
+        for (Vec3& point : contour.points)
+        {
+          point = meridional(point, carrier.axisPoint, carrier.axis);
+        }
+      }
+      carrier.refs = { addHiddenCarrier(contour) };
+      return;
+    }
+
+    if (kind->key == "gordon" || kind->key == "network")
+    {
+      syntax::checkKeys(keys,
+        { kind->key, "blending", "at", "closed", "degree", "parameters" }, entityText, Report);
+      carrier.kind = kind->key == "gordon" ? Carrier::Kind::Gordon : Carrier::Kind::Network;
+      carrier.blending = Carrier::Blending::Spline;
+      if (const MapEntry* blending = syntax::findEntry(keys, "blending"))
+      {
+        const std::string text = name(blending->value, blending->line, entityText, "blending");
+        if (text == "lagrange")
+        {
+          carrier.blending = Carrier::Blending::Lagrange;
+        }
+        else if (text != "spline")
+        {
+          fail(blending->line, entityText,
+            "blending: expected spline or lagrange, got '" + text + "'");
+        }
+      }
+      carrier.closed = flag(keys, "closed", false, entityText);
+      Carrier sectionTemplate;
+      sectionTemplate.kind = Carrier::Kind::Interpolate;
+      sectionTemplate.where = carrier.where;
+      readInterpolationOptions(keys, entityText, sectionTemplate);
+      const MapEntry* at = syntax::findEntry(keys, "at");
+      if (carrier.kind == Carrier::Kind::Gordon)
+      {
+        std::vector<double> spans;
+        if (kind->value.IsSequence())
+        {
+          for (std::size_t k = 0; k < kind->value.size(); ++k)
+          {
+            carrier.refs.push_back(carrierRef(
+              kind->value[k], here, entityText, "section " + std::to_string(k + 1), Want::Curve));
+          }
+        }
+        else
+        {
+          const std::string source = name(kind->value, kind->line, entityText, "gordon");
+          const BoundInput& input = inputRef(source, here, entityText, "gordon");
+          if (!input.set->isList)
+          {
+            fail(here, entityText,
+              "gordon: input '" + source + "' is one curve; a Gordon surface needs a list of "
+              "sections (or a list of curve carriers [c1, c2, ...])");
+          }
+          const auto& curves = input.set->curves;
+          for (std::size_t k = 0; k < curves.size(); ++k)
+          {
+            Carrier section = sectionTemplate;
+            section.name = carrier.name + ".section" + std::to_string(k + 1);
+            section.points = withoutDuplicates(curves[k].points);
+            spans.push_back(curves[k].span);
+            if (carrier.closed)
+            {
+              checkClosedSection(section.points, entityText, here,
+                "section " + std::to_string(k + 1) +
+                  (curves[k].name.empty() ? std::string() : " ('" + curves[k].name + "')"));
+            }
+            try
+            {
+              carrier.refs.push_back(addHiddenCarrier(section));
+            }
+            catch (const TemplateError& error)
+            {
+              fail(here, entityText,
+                "section " + std::to_string(k + 1) + " of input '" + source + "': " +
+                  error.what());
+            }
+          }
+        }
+        if (carrier.refs.size() < 2)
+        {
+          fail(here, entityText, "a Gordon surface needs at least 2 sections");
+        }
+        carrier.nodes = sectionParameters(at, carrier.refs.size(), spans, entityText);
+        if (carrier.closed && kind->value.IsSequence())
+        {
+          for (std::size_t k = 0; k < carrier.refs.size(); ++k)
+          {
+            const CurvePtr& curve = Geometry.curve(carrier.refs[k]);
+            const double gap = (curve->point(0.0) - curve->point(1.0)).norm();
+            if (gap > 1e-9 * Geometry.size(carrier.refs[k]))
+            {
+              fail(here, entityText,
+                "closed: section " + std::to_string(k + 1) + " ('" +
+                  Model.carriers[carrier.refs[k]].name + "') is open: its ends are " +
+                  shortNumber(gap) + " apart");
+            }
+          }
+        }
+        return;
+      }
+      // network: {along_s: [curves at t = at_t], at_t: [...], along_t: [...], at_s: [...]}
+      if (at)
+      {
+        fail(at->line, entityText, "a network gives its parameters as at_s and at_t");
+      }
+      const auto parts = syntax::mapEntries(kind->value, kind->line, entityText, "network", Report);
+      syntax::checkKeys(parts, { "along_s", "at_t", "along_t", "at_s" }, entityText, Report);
+      const MapEntry* alongS = syntax::findEntry(parts, "along_s");
+      const MapEntry* alongT = syntax::findEntry(parts, "along_t");
+      if (!alongS || !alongT || !alongS->value.IsSequence() || !alongT->value.IsSequence())
+      {
+        fail(here, entityText,
+          "network needs along_s: [curves running in s] and along_t: [curves running in t]");
+      }
+      for (std::size_t k = 0; k < alongS->value.size(); ++k)
+      {
+        carrier.refs.push_back(carrierRef(
+          alongS->value[k], alongS->line, entityText, "along_s " + std::to_string(k + 1), Want::Curve));
+      }
+      for (std::size_t k = 0; k < alongT->value.size(); ++k)
+      {
+        carrier.crossRefs.push_back(carrierRef(
+          alongT->value[k], alongT->line, entityText, "along_t " + std::to_string(k + 1), Want::Curve));
+      }
+      if (carrier.refs.size() < 2 || carrier.crossRefs.size() < 2)
+      {
+        fail(here, entityText, "a network needs at least 2 curves in each direction");
+      }
+      carrier.nodes = sectionParameters(syntax::findEntry(parts, "at_t"), carrier.refs.size(), {}, entityText);
+      carrier.crossNodes =
+        sectionParameters(syntax::findEntry(parts, "at_s"), carrier.crossRefs.size(), {}, entityText);
+      return;
+    }
+
+    if (kind->key == "coons")
+    {
+      syntax::checkKeys(keys, { "coons" }, entityText, Report);
+      carrier.kind = Carrier::Kind::Coons;
+      if (!kind->value.IsSequence() || kind->value.size() != 4)
+      {
+        fail(here, entityText,
+          "coons expects four curves [bottom, right, top, left]: P(s, 0), P(1, t), P(s, 1), "
+          "P(0, t), each running in increasing s or t");
+      }
+      static const char* const roles[4] = { "bottom", "right", "top", "left" };
+      for (int k = 0; k < 4; ++k)
+      {
+        carrier.refs.push_back(carrierRef(kind->value[k], here, entityText, roles[k], Want::Curve));
+      }
+      return;
+    }
+
+    if (kind->key == "surface_curve")
+    {
+      syntax::checkKeys(keys, { "surface_curve", "through" }, entityText, Report);
+      carrier.kind = Carrier::Kind::SurfaceCurve;
+      const int surface =
+        carrierRef(kind->value, kind->line, entityText, "surface_curve", Want::Surface);
+      carrier.refs = { surface };
+      const MapEntry* through = syntax::findEntry(keys, "through");
+      if (!through || !through->value.IsSequence() || through->value.size() < 2)
+      {
+        fail(through ? through->line : entry.line, entityText,
+          "surface_curve needs 'through: [...]' with at least 2 items: vertices on the "
+          "surface or parameter pairs [s, t]");
+      }
+      for (std::size_t k = 0; k < through->value.size(); ++k)
+      {
+        const YAML::Node item = through->value[k];
+        const std::string what = "through " + std::to_string(k + 1);
+        if (item.IsSequence())
+        {
+          if (item.size() != 2)
+          {
+            fail(lineOrFallback(item, through->line), entityText, what + ": expected [s, t]");
+          }
+          carrier.parameterPoints.emplace_back(
+            number(item[0], through->line, entityText, what + " s"),
+            number(item[1], through->line, entityText, what + " t"));
+        }
+        else
+        {
+          const int vertex = vertexRef(item, through->line, entityText);
+          double s = 0.0, t = 0.0, distance = 0.0;
+          Geometry.vertexParameters(Model, vertex, surface, s, t, distance);
+          checkOnCarrier(vertex, surface, distance, lineOrFallback(item, through->line), entityText);
+          carrier.parameterPoints.emplace_back(s, t);
+        }
+      }
+      return;
+    }
+
+    // intersect
+    syntax::checkKeys(keys, { "intersect", "range", "samples" }, entityText, Report);
+    carrier.kind = Carrier::Kind::Intersect;
+    if (!kind->value.IsSequence() || kind->value.size() != 2)
+    {
+      fail(here, entityText,
+        "intersect expects [surface, surface of revolution], e.g. [blade, hub]");
+    }
+    carrier.refs = { carrierRef(kind->value[0], here, entityText, "intersect", Want::Surface),
+      carrierRef(kind->value[1], here, entityText, "intersect", Want::Surface) };
+    if (const MapEntry* range = syntax::findEntry(keys, "range"))
+    {
+      if (!range->value.IsSequence() || range->value.size() != 2)
+      {
+        fail(range->line, entityText, "'range' expects [t_min, t_max] on the first surface");
+      }
+      carrier.rangeMin = number(range->value[0], range->line, entityText, "range t_min");
+      carrier.rangeMax = number(range->value[1], range->line, entityText, "range t_max");
+      if (!(carrier.rangeMax > carrier.rangeMin))
+      {
+        fail(range->line, entityText, "'range' needs t_min < t_max");
+      }
+    }
+    if (const MapEntry* samples = syntax::findEntry(keys, "samples"))
+    {
+      const double value = number(samples->value, samples->line, entityText, "samples");
+      if (value != std::floor(value) || value < 4 || value > 100000)
+      {
+        fail(samples->line, entityText, "samples must be a whole number from 4 to 100000");
+      }
+      carrier.samples = static_cast<int>(value);
+    }
+  }
+
+  void checkClosedSection(const std::vector<Vec3>& points, const std::string& entityText,
+    int line, const std::string& what)
+  {
+    Vec3 low = points.front(), high = low;
+    for (const Vec3& p : points)
+    {
+      low = low.cwiseMin(p);
+      high = high.cwiseMax(p);
+    }
+    const double size = std::max((high - low).norm(), 1e-300);
+    const double gap = (points.front() - points.back()).norm();
+    if (points.size() < 3 || gap > 1e-9 * size)
+    {
+      fail(line, entityText,
+        "closed: " + what + " is open: its first and last points are " + shortNumber(gap) +
+          " apart (relative " + shortNumber(gap / size) +
+          "); the blade surface must close around every section");
+    }
+  }
+
+  /// Tolerance for "lies on": 1e-9 of the larger of the vertices' and the carrier's size.
+  double onTolerance(int carrier) const
+  {
+    return 1e-9 * std::max(vertexSpan(), Geometry.size(carrier));
+  }
+
+  double vertexSpan() const
+  {
+    Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
+    bool any = false;
+    for (const Vertex& vertex : Model.vertices)
+    {
+      if (vertex.position.allFinite())
+      {
+        low = low.cwiseMin(vertex.position);
+        high = high.cwiseMax(vertex.position);
+        any = true;
+      }
+    }
+    return any ? (high - low).norm() : 0.0;
+  }
+
+  void checkOnCarrier(int vertex, int carrier, double distance, int line, const std::string& entityText)
+  {
+    if (distance > onTolerance(carrier))
+    {
+      fail(line, entityText,
+        "vertex '" + Model.vertices[vertex].name + "' is not on carrier '" +
+          Model.carriers[carrier].name + "' (" + shortNumber(distance) +
+          " away); attach it with {on_curve: ...}, {on_surface: ...} or {project: ..., onto: ...}");
+    }
+  }
+  // --- vertices (format 2) ----------------------------------------------------------
+  /// A point given as [x, y, z], {cylindrical: [axial, radius, theta]} or a vertex name.
+  Vec3 pointValue(const YAML::Node& node, int line, const std::string& entityText,
+    const std::string& what)
+  {
+    const int here = lineOrFallback(node, line);
+    if (node.IsSequence())
+    {
+      return vector3(node, here, entityText, what);
+    }
+    if (node.IsMap())
+    {
+      const auto keys = syntax::mapEntries(node, here, entityText, what, Report);
+      syntax::checkKeys(keys, { "cylindrical" }, entityText, Report);
+      const MapEntry* cyl = syntax::findEntry(keys, "cylindrical");
+      if (!cyl)
+      {
+        fail(here, entityText, what + ": expected [x, y, z], {cylindrical: [axial, radius, theta]} or a vertex");
+      }
+      return cylindricalValue(*cyl, entityText);
+    }
+    const int vertex = vertexRef(node, here, entityText);
+    return Model.vertices[vertex].position;
+  }
+
+  Vec3 cylindricalValue(const MapEntry& entry, const std::string& entityText)
+  {
+    if (!entry.value.IsSequence() || entry.value.size() != 3)
+    {
+      fail(entry.line, entityText,
+        "cylindrical expects [axial, radius, theta] about the machine axis (theta in "
+        "radians, 10deg, from the reference direction)");
+    }
+    const double axial = number(entry.value[0], entry.line, entityText, "axial");
+    const double radius = number(entry.value[1], entry.line, entityText, "radius");
+    const double theta = number(entry.value[2], entry.line, entityText, "theta");
+    return fromCylindrical(axial, radius, theta);
+  }
+
+  /// The value of a quantity at a point: x, y, z, axial, radius, theta.
+  double quantity(const std::string& which, const Vec3& p) const
+  {
+    double axial = 0.0, radius = 0.0, theta = 0.0;
+    cylindrical(p, axial, radius, theta);
+    if (which == "x")
+      return p.x();
+    if (which == "y")
+      return p.y();
+    if (which == "z")
+      return p.z();
+    if (which == "axial")
+      return axial;
+    if (which == "radius")
+      return radius;
+    return theta;
+  }
+
+  /// Parameter u of curve `carrier` where `which` is smallest (sign = 1) or largest (-1):
+  /// a sample of 512 points, then golden-section search in the bracketing interval.
+  double extremum(int carrier, const std::string& which, double sign)
+  {
+    const int samples = 512;
+    const bool closed = Geometry.closedS(carrier);
+    auto f = [&](double u) { return sign * quantity(which, Geometry.point(carrier, u)); };
+    int best = 0;
+    double bestValue = f(0.0);
+    for (int k = 1; k <= samples; ++k)
+    {
+      const double value = f(static_cast<double>(k) / samples);
+      if (value < bestValue)
+      {
+        bestValue = value;
+        best = k;
+      }
+    }
+    double a = static_cast<double>(best - 1) / samples, b = static_cast<double>(best + 1) / samples;
+    if (!closed)
+    {
+      a = std::max(a, 0.0);
+      b = std::min(b, 1.0);
+    }
+    const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
+    double c = b - ratio * (b - a), d = a + ratio * (b - a);
+    double fc = f(c), fd = f(d);
+    while (b - a > 1e-14)
+    {
+      if (fc < fd)
+      {
+        b = d;
+        d = c;
+        fd = fc;
+        c = b - ratio * (b - a);
+        fc = f(c);
+      }
+      else
+      {
+        a = c;
+        c = d;
+        fc = fd;
+        d = a + ratio * (b - a);
+        fd = f(d);
+      }
+    }
+    double u = 0.5 * (a + b);
+    if (!closed && f(0.0) <= f(u))
+    {
+      u = 0.0;
+    }
+    if (!closed && f(1.0) < f(u))
+    {
+      u = 1.0;
+    }
+    return closed ? wrapUnit(u) : u;
+  }
+
+  /// Parameter u where curve `curve` meets surface `surface`.
+  double curveSurfaceIntersection(int curve, int surface, const MapEntry* near,
+    const std::string& entityText, int line)
+  {
+    const int samples = 512;
+    const SurfaceOfRevolution* revolution = Geometry.revolution(surface);
+    std::vector<double> roots;
+    auto refine = [&](auto&& f, double a, double b) {
+      double fa = f(a), fb = f(b);
+      for (int iteration = 0; iteration < 200 && b - a > 1e-15; ++iteration)
+      {
+        // Illinois-style regula falsi with bisection safeguard.
+        double m = fb != fa ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
+        if (!(m > a && m < b) || iteration % 3 == 2)
+        {
+          m = 0.5 * (a + b);
+        }
+        const double fm = f(m);
+        if (fm == 0.0)
+        {
+          return m;
+        }
+        if ((fm < 0.0) == (fa < 0.0))
+        {
+          a = m;
+          fa = fm;
+        }
+        else
+        {
+          b = m;
+          fb = fm;
+        }
+      }
+      return std::abs(fa) < std::abs(fb) ? a : b;
+    };
+    if (revolution)
+    {
+      auto f = [&](double u) { return revolution->signedMeridionalDistance(Geometry.point(curve, u)); };
+      double previous = f(0.0);
+      if (previous == 0.0)
+      {
+        roots.push_back(0.0);
+      }
+      for (int k = 1; k <= samples; ++k)
+      {
+        const double u = static_cast<double>(k) / samples;
+        const double value = f(u);
+        if (value == 0.0)
+        {
+          roots.push_back(u);
+        }
+        else if (previous != 0.0 && (value < 0.0) != (previous < 0.0))
+        {
+          roots.push_back(refine(f, static_cast<double>(k - 1) / samples, u));
+        }
+        previous = value;
+      }
+    }
+    else
+    {
+      auto f = [&](double u) {
+        double s = 0.0, t = 0.0, distance = 0.0;
+        Geometry.project(surface, Geometry.point(curve, u), s, t, distance);
+        return distance;
+      };
+      int best = 0;
+      double bestValue = f(0.0);
+      for (int k = 1; k <= samples; ++k)
+      {
+        const double value = f(static_cast<double>(k) / samples);
+        if (value < bestValue)
+        {
+          bestValue = value;
+          best = k;
+        }
+      }
+      double a = std::max(0.0, (best - 1.0) / samples), b = std::min(1.0, (best + 1.0) / samples);
+      const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
+      while (b - a > 1e-15)
+      {
+        const double c = b - ratio * (b - a), d = a + ratio * (b - a);
+        if (f(c) < f(d))
+        {
+          b = d;
+        }
+        else
+        {
+          a = c;
+        }
+      }
+      const double u = 0.5 * (a + b);
+      const double distance = f(u);
+      if (distance > onTolerance(surface))
+      {
+        fail(line, entityText,
+          "curve '" + Model.carriers[curve].name + "' does not meet surface '" +
+            Model.carriers[surface].name + "' (closest approach " + shortNumber(distance) + ")");
+      }
+      return u;
+    }
+    if (roots.empty())
+    {
+      fail(line, entityText,
+        "curve '" + Model.carriers[curve].name + "' does not cross surface '" +
+          Model.carriers[surface].name + "'");
+    }
+    if (roots.size() == 1)
+    {
+      return roots.front();
+    }
+    if (!near)
+    {
+      fail(line, entityText,
+        "curve '" + Model.carriers[curve].name + "' crosses surface '" +
+          Model.carriers[surface].name + "' " + std::to_string(roots.size()) +
+          " times; add 'near: [x, y, z]' (or a vertex) to choose one");
+    }
+    const Vec3 target = pointValue(near->value, near->line, entityText, "near");
+    double best = roots.front();
+    for (double u : roots)
+    {
+      if ((Geometry.point(curve, u) - target).norm() < (Geometry.point(curve, best) - target).norm())
+      {
+        best = u;
+      }
+    }
+    return best;
+  }
+
+  void readVertexV2(const MapEntry& entry, const std::string& entityText, Vertex& vertex)
+  {
+    if (entry.value.IsSequence())
+    {
+      vertex.position = vector3(entry.value, entry.line, entityText, "position");
+      return;
+    }
+    static const std::vector<std::string> kinds = { "position", "rotate", "cylindrical",
+      "on_curve", "on_surface", "project", "periodic", "intersect" };
+    if (!entry.value.IsMap())
+    {
+      fail(entry.line, entityText,
+        "expected a position [x, y, z] or a mapping with one of: " + syntax::joinNames(kinds));
+    }
+    const auto keys = syntax::mapEntries(entry.value, entry.line, entityText, "the vertex", Report);
+    const MapEntry* kind = nullptr;
+    for (const MapEntry& key : keys)
+    {
+      if (std::find(kinds.begin(), kinds.end(), key.key) != kinds.end())
+      {
+        if (kind)
+        {
+          fail(key.line, entityText,
+            "give one kind only, not both '" + kind->key + "' and '" + key.key + "'");
+        }
+        kind = &key;
+      }
+    }
+    if (!kind)
+    {
+      syntax::checkKeys(keys, kinds, entityText, Report);
+      fail(entry.line, entityText, "needs one of: " + syntax::joinNames(kinds));
+    }
+    const int here = lineOrFallback(kind->value, kind->line);
+    if (kind->key == "position" || kind->key == "rotate")
+    {
+      vertex.position = readVertexMapping(entry, entityText);
+      return;
+    }
+    if (kind->key == "cylindrical")
+    {
+      syntax::checkKeys(keys, { "cylindrical" }, entityText, Report);
+      vertex.position = cylindricalValue(*kind, entityText);
+      return;
+    }
+    VertexConstraint& constraint = vertex.constraint;
+    if (kind->key == "on_curve")
+    {
+      syntax::checkKeys(keys, { "on_curve", "at" }, entityText, Report);
+      const int curve = carrierRef(kind->value, kind->line, entityText, "on_curve", Want::Curve);
+      const MapEntry* at = syntax::findEntry(keys, "at");
+      if (!at)
+      {
+        fail(entry.line, entityText,
+          "on_curve needs 'at': a parameter u in [0, 1], {length: fraction}, "
+          "{min: quantity} or {max: quantity} (quantities: x y z axial radius theta)");
+      }
+      double u = 0.0;
+      if (at->value.IsMap())
+      {
+        const auto how = syntax::mapEntries(at->value, at->line, entityText, "'at'", Report);
+        syntax::checkKeys(how, { "length", "min", "max" }, entityText, Report);
+        if (how.size() != 1)
+        {
+          fail(at->line, entityText, "'at' takes one of length, min or max");
+        }
+        if (how[0].key == "length")
+        {
+          const double fraction = number(how[0].value, how[0].line, entityText, "length");
+          if (fraction < 0.0 || fraction > 1.0)
+          {
+            fail(how[0].line, entityText, "the length fraction must be in [0, 1]");
+          }
+          u = ArcLengthTable(Geometry.curve(curve)).parameterAtFraction(fraction);
+        }
+        else
+        {
+          static const std::vector<std::string> quantities = { "x", "y", "z", "axial", "radius",
+            "theta" };
+          const std::string which = name(how[0].value, how[0].line, entityText, how[0].key);
+          if (std::find(quantities.begin(), quantities.end(), which) == quantities.end())
+          {
+            fail(how[0].line, entityText,
+              how[0].key + ": unknown quantity '" + which + "'; use one of " +
+                syntax::joinNames(quantities));
+          }
+          u = extremum(curve, which, how[0].key == "min" ? 1.0 : -1.0);
+        }
+      }
+      else
+      {
+        u = number(at->value, at->line, entityText, "at");
+        if (Geometry.closedS(curve))
+        {
+          u = wrapUnit(u);
+        }
+        else if (u < 0.0 || u > 1.0)
+        {
+          fail(at->line, entityText,
+            "at = " + shortNumber(u) + " is outside the curve's parameter range [0, 1]");
+        }
+      }
+      constraint.carrier = curve;
+      constraint.s = u;
+      vertex.position = Geometry.point(curve, u);
+      return;
+    }
+    if (kind->key == "on_surface")
+    {
+      syntax::checkKeys(keys, { "on_surface", "at" }, entityText, Report);
+      const int surface =
+        carrierRef(kind->value, kind->line, entityText, "on_surface", Want::Surface);
+      const MapEntry* at = syntax::findEntry(keys, "at");
+      if (!at || !at->value.IsSequence() || at->value.size() != 2)
+      {
+        fail(at ? at->line : entry.line, entityText, "on_surface needs 'at: [s, t]'");
+      }
+      double st[2] = { number(at->value[0], at->line, entityText, "at s"),
+        number(at->value[1], at->line, entityText, "at t") };
+      const bool closed[2] = { Geometry.closedS(surface), Geometry.closedT(surface) };
+      const double low[2] = { 0.0, Geometry.tMin(surface) };
+      const double high[2] = { 1.0, Geometry.tMax(surface) };
+      for (int k = 0; k < 2; ++k)
+      {
+        if (closed[k])
+        {
+          st[k] = wrapUnit(st[k]);
+        }
+        else if (st[k] < low[k] || st[k] > high[k])
+        {
+          fail(at->line, entityText,
+            std::string(k ? "t" : "s") + " = " + shortNumber(st[k]) +
+              " is outside the surface's parameter range [" + shortNumber(low[k]) + ", " +
+              shortNumber(high[k]) + "]");
+        }
+      }
+      constraint.carrier = surface;
+      constraint.s = st[0];
+      constraint.t = st[1];
+      vertex.position = Geometry.point(surface, st[0], st[1]);
+      return;
+    }
+    if (kind->key == "project")
+    {
+      syntax::checkKeys(keys, { "project", "onto" }, entityText, Report);
+      const MapEntry* onto = syntax::findEntry(keys, "onto");
+      if (!onto)
+      {
+        fail(entry.line, entityText, "project needs 'onto: <carrier>'");
+      }
+      const Vec3 point = pointValue(kind->value, kind->line, entityText, "project");
+      const int carrier = carrierRef(onto->value, onto->line, entityText, "onto", Want::Any);
+      double s = 0.0, t = 0.0, distance = 0.0;
+      Geometry.project(carrier, point, s, t, distance);
+      constraint.carrier = carrier;
+      constraint.s = s;
+      constraint.t = t;
+      vertex.position = Geometry.point(carrier, s, t);
+      return;
+    }
+    if (kind->key == "intersect")
+    {
+      syntax::checkKeys(keys, { "intersect", "near" }, entityText, Report);
+      if (!kind->value.IsSequence() || kind->value.size() != 2)
+      {
+        fail(here, entityText, "intersect expects [curve, surface]");
+      }
+      const int curve = carrierRef(kind->value[0], here, entityText, "intersect", Want::Curve);
+      const int surface = carrierRef(kind->value[1], here, entityText, "intersect", Want::Surface);
+      const double u =
+        curveSurfaceIntersection(curve, surface, syntax::findEntry(keys, "near"), entityText, here);
+      constraint.carrier = curve;
+      constraint.s = u;
+      vertex.position = Geometry.point(curve, u);
+      return;
+    }
+    // periodic
+    syntax::checkKeys(keys, { "periodic", "pitches" }, entityText, Report);
+    const int source = vertexRef(kind->value, kind->line, entityText);
+    int pitches = 1;
+    if (const MapEntry* count = syntax::findEntry(keys, "pitches"))
+    {
+      const double value = number(count->value, count->line, entityText, "pitches");
+      if (value != std::floor(value) || value == 0.0 || std::abs(value) > 100000)
+      {
+        fail(count->line, entityText, "pitches must be a whole number other than 0");
+      }
+      pitches = static_cast<int>(value);
+    }
+    const Machine& machine = Model.machine;
+    if (machine.bladeCount <= 0)
+    {
+      fail(here, entityText,
+        "a periodic vertex needs the blade count: " + Evaluator.Unavailable["pitch"]);
+    }
+    const double angle = pitches * machine.pitch();
+    const Vertex& original = Model.vertices[source];
+    vertex.position = rotateAboutAxis(original.position, machine.axisPoint, machine.axis, angle);
+    constraint.periodicSource = source;
+    constraint.pitches = pitches;
+    constraint.carrier = -1;
+    // The paper's parameter offsets: the image of a point on a surface of revolution about
+    // the machine axis is on the same surface at t + angle / (a1 - a0).
+    if (original.constraint.carrier >= 0)
+    {
+      const int carrier = original.constraint.carrier;
+      const Carrier& definition = Model.carriers[carrier];
+      if (definition.kind == Carrier::Kind::Revolve &&
+        (definition.axis - machine.axis).norm() <= 1e-12 &&
+        (definition.axisPoint - machine.axisPoint).norm() <= 1e-12 * std::max(1.0, vertexSpan()))
+      {
+        double t = original.constraint.t + angle / (definition.angleEnd - definition.angleStart);
+        if (Geometry.closedT(carrier))
+        {
+          t = wrapUnit(t);
+        }
+        if (t >= 0.0 && t <= 1.0)
+        {
+          constraint.carrier = carrier;
+          constraint.s = original.constraint.s;
+          constraint.t = t;
+        }
+      }
+    }
+  }
+  // --- edges and faces (format 2) --------------------------------------------------
+  bool isEdgeV2(const MapEntry& entry) const
+  {
+    if (Version < 2 || !entry.value.IsMap())
+    {
+      return false;
+    }
+    for (const char* key : { "on_curve", "on_surface", "project", "periodic" })
+    {
+      if (entry.value[key])
+      {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  void readEdgeV2(const MapEntry& entry, const std::string& entityText)
+  {
+    const auto keys = syntax::mapEntries(entry.value, entry.line, entityText, "the edge", Report);
+    syntax::checkKeys(
+      keys, { "on_curve", "on_surface", "project", "periodic", "between", "at", "pitches" },
+      entityText, Report);
+    const MapEntry* kind = nullptr;
+    for (const MapEntry& key : keys)
+    {
+      if (key.key == "on_curve" || key.key == "on_surface" || key.key == "project" ||
+        key.key == "periodic")
+      {
+        if (kind)
+        {
+          fail(key.line, entityText,
+            "give one kind only, not both '" + kind->key + "' and '" + key.key + "'");
+        }
+        kind = &key;
+      }
+    }
+    Edge edge;
+    edge.name = entry.key;
+    edge.where = where(entry.line);
+    const MapEntry* between = syntax::findEntry(keys, "between");
+    if (!between || !between->value.IsSequence() || between->value.size() != 2)
+    {
+      fail(between ? between->line : entry.line, entityText,
+        "'" + kind->key + "' edges need 'between: [a, b]', their two end vertices");
+    }
+    edge.from = vertexRef(between->value[0], between->line, entityText);
+    edge.to = vertexRef(between->value[1], between->line, entityText);
+    if (edge.from == edge.to)
+    {
+      fail(between->line, entityText, "an edge needs two different end vertices");
+    }
+    const MapEntry* at = syntax::findEntry(keys, "at");
+    const MapEntry* pitches = syntax::findEntry(keys, "pitches");
+    if (pitches && kind->key != "periodic")
+    {
+      fail(pitches->line, entityText, "'pitches' belongs to periodic edges");
+    }
+    if (kind->key == "periodic")
+    {
+      if (at)
+      {
+        fail(at->line, entityText, "a periodic edge takes its nodes from its source edge");
+      }
+      edge.kind = Edge::Kind::Periodic;
+      const std::string sourceName = name(kind->value, kind->line, entityText, "periodic");
+      for (std::size_t e = 0; e < Model.edges.size(); ++e)
+      {
+        if (Model.edges[e].name == sourceName)
+        {
+          edge.source = static_cast<int>(e);
+        }
+      }
+      if (edge.source < 0)
+      {
+        std::vector<std::string> names;
+        for (const Edge& other : Model.edges)
+        {
+          names.push_back(other.name);
+        }
+        const std::string suggestion = syntax::closestName(sourceName, names);
+        fail(kind->line, entityText,
+          "periodic: unknown edge '" + sourceName + "'" +
+            (suggestion.empty() ? std::string() : " (did you mean '" + suggestion + "'?)") +
+            "; the source edge must be defined above this one");
+      }
+      edge.pitches = 1;
+      if (pitches)
+      {
+        const double value = number(pitches->value, pitches->line, entityText, "pitches");
+        if (value != std::floor(value) || value == 0.0 || std::abs(value) > 100000)
+        {
+          fail(pitches->line, entityText, "pitches must be a whole number other than 0");
+        }
+        edge.pitches = static_cast<int>(value);
+      }
+      if (Model.machine.bladeCount <= 0)
+      {
+        fail(kind->line, entityText,
+          "a periodic edge needs the blade count: " + Evaluator.Unavailable["pitch"]);
+      }
+    }
+    else
+    {
+      const Want want = kind->key == "on_curve" ? Want::Curve : Want::Surface;
+      edge.carrier = carrierRef(kind->value, kind->line, entityText, kind->key, want);
+      edge.kind = kind->key == "on_curve" ? Edge::Kind::OnCurve
+        : kind->key == "on_surface"       ? Edge::Kind::OnSurface
+                                          : Edge::Kind::Project;
+      if (at)
+      {
+        if (edge.kind == Edge::Kind::Project)
+        {
+          fail(at->line, entityText, "a projected edge takes no 'at'");
+        }
+        if (!at->value.IsSequence() || at->value.size() != 2)
+        {
+          fail(at->line, entityText,
+            edge.kind == Edge::Kind::OnCurve ? "'at' expects [u_a, u_b]"
+                                             : "'at' expects [[s_a, t_a], [s_b, t_b]]");
+        }
+        for (int end = 0; end < 2; ++end)
+        {
+          const YAML::Node item = at->value[end];
+          if (edge.kind == Edge::Kind::OnCurve)
+          {
+            edge.at.push_back(number(item, at->line, entityText, "at"));
+          }
+          else
+          {
+            if (!item.IsSequence() || item.size() != 2)
+            {
+              fail(at->line, entityText, "'at' expects [[s_a, t_a], [s_b, t_b]]");
+            }
+            edge.at.push_back(number(item[0], at->line, entityText, "at s"));
+            edge.at.push_back(number(item[1], at->line, entityText, "at t"));
+          }
+        }
+      }
+    }
+    const int other = Model.findEdge(edge.from, edge.to);
+    if (other >= 0)
+    {
+      fail(entry.line, entityText,
+        "joins the same vertices as edge '" + Model.edges[other].name + "' (line " +
+          std::to_string(Model.edges[other].where.line) + ")");
+    }
+    Model.edges.push_back(edge);
+  }
+
+  /// Faces whose grids lie on surfaces: {on_surface: S, faces: [block.face | [4 vertices]]}.
+  void readFaces()
+  {
+    const MapEntry* faces = section("faces");
+    if (!faces)
+    {
+      return;
+    }
+    for (const MapEntry& entry :
+      syntax::mapEntries(faces->value, faces->line, "", "the faces section", Report, "face set"))
+    {
+      checkEntityName(entry, "face set");
+      const std::string entityText = entity("face set", entry.key);
+      if (!entry.value.IsMap())
+      {
+        fail(entry.line, entityText, "expected {on_surface: S, faces: [block.face, ...]}");
+      }
+      const auto keys = syntax::mapEntries(entry.value, entry.line, entityText, "the face set", Report);
+      syntax::checkKeys(keys, { "on_surface", "faces" }, entityText, Report);
+      const MapEntry* surface = syntax::findEntry(keys, "on_surface");
+      const MapEntry* list = syntax::findEntry(keys, "faces");
+      if (!surface)
+      {
+        fail(entry.line, entityText,
+          "needs 'on_surface: <surface carrier>' (periodic faces come from periodic patches)");
+      }
+      if (!list || !list->value.IsSequence() || list->value.size() == 0)
+      {
+        fail(list ? list->line : entry.line, entityText,
+          "needs 'faces: [...]': block.face names or lists of 4 corner vertices");
+      }
+      SurfaceFaces set;
+      set.name = entry.key;
+      set.where = where(entry.line);
+      set.carrier = carrierRef(surface->value, surface->line, entityText, "on_surface", Want::Surface);
+      for (std::size_t f = 0; f < list->value.size(); ++f)
+      {
+        const YAML::Node item = list->value[f];
+        if (item.IsSequence())
+        {
+          set.faces.push_back(faceByVertices(item, list->line, entityText));
+        }
+        else
+        {
+          set.faces.push_back(faceRef(item, list->line, entityText));
+        }
+      }
+      Model.surfaceFaces.push_back(set);
+    }
+  }
+
+  BlockFace faceByVertices(const YAML::Node& node, int line, const std::string& entityText)
+  {
+    const int here = lineOrFallback(node, line);
+    if (node.size() != 4)
+    {
+      fail(here, entityText, "a face by its corners needs 4 vertices");
+    }
+    std::array<int, 4> wanted{};
+    for (int c = 0; c < 4; ++c)
+    {
+      wanted[c] = vertexRef(node[c], here, entityText);
+    }
+    std::sort(wanted.begin(), wanted.end());
+    for (std::size_t b = 0; b < Model.blocks.size(); ++b)
+    {
+      for (int f = 0; f < 6; ++f)
+      {
+        std::array<int, 4> ids{};
+        const std::array<int, 4> corners = faceCorners(f);
+        for (int c = 0; c < 4; ++c)
+        {
+          ids[c] = Model.blocks[b].vertices[corners[c]];
+        }
+        std::sort(ids.begin(), ids.end());
+        if (ids == wanted)
+        {
+          return BlockFace{ static_cast<int>(b), f };
+        }
+      }
+    }
+    std::string names;
+    for (int c = 0; c < 4; ++c)
+    {
+      names += (c ? ", " : "") + node[c].Scalar();
+    }
+    fail(here, entityText, "no block has a face with the corners [" + names + "]");
   }
 
   const std::string& Text;
   const ParameterOverrides& Overrides;
+  const TemplateInputs* Inputs = nullptr;
+  bool InfoOnly = false;
+  int Version = 1;
+  std::map<std::string, BoundInput> BoundInputs;
+  CarrierGeometry Geometry;
+  std::vector<MapEntry> CarrierEntries, VertexEntries;
+  std::vector<int> CarrierState, VertexState; // 0 pending, 1 in progress, 2 done
+  std::vector<std::string> Resolving;         // entities being resolved, for cycles
   syntax::Reporter Report;
   ExpressionEvaluator Evaluator;
   std::vector<MapEntry> Sections;
@@ -1116,10 +3002,10 @@ std::string readFile(const std::string& path)
 }
 } // namespace
 
-BlockModel parseTemplate(
-  const std::string& text, const std::string& fileName, const ParameterOverrides& overrides)
+BlockModel parseTemplate(const std::string& text, const std::string& fileName,
+  const ParameterOverrides& overrides, const TemplateInputs* inputs)
 {
-  TemplateReader reader(text, fileName, overrides);
+  TemplateReader reader(text, fileName, overrides, inputs);
   BlockModel model = reader.readModel();
   // Topology and geometry problems are template errors too: report them now, with the
   // template's lines, rather than when the mesher runs.
@@ -1127,16 +3013,17 @@ BlockModel parseTemplate(
   return model;
 }
 
-BlockModel loadTemplate(const std::string& path, const ParameterOverrides& overrides)
+BlockModel loadTemplate(
+  const std::string& path, const ParameterOverrides& overrides, const TemplateInputs* inputs)
 {
-  return parseTemplate(readFile(path), path, overrides);
+  return parseTemplate(readFile(path), path, overrides, inputs);
 }
 
-std::vector<ParameterInfo> templateParameters(
-  const std::string& path, const ParameterOverrides& overrides)
+std::vector<ParameterInfo> templateParameters(const std::string& path,
+  const ParameterOverrides& overrides, const TemplateInputs* inputs)
 {
   const std::string text = readFile(path);
-  TemplateReader reader(text, path, overrides);
+  TemplateReader reader(text, path, overrides, inputs);
   return reader.readParameterInfos();
 }
 } // namespace model

@@ -1,6 +1,6 @@
 /**
  * @file Template.h
- * @brief The template engine: reads a BlockForge template (format version 1, YAML
+ * @brief The template engine: reads a BlockForge template (format version 1 or 2, YAML
  * syntax, the paper's "macro file"), evaluates its parameter expressions and builds the
  * BlockModel. The format is documented in Templates/README.md.
  */
@@ -8,6 +8,7 @@
 
 #include "BlockModel.h"
 
+#include <limits>
 #include <stdexcept>
 
 namespace blockforge
@@ -35,13 +36,45 @@ private:
 /// Parameter overrides: name -> expression (may use other parameters).
 using ParameterOverrides = std::map<std::string, std::string>;
 
+/// One curve of input points (a hub contour, one blade section).
+struct InputCurve
+{
+  std::string name;
+  std::vector<Vec3> points;
+  double span = std::numeric_limits<double>::quiet_NaN(); ///< sections: span fraction
+};
+
+/// A named point set of the filter input: one curve ("Hub") or a list ("Profiles").
+struct InputPointSet
+{
+  std::string name;
+  bool isList = false;
+  std::vector<InputCurve> curves;
+};
+
+/**
+ * The point data a template of format 2 is applied to (the paper's user input data):
+ * what vtkBlockTemplate takes from the TurboPointSetsReader output, or what a test builds.
+ */
+struct TemplateInputs
+{
+  std::vector<InputPointSet> pointSets;
+  bool hasMachine = false;   ///< the axis below is the machine's
+  Vec3 axis = Vec3::UnitZ(); ///< machine axis (unit vector) through axisPoint
+  Vec3 axisPoint = Vec3::Zero();
+  int bladeCount = 0;        ///< 0: unknown
+  std::string origin = "the filter input"; ///< for messages
+};
+
 /// Reads and applies a template file. Throws TemplateError (missing file, YAML syntax
-/// error, bad expression, unknown name, wrong count of vertices, ...).
-BlockModel loadTemplate(const std::string& path, const ParameterOverrides& overrides = {});
+/// error, bad expression, unknown name, wrong count of vertices, ...). Templates with an
+/// `inputs:` section need `inputs`.
+BlockModel loadTemplate(const std::string& path, const ParameterOverrides& overrides = {},
+  const TemplateInputs* inputs = nullptr);
 
 /// Same, from text; `fileName` is used in messages only.
 BlockModel parseTemplate(const std::string& text, const std::string& fileName,
-  const ParameterOverrides& overrides = {});
+  const ParameterOverrides& overrides = {}, const TemplateInputs* inputs = nullptr);
 
 /// A template parameter as declared (for GUIs and --help style listings).
 struct ParameterInfo
@@ -52,6 +85,6 @@ struct ParameterInfo
   std::string comment;    ///< trailing comment (units), may be empty
 };
 std::vector<ParameterInfo> templateParameters(const std::string& path,
-  const ParameterOverrides& overrides = {});
+  const ParameterOverrides& overrides = {}, const TemplateInputs* inputs = nullptr);
 } // namespace model
 } // namespace blockforge

@@ -13,6 +13,8 @@ from vtkmodules import vtkCommonCore, vtkCommonDataModel, vtkCommonExecutionMode
 
 from .BlockForgeFilters import (  # noqa: F401
     vtkBlockMesher,
+    vtkBlockTemplate,
+    vtkBlockTemplateAlgorithm,
     vtkBlockTemplateSource,
     vtkGridQuality,
     vtkTurboPointSetsReader,
@@ -20,6 +22,8 @@ from .BlockForgeFilters import (  # noqa: F401
 
 __all__ = [
     "vtkBlockMesher",
+    "vtkBlockTemplate",
+    "vtkBlockTemplateAlgorithm",
     "vtkBlockTemplateSource",
     "vtkGridQuality",
     "vtkTurboPointSetsReader",

@@ -586,8 +586,8 @@ TEST(TemplateErrors, VersionAndTopLevel)
 {
   expectError([] { parseTemplate("name: x\nvertices: {}\n", "noversion.yaml"); },
     { "noversion.yaml:1: ", "missing 'blockforge: 1'" });
-  expectTwoBoxesError(replaced(TwoBoxes, "blockforge: 1", "blockforge: 2"), "blockforge: 2", "",
-    { "format 2", "update BlockForge" });
+  expectTwoBoxesError(replaced(TwoBoxes, "blockforge: 1", "blockforge: 3"), "blockforge: 3", "",
+    { "format 3", "update BlockForge" });
   expectTwoBoxesError(replaced(TwoBoxes, "patches:", "patchs:"), "patchs:", "",
     { "unknown key 'patchs'", "did you mean 'patches'" });
   expectError([] { parseTemplate("", "empty.yaml"); }, { "empty.yaml:1: ", "empty" });
@@ -688,7 +688,7 @@ TEST(ModelDocument, ErrorsAfterReloadNameTheTemplateLine)
 TEST(ModelDocument, RejectsNewerAndMalformedDocuments)
 {
   const std::string document = writeModelDocument(parseTemplate(TwoBoxes, TwoBoxesFile));
-  expectError([&] { readModelDocument(replaced(document, "blockforge_model: 1", "blockforge_model: 2")); },
+  expectError([&] { readModelDocument(replaced(document, "blockforge_model: 1", "blockforge_model: 3")); },
     { "<model document>", "newer", "update BlockForge" });
   expectError([&] { readModelDocument("just: text\n"); }, { "<model document>", "not a BlockForge model" });
   expectError([&] { readModelDocument("blockforge_model: 1\nvertices: [{name: a, position: [0, 0]}]\n"); },

@@ -1,0 +1,617 @@
+#include "CarrierGeometry.h"
+
+#include "ModelSyntax.h"
+#include "Template.h"
+
+#include "../Core/BSpline.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace blockforge
+{
+namespace model
+{
+namespace
+{
+constexpr double Pi = 3.14159265358979323846;
+constexpr int MaxDepth = 64;
+
+double clampUnit(double x)
+{
+  return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
+}
+} // namespace
+
+double wrapUnit(double x)
+{
+  if (x >= 0.0 && x <= 1.0)
+  {
+    return x;
+  }
+  return x - std::floor(x);
+}
+
+// ------------------------------------------------------------------------ SubCurve
+SubCurve::SubCurve(CurvePtr curve, double u0, double u1, bool closed)
+  : Base(std::move(curve))
+  , U0(u0)
+  , U1(u1)
+  , Closed(closed)
+{
+}
+
+double SubCurve::map(double t) const
+{
+  const double u = t <= 0.0 ? U0 : (t >= 1.0 ? U1 : U0 + t * (U1 - U0));
+  return Closed ? wrapUnit(u) : clampUnit(u);
+}
+
+Vec3 SubCurve::point(double t) const
+{
+  return Base->point(map(t));
+}
+
+Vec3 SubCurve::derivative(double t, int order) const
+{
+  const double scale = U1 - U0;
+  return Base->derivative(map(t), order) * (order == 1 ? scale : scale * scale);
+}
+
+// ------------------------------------------------------------- ParameterLineCurve
+ParameterLineCurve::ParameterLineCurve(SurfacePtr surface, const Eigen::Vector2d& from,
+  const Eigen::Vector2d& to, bool closedS, bool closedT, bool extendT)
+  : TheSurface(std::move(surface))
+  , From(from)
+  , To(to)
+  , ClosedS(closedS)
+  , ClosedT(closedT)
+  , ExtendT(extendT)
+{
+}
+
+Eigen::Vector2d ParameterLineCurve::parameters(double u) const
+{
+  Eigen::Vector2d st = u <= 0.0 ? From : (u >= 1.0 ? To : Eigen::Vector2d(From + u * (To - From)));
+  st[0] = ClosedS ? wrapUnit(st[0]) : clampUnit(st[0]);
+  st[1] = ClosedT ? wrapUnit(st[1]) : ExtendT ? std::max(-1.0, std::min(2.0, st[1])) : clampUnit(st[1]);
+  return st;
+}
+
+Vec3 ParameterLineCurve::point(double u) const
+{
+  const Eigen::Vector2d st = parameters(u);
+  return TheSurface->point(st[0], st[1]);
+}
+
+Vec3 ParameterLineCurve::derivative(double u, int order) const
+{
+  const Eigen::Vector2d st = parameters(u);
+  SurfaceDerivatives d;
+  TheSurface->derivatives(st[0], st[1], d);
+  const Eigen::Vector2d delta = To - From;
+  if (order == 1)
+  {
+    return d.Ps * delta[0] + d.Pt * delta[1];
+  }
+  return d.Pss * delta[0] * delta[0] + 2.0 * d.Pst * delta[0] * delta[1] +
+    d.Ptt * delta[1] * delta[1];
+}
+
+// ----------------------------------------------------------------- ArcLengthTable
+namespace
+{
+const double GaussX[5] = { -0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
+  0.9061798459386640 };
+const double GaussW[5] = { 0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
+  0.4786286704993665, 0.2369268850561891 };
+}
+
+ArcLengthTable::ArcLengthTable(CurvePtr curve, int pieces)
+  : TheCurve(std::move(curve))
+{
+  Cumulative.assign(pieces + 1, 0.0);
+  for (int k = 0; k < pieces; ++k)
+  {
+    Cumulative[k + 1] =
+      Cumulative[k] + piece(static_cast<double>(k) / pieces, static_cast<double>(k + 1) / pieces);
+  }
+}
+
+double ArcLengthTable::piece(double a, double b) const
+{
+  const double half = 0.5 * (b - a), centre = 0.5 * (a + b);
+  double sum = 0.0;
+  for (int k = 0; k < 5; ++k)
+  {
+    sum += GaussW[k] * TheCurve->derivative(centre + half * GaussX[k], 1).norm();
+  }
+  return sum * half;
+}
+
+double ArcLengthTable::parameterAtFraction(double fraction) const
+{
+  const double total = totalLength();
+  if (!(fraction > 0.0) || !(total > 0.0))
+  {
+    return fraction >= 1.0 ? 1.0 : 0.0;
+  }
+  if (fraction >= 1.0)
+  {
+    return 1.0;
+  }
+  const int pieces = static_cast<int>(Cumulative.size()) - 1;
+  const double target = fraction * total;
+  int k = static_cast<int>(
+    std::upper_bound(Cumulative.begin(), Cumulative.end(), target) - Cumulative.begin()) - 1;
+  k = std::max(0, std::min(k, pieces - 1));
+  const double a = static_cast<double>(k) / pieces, b = static_cast<double>(k + 1) / pieces;
+  const double span = Cumulative[k + 1] - Cumulative[k];
+  double low = a, high = b;
+  double t = span > 0.0 ? a + (target - Cumulative[k]) / span * (b - a) : a;
+  for (int iteration = 0; iteration < 60; ++iteration)
+  {
+    const double error = Cumulative[k] + piece(a, t) - target;
+    if (error > 0.0)
+    {
+      high = t;
+    }
+    else
+    {
+      low = t;
+    }
+    if (std::abs(error) <= 1e-15 * total)
+    {
+      break;
+    }
+    const double speed = TheCurve->derivative(t, 1).norm();
+    double next = speed > 0.0 ? t - error / speed : 0.5 * (low + high);
+    if (!(next > low && next < high))
+    {
+      next = 0.5 * (low + high);
+    }
+    if (next == t)
+    {
+      break;
+    }
+    t = next;
+  }
+  return t;
+}
+
+// ---------------------------------------------------------------- CarrierGeometry
+CarrierGeometry::CarrierGeometry(const BlockModel& model)
+{
+  for (int i = 0; i < static_cast<int>(model.carriers.size()); ++i)
+  {
+    build(model, i);
+  }
+}
+
+void CarrierGeometry::build(const BlockModel& model, int index)
+{
+  if (Entries.size() < model.carriers.size())
+  {
+    Entries.resize(model.carriers.size());
+  }
+  buildEntry(model, index, 0);
+}
+
+void CarrierGeometry::buildEntry(const BlockModel& model, int index, int depth)
+{
+  const Carrier& carrier = model.carriers.at(index);
+  const std::string entityText = syntax::entity("carrier", carrier.name);
+  auto fail = [&](const std::string& what) {
+    throw TemplateError(carrier.where.file, carrier.where.line, entityText, what);
+  };
+  Entry& entry = Entries[index];
+  if (entry.built)
+  {
+    return;
+  }
+  if (depth > MaxDepth)
+  {
+    fail("the carriers refer to each other in a cycle");
+  }
+  const int count = static_cast<int>(model.carriers.size());
+  auto checkRef = [&](int ref, bool surface, const char* role) {
+    if (ref < 0 || ref >= count || ref == index)
+    {
+      fail(std::string("refers to a ") + role + " carrier that does not exist");
+    }
+    buildEntry(model, ref, depth + 1);
+    if (Entries[ref].surface != nullptr) // a surface
+    {
+      if (!surface)
+      {
+        fail(std::string("'") + model.carriers[ref].name + "' is a surface, but a " + role +
+          " curve is needed here");
+      }
+    }
+    else if (surface)
+    {
+      fail(std::string("'") + model.carriers[ref].name + "' is a curve, but a " + role +
+        " surface is needed here");
+    }
+  };
+  auto refCount = [&](std::size_t low, std::size_t high) {
+    if (carrier.refs.size() < low || carrier.refs.size() > high)
+    {
+      fail("refers to " + std::to_string(carrier.refs.size()) + " carriers, expected " +
+        (low == high ? std::to_string(low) : std::to_string(low) + " or more"));
+    }
+  };
+  for (const Vec3& point : carrier.points)
+  {
+    if (!point.allFinite())
+    {
+      fail("a point is not finite");
+    }
+  }
+
+  Entry built;
+  try
+  {
+    switch (carrier.kind)
+    {
+      case Carrier::Kind::Interpolate:
+      {
+        if (carrier.degree < 1 || carrier.degree > bspline::MaxDegree)
+        {
+          fail("the degree must be from 1 to " + std::to_string(bspline::MaxDegree));
+        }
+        const ParameterMethod method = carrier.parameterMethod == 0
+          ? ParameterMethod::Uniform
+          : carrier.parameterMethod == 2 ? ParameterMethod::Centripetal
+                                         : ParameterMethod::ChordLength;
+        built.curve = std::make_shared<BSplineCurve>(
+          BSplineCurve::interpolate(carrier.points, carrier.degree, method));
+        built.closedS = carrier.points.size() > 2 && carrier.points.front() == carrier.points.back();
+        break;
+      }
+      case Carrier::Kind::Revolve:
+      {
+        refCount(1, 1);
+        checkRef(carrier.refs[0], false, "contour");
+        if (!carrier.axis.allFinite() || !(carrier.axis.norm() > 0.0) ||
+          !carrier.axisPoint.allFinite() || !std::isfinite(carrier.angleStart) ||
+          !std::isfinite(carrier.angleEnd) || !(carrier.angleEnd > carrier.angleStart))
+        {
+          fail("needs a non-zero axis and an angle range [a0, a1] with a0 < a1");
+        }
+        auto revolution = std::make_shared<SurfaceOfRevolution>(Entries[carrier.refs[0]].curve,
+          carrier.axisPoint, carrier.axis.normalized(), carrier.angleStart, carrier.angleEnd);
+        built.revolution = revolution;
+        built.surface = revolution;
+        built.closedT = carrier.angleEnd - carrier.angleStart >= 2.0 * Pi * (1.0 - 1e-12);
+        break;
+      }
+      case Carrier::Kind::Gordon:
+      case Carrier::Kind::Network:
+      {
+        refCount(2, 100000);
+        std::vector<CurvePtr> sections, cross;
+        for (int ref : carrier.refs)
+        {
+          checkRef(ref, false, "section");
+          sections.push_back(Entries[ref].curve);
+        }
+        for (int ref : carrier.crossRefs)
+        {
+          checkRef(ref, false, "cross-section");
+          cross.push_back(Entries[ref].curve);
+        }
+        if (carrier.nodes.size() != sections.size())
+        {
+          fail("needs one parameter per section");
+        }
+        const GordonSurface::Blending blending = carrier.blending == Carrier::Blending::Lagrange
+          ? GordonSurface::Blending::Lagrange
+          : GordonSurface::Blending::Spline;
+        std::shared_ptr<const GordonSurface> gordon;
+        if (carrier.kind == Carrier::Kind::Gordon)
+        {
+          gordon = std::make_shared<GordonSurface>(
+            GordonSurface::fromSections(sections, carrier.nodes, blending));
+        }
+        else
+        {
+          if (cross.size() < 2 || carrier.crossNodes.size() != cross.size())
+          {
+            fail("a network needs at least 2 curves in each direction, each with its "
+                 "parameter");
+          }
+          gordon = std::make_shared<GordonSurface>(GordonSurface::fromNetwork(
+            sections, carrier.nodes, cross, carrier.crossNodes, blending));
+        }
+        built.gordon = gordon;
+        built.surface = gordon;
+        built.closedS = carrier.closed;
+        built.extendT = true;
+        break;
+      }
+      case Carrier::Kind::Coons:
+      {
+        refCount(4, 4);
+        std::array<CurvePtr, 4> sides;
+        for (int k = 0; k < 4; ++k)
+        {
+          checkRef(carrier.refs[k], false, "boundary");
+          sides[k] = Entries[carrier.refs[k]].curve;
+        }
+        built.surface = std::make_shared<CoonsPatch>(sides[0], sides[1], sides[2], sides[3]);
+        break;
+      }
+      case Carrier::Kind::SurfaceCurve:
+      {
+        refCount(1, 1);
+        checkRef(carrier.refs[0], true, "base");
+        if (carrier.parameterPoints.size() < 2)
+        {
+          fail("a curve on a surface needs at least 2 points");
+        }
+        const Entry& base = Entries[carrier.refs[0]];
+        std::vector<Eigen::Vector2d> points = carrier.parameterPoints;
+        if (!base.closedS && !base.closedT)
+        {
+          built.curve = std::make_shared<SurfaceCurve>(base.surface, points);
+        }
+        else if (points.size() == 2)
+        {
+          built.curve = std::make_shared<ParameterLineCurve>(
+            base.surface, points[0], points[1], base.closedS, base.closedT, base.extendT);
+        }
+        else
+        {
+          for (const Eigen::Vector2d& st : points)
+          {
+            if (st[0] < 0.0 || st[0] > 1.0 || st[1] < 0.0 || st[1] > 1.0)
+            {
+              fail("a curve through more than 2 points of a closed surface must stay "
+                   "inside [0, 1] x [0, 1]");
+            }
+          }
+          built.curve = std::make_shared<SurfaceCurve>(base.surface, points);
+        }
+        break;
+      }
+      case Carrier::Kind::Intersect:
+      {
+        refCount(2, 2);
+        checkRef(carrier.refs[0], true, "cut");
+        checkRef(carrier.refs[1], true, "cutting");
+        const Entry& cut = Entries[carrier.refs[0]];
+        const Entry& by = Entries[carrier.refs[1]];
+        if (!cut.gordon)
+        {
+          fail("the first surface of an intersection must be a Gordon surface (a blade)");
+        }
+        if (!by.revolution)
+        {
+          fail("the second surface of an intersection must be a surface of revolution "
+               "(hub or shroud)");
+        }
+        built.curve = intersectWithRevolution(
+          cut.gordon, *by.revolution, carrier.rangeMin, carrier.rangeMax, carrier.samples);
+        break;
+      }
+    }
+  }
+  catch (const GeometryError& error)
+  {
+    fail(error.what());
+  }
+
+  // Size of a sample, for tolerances; curves also learn here whether they are closed.
+  Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 high = -low;
+  if (built.surface)
+  {
+    for (int j = 0; j <= 16; ++j)
+    {
+      for (int i = 0; i <= 16; ++i)
+      {
+        const Vec3 p = built.surface->point(i / 16.0, j / 16.0);
+        low = low.cwiseMin(p);
+        high = high.cwiseMax(p);
+      }
+    }
+  }
+  else
+  {
+    for (int i = 0; i <= 64; ++i)
+    {
+      const Vec3 p = built.curve->point(i / 64.0);
+      low = low.cwiseMin(p);
+      high = high.cwiseMax(p);
+    }
+  }
+  const double size = (high - low).norm();
+  if (!std::isfinite(size))
+  {
+    fail("the carrier has points that are not finite");
+  }
+  built.size = size > 0.0 ? size : 1.0;
+  if (built.curve && !built.closedS)
+  {
+    built.closedS = (built.curve->point(0.0) - built.curve->point(1.0)).norm() <= 1e-12 * built.size;
+  }
+  built.built = true;
+  entry = std::move(built);
+}
+
+Vec3 CarrierGeometry::point(int index, double s, double t) const
+{
+  const Entry& entry = Entries.at(index);
+  const double ws = entry.closedS ? wrapUnit(s) : clampUnit(s);
+  if (entry.surface)
+  {
+    const double wt = entry.closedT ? wrapUnit(t)
+      : entry.extendT             ? std::max(-1.0, std::min(2.0, t))
+                                  : clampUnit(t);
+    return entry.surface->point(ws, wt);
+  }
+  return entry.curve->point(ws);
+}
+
+void CarrierGeometry::project(
+  int index, const Vec3& p, double& s, double& t, double& distance) const
+{
+  const Entry& entry = Entries.at(index);
+  if (entry.revolution)
+  {
+    // Exact: the closest point lies in p's meridional plane.
+    const SurfaceOfRevolution& surface = *entry.revolution;
+    s = surface.contourParameter(p);
+    const Vec3 axis = surface.axisDirection();
+    const Vec3 c = surface.contour()->point(s) - surface.axisPoint();
+    const Vec3 q = p - surface.axisPoint();
+    const Vec3 cp = c - c.dot(axis) * axis, qp = q - q.dot(axis) * axis;
+    double angle = std::atan2(cp.cross(qp).dot(axis), cp.dot(qp));
+    const double a0 = surface.angleStart(), a1 = surface.angleEnd();
+    while (angle < a0 && angle + 2.0 * Pi <= a1 + 1e-12)
+    {
+      angle += 2.0 * Pi;
+    }
+    while (angle > a1 && angle - 2.0 * Pi >= a0 - 1e-12)
+    {
+      angle -= 2.0 * Pi;
+    }
+    t = clampUnit((angle - a0) / (a1 - a0));
+    distance = (surface.point(s, t) - p).norm();
+    return;
+  }
+  if (entry.surface)
+  {
+    if (!entry.surfaceProjector)
+    {
+      entry.surfaceProjector = std::make_shared<SurfaceProjector>(entry.surface, 64, 64);
+    }
+    const SurfaceProjection found = entry.surfaceProjector->project(p);
+    s = found.s;
+    t = found.t;
+    distance = found.distance;
+    if (entry.extendT && (t <= 1e-9 || t >= 1.0 - 1e-9))
+    {
+      refineExtended(entry, p, s, t, distance);
+    }
+    return;
+  }
+  if (!entry.curveProjector)
+  {
+    entry.curveProjector = std::make_shared<CurveProjector>(entry.curve, 256);
+  }
+  const CurveProjection found = entry.curveProjector->project(p);
+  s = found.t;
+  t = 0.0;
+  distance = found.distance;
+}
+
+void CarrierGeometry::refineExtended(
+  const Entry& entry, const Vec3& p, double& s, double& t, double& distance) const
+{
+  // Newton on |S(s, t) - p|^2 with t free in [-1, 2]: the projector stops at t = 0 or 1,
+  // the continued surface goes on.
+  auto evaluate = [&](double ss, double tt) {
+    return entry.surface->point(entry.closedS ? wrapUnit(ss) : clampUnit(ss), tt);
+  };
+  double best = (evaluate(s, t) - p).squaredNorm();
+  for (int iteration = 0; iteration < 100; ++iteration)
+  {
+    SurfaceDerivatives d;
+    entry.surface->derivatives(entry.closedS ? wrapUnit(s) : clampUnit(s), t, d);
+    const Vec3 r = d.P - p;
+    const Eigen::Vector2d g(d.Ps.dot(r), d.Pt.dot(r));
+    Eigen::Matrix2d h;
+    h << d.Ps.dot(d.Ps) + d.Pss.dot(r), d.Ps.dot(d.Pt) + d.Pst.dot(r),
+      d.Ps.dot(d.Pt) + d.Pst.dot(r), d.Pt.dot(d.Pt) + d.Ptt.dot(r);
+    Eigen::Vector2d step;
+    if (std::abs(h.determinant()) > 1e-300 && h(0, 0) > 0.0 && h.determinant() > 0.0)
+    {
+      step = -h.inverse() * g;
+    }
+    else
+    {
+      const Eigen::Vector2d diagonal(d.Ps.squaredNorm(), d.Pt.squaredNorm());
+      step = Eigen::Vector2d(-g[0] / std::max(diagonal[0], 1e-300), -g[1] / std::max(diagonal[1], 1e-300));
+    }
+    bool improved = false;
+    for (double damping = 1.0; damping > 1e-6; damping *= 0.5)
+    {
+      double ns = s + damping * step[0];
+      double nt = std::max(-1.0, std::min(2.0, t + damping * step[1]));
+      if (!entry.closedS)
+      {
+        ns = clampUnit(ns);
+      }
+      const double value = (evaluate(ns, nt) - p).squaredNorm();
+      if (value < best)
+      {
+        const bool converged = std::abs(ns - s) < 1e-15 && std::abs(nt - t) < 1e-15;
+        s = ns;
+        t = nt;
+        best = value;
+        improved = !converged;
+        break;
+      }
+    }
+    if (!improved)
+    {
+      break;
+    }
+  }
+  if (entry.closedS)
+  {
+    s = wrapUnit(s);
+  }
+  distance = std::sqrt(best);
+}
+
+void CarrierGeometry::vertexParameters(const BlockModel& model, int vertex, int carrier,
+  double& s, double& t, double& distance) const
+{
+  const Vertex& v = model.vertices.at(vertex);
+  const int own = v.constraint.carrier;
+  if (own == carrier)
+  {
+    s = v.constraint.s;
+    t = v.constraint.t;
+    distance = (point(carrier, s, t) - v.position).norm();
+    return;
+  }
+  if (own >= 0 && own < static_cast<int>(Entries.size()) && isSurface(carrier) &&
+    !isSurface(own))
+  {
+    const Carrier& curve = model.carriers[own];
+    if ((curve.kind == Carrier::Kind::SurfaceCurve || curve.kind == Carrier::Kind::Intersect) &&
+      !curve.refs.empty() && curve.refs[0] == carrier)
+    {
+      const double u = closedS(own) ? wrapUnit(v.constraint.s) : clampUnit(v.constraint.s);
+      Eigen::Vector2d st(0.0, 0.0);
+      bool found = false;
+      if (const auto* onSurface = dynamic_cast<const SurfaceCurve*>(Entries[own].curve.get()))
+      {
+        st = onSurface->parameters(u);
+        found = true;
+      }
+      else if (const auto* line = dynamic_cast<const ParameterLineCurve*>(Entries[own].curve.get()))
+      {
+        st = line->parameters(u);
+        found = true;
+      }
+      if (found)
+      {
+        s = st[0];
+        t = st[1];
+        distance = (point(carrier, s, t) - v.position).norm();
+        return;
+      }
+    }
+  }
+  project(carrier, v.position, s, t, distance);
+}
+} // namespace model
+} // namespace blockforge

@@ -1,0 +1,147 @@
+/**
+ * @file CarrierGeometry.h
+ * @brief The curves and surfaces of a model's carriers (format 2), built from their
+ * definitions in the model. The template engine, the model check and the mesher all build
+ * them here, from the same numbers, so they get the same geometry bit for bit.
+ *
+ * Also the small curve types edges need: a piece of a curve between two parameters and a
+ * straight line in the (s, t) space of a surface. Parameters outside [0, 1] wrap around
+ * carriers that are closed in that direction (a blade surface around its sections, a full
+ * surface of revolution around the axis).
+ */
+#pragma once
+
+#include "BlockModel.h"
+
+#include "../Core/Carriers.h"
+#include "../Core/Projection.h"
+
+#include <memory>
+
+namespace blockforge
+{
+namespace model
+{
+/// x for x in [0, 1], else x - floor(x): the parameter on a closed carrier.
+double wrapUnit(double x);
+
+/// The piece u0 -> u1 of a curve, reparametrised on [0, 1] (u0 > u1 runs backwards).
+/// With `closed`, parameters outside [0, 1] wrap.
+class SubCurve : public Curve
+{
+public:
+  SubCurve(CurvePtr curve, double u0, double u1, bool closed);
+  Vec3 point(double t) const override;
+  Vec3 derivative(double t, int order = 1) const override;
+
+private:
+  CurvePtr Base;
+  double U0, U1;
+  bool Closed;
+  double map(double t) const;
+};
+
+/// The straight line from (s0, t0) to (s1, t1) in the parameter space of a surface,
+/// mapped onto it; every point lies on the surface.
+class ParameterLineCurve : public Curve
+{
+public:
+  ParameterLineCurve(SurfacePtr surface, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
+    bool closedS, bool closedT, bool extendT = false);
+  Vec3 point(double u) const override;
+  Vec3 derivative(double u, int order = 1) const override;
+  Eigen::Vector2d parameters(double u) const;
+
+private:
+  SurfacePtr TheSurface;
+  Eigen::Vector2d From, To;
+  bool ClosedS, ClosedT, ExtendT;
+};
+
+/**
+ * @class ArcLengthTable
+ * @brief Arc length of a carrier curve by a fixed composite 5-point Gauss-Legendre rule
+ * (512 pieces) and its inverse by Newton inside the piece: bounded cost whatever the
+ * curve's smoothness (curves on blade surfaces are only C1 at the section knots), accurate
+ * to about 1e-12 of the length for placing nodes, deterministic.
+ */
+class ArcLengthTable
+{
+public:
+  explicit ArcLengthTable(CurvePtr curve, int pieces = 512);
+  double totalLength() const { return Cumulative.back(); }
+  /// Parameter t at which the length from 0 is `fraction` of the total; 0 and 1 exactly
+  /// at the ends.
+  double parameterAtFraction(double fraction) const;
+
+private:
+  double piece(double a, double b) const;
+  CurvePtr TheCurve;
+  std::vector<double> Cumulative;
+};
+
+/**
+ * @class CarrierGeometry
+ * @brief Built carriers of one model, by carrier index.
+ */
+class CarrierGeometry
+{
+public:
+  CarrierGeometry() = default;
+  /// Builds every carrier; throws TemplateError naming the carrier on a geometry error.
+  explicit CarrierGeometry(const BlockModel& model);
+  /// Builds carrier `index` and, first, the carriers it refers to (template engine).
+  void build(const BlockModel& model, int index);
+
+  bool isSurface(int index) const { return Entries.at(index).surface != nullptr; }
+  const CurvePtr& curve(int index) const { return Entries.at(index).curve; }
+  const SurfacePtr& surface(int index) const { return Entries.at(index).surface; }
+  /// The surface of revolution, or nullptr for other carriers.
+  const SurfaceOfRevolution* revolution(int index) const
+  {
+    return Entries.at(index).revolution.get();
+  }
+  /// Closed in s (curves: closed loop; Gordon: closed sections) / in t (full revolution).
+  bool closedS(int index) const { return Entries.at(index).closedS; }
+  bool closedT(int index) const { return Entries.at(index).closedT; }
+  /// Gordon surfaces continue past their first and last sections: t may lie in
+  /// [-1, 2] (a blade extended to the hub and shroud it stops short of).
+  bool extendsT(int index) const { return Entries.at(index).extendT; }
+  /// The range of t: [0, 1], or [-1, 2] for extending surfaces.
+  double tMin(int index) const { return extendsT(index) ? -1.0 : 0.0; }
+  double tMax(int index) const { return extendsT(index) ? 2.0 : 1.0; }
+
+  /// Curve point at u or surface point at (s, t); wraps on closed carriers.
+  Vec3 point(int index, double s, double t = 0.0) const;
+  /// Parameters of the closest point of carrier `index` to p (t = 0 for curves).
+  void project(int index, const Vec3& p, double& s, double& t, double& distance) const;
+  /**
+   * Parameters of vertex `vertex` on carrier `carrier`: its own (s, t) when it is attached
+   * to that carrier; the surface parameters of its curve point when it is attached to a
+   * curve lying on that surface (a surface curve, an intersection); else the parameters of
+   * its closest point. `distance` is how far the vertex is from carrier(s, t).
+   */
+  void vertexParameters(const BlockModel& model, int vertex, int carrier, double& s, double& t,
+    double& distance) const;
+  /// Diagonal of the bounding box of a sample of the carrier.
+  double size(int index) const { return Entries.at(index).size; }
+
+private:
+  struct Entry
+  {
+    bool built = false;
+    CurvePtr curve;
+    SurfacePtr surface;
+    std::shared_ptr<const SurfaceOfRevolution> revolution;
+    std::shared_ptr<const GordonSurface> gordon;
+    bool closedS = false, closedT = false, extendT = false;
+    double size = 1.0;
+    mutable std::shared_ptr<CurveProjector> curveProjector;
+    mutable std::shared_ptr<SurfaceProjector> surfaceProjector;
+  };
+  void buildEntry(const BlockModel& model, int index, int depth);
+  void refineExtended(const Entry& entry, const Vec3& p, double& s, double& t, double& distance) const;
+  std::vector<Entry> Entries;
+};
+} // namespace model
+} // namespace blockforge

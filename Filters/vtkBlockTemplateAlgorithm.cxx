@@ -1,0 +1,209 @@
+#include "vtkBlockTemplateAlgorithm.h"
+
+#include "BlockForgeModelIO.h"
+
+#include "../Model/CarrierGeometry.h"
+#include "../Model/ModelDocument.h"
+#include "../Model/Template.h"
+
+#include <vtkCellArray.h>
+#include <vtkCompositeDataSet.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkStructuredGrid.h>
+
+#include <iterator>
+
+vtkBlockTemplateAlgorithm::vtkBlockTemplateAlgorithm() = default;
+
+vtkBlockTemplateAlgorithm::~vtkBlockTemplateAlgorithm()
+{
+  this->SetTemplateFile(nullptr);
+}
+
+void vtkBlockTemplateAlgorithm::SetParameter(const char* name, const char* expression)
+{
+  if (!name || !*name)
+  {
+    return;
+  }
+  const std::string value = expression ? expression : "";
+  auto found = this->Parameters.find(name);
+  if (found != this->Parameters.end() && found->second == value)
+  {
+    return;
+  }
+  this->Parameters[name] = value;
+  this->Modified();
+}
+
+void vtkBlockTemplateAlgorithm::ClearParameters()
+{
+  if (!this->Parameters.empty())
+  {
+    this->Parameters.clear();
+    this->Modified();
+  }
+}
+
+int vtkBlockTemplateAlgorithm::GetNumberOfParameters() const
+{
+  return static_cast<int>(this->Parameters.size());
+}
+
+const char* vtkBlockTemplateAlgorithm::GetParameterName(int index) const
+{
+  if (index < 0 || index >= this->GetNumberOfParameters())
+  {
+    return nullptr;
+  }
+  return std::next(this->Parameters.begin(), index)->first.c_str();
+}
+
+const char* vtkBlockTemplateAlgorithm::GetParameterExpression(int index) const
+{
+  if (index < 0 || index >= this->GetNumberOfParameters())
+  {
+    return nullptr;
+  }
+  return std::next(this->Parameters.begin(), index)->second.c_str();
+}
+
+namespace
+{
+/// One block per carrier declared in the template (not the sections and contours made
+/// along the way): curves as polylines of 257 points, surfaces as 65 x 65 grids.
+void fillCarriers(const blockforge::model::BlockModel& model, vtkMultiBlockDataSet* output)
+{
+  const blockforge::model::CarrierGeometry geometry(model);
+  unsigned int block = 0;
+  for (std::size_t c = 0; c < model.carriers.size(); ++c)
+  {
+    const std::string& name = model.carriers[c].name;
+    if (name.find('.') != std::string::npos)
+    {
+      continue;
+    }
+    const int index = static_cast<int>(c);
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    vtkSmartPointer<vtkDataObject> data;
+    if (geometry.isSurface(index))
+    {
+      const int n = 65;
+      const double t0 = 0.0;
+      for (int j = 0; j < n; ++j)
+      {
+        for (int i = 0; i < n; ++i)
+        {
+          const blockforge::Vec3 p = geometry.point(
+            index, static_cast<double>(i) / (n - 1), t0 + static_cast<double>(j) / (n - 1));
+          points->InsertNextPoint(p.data());
+        }
+      }
+      vtkNew<vtkStructuredGrid> grid;
+      grid->SetDimensions(n, n, 1);
+      grid->SetPoints(points);
+      data = grid;
+    }
+    else
+    {
+      const int n = 257;
+      vtkNew<vtkCellArray> lines;
+      lines->InsertNextCell(n);
+      for (int i = 0; i < n; ++i)
+      {
+        const blockforge::Vec3 p = geometry.point(index, static_cast<double>(i) / (n - 1));
+        points->InsertNextPoint(p.data());
+        lines->InsertCellPoint(i);
+      }
+      vtkNew<vtkPolyData> curve;
+      curve->SetPoints(points);
+      curve->SetLines(lines);
+      data = curve;
+    }
+    output->SetBlock(block, data);
+    output->GetMetaData(block)->Set(vtkCompositeDataSet::NAME(), name.c_str());
+    ++block;
+  }
+}
+} // namespace
+
+int vtkBlockTemplateAlgorithm::ApplyTemplate(
+  vtkDataObject* input, vtkInformationVector* outputVector)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  auto* output = vtkMultiBlockDataSet::GetData(outInfo);
+  vtkMultiBlockDataSet* carriers = this->GetNumberOfOutputPorts() > 1
+    ? vtkMultiBlockDataSet::GetData(outputVector, 1)
+    : nullptr;
+  if (carriers)
+  {
+    carriers->Initialize();
+  }
+  this->ModelDocument.clear();
+  if (!this->TemplateFile || !*this->TemplateFile)
+  {
+    vtkErrorMacro("No TemplateFile set: choose a BlockForge template (.yaml).");
+    output->Initialize();
+    return 0;
+  }
+  const int piece = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+    : 0;
+  const int pieceCount = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
+    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
+    : 1;
+  try
+  {
+    this->UpdateProgress(0.0);
+    blockforge::model::TemplateInputs inputs;
+    const bool hasInput = input != nullptr;
+    if (hasInput)
+    {
+      blockforge::vtkglue::readTemplateInputs(input, inputs);
+    }
+    this->UpdateProgress(0.05);
+    const blockforge::model::BlockModel blockModel = blockforge::model::loadTemplate(
+      this->TemplateFile, this->Parameters, hasInput ? &inputs : nullptr);
+    this->UpdateProgress(0.4);
+    const std::string document = blockforge::model::writeModelDocument(blockModel);
+    blockforge::vtkglue::meshModel(blockModel, document, 1.0, this->PreviewCells, piece,
+      pieceCount, output, [this](double fraction) { this->UpdateProgress(0.4 + 0.55 * fraction); });
+    if (carriers && piece == 0)
+    {
+      fillCarriers(blockModel, carriers);
+    }
+    this->ModelDocument = document;
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< error.what());
+    output->Initialize();
+    if (carriers)
+    {
+      carriers->Initialize();
+    }
+    return 0;
+  }
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+void vtkBlockTemplateAlgorithm::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "TemplateFile: " << (this->TemplateFile ? this->TemplateFile : "(none)")
+     << "\n";
+  os << indent << "PreviewCells: " << this->PreviewCells << "\n";
+  for (const auto& parameter : this->Parameters)
+  {
+    os << indent << "Parameter " << parameter.first << " = " << parameter.second << "\n";
+  }
+}

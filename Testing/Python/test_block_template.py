@@ -1,0 +1,227 @@
+"""pvpython tests of the BlockTemplate proxy (templates of format 2 applied to point sets)
+through paraview.simple: point sets built in Python and saved as .vtm, and the real Rotor 37
+export read by the TurboPointSetsReader, each -> BlockTemplate -> BlockMesher.
+
+Run by CTest with pvpython; BLOCKFORGE_PLUGIN is the plugin library of the build tree.
+"""
+import math
+import os
+import sys
+import unittest
+
+from paraview import servermanager
+from paraview.simple import Delete, LoadPlugin, OpenDataFile
+from paraview.vtk.numpy_interface import dataset_adapter as dsa
+from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIntArray, vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkMultiBlockDataSet, vtkPolyData
+from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataWriter
+import numpy as np
+
+PLUGIN = os.environ["BLOCKFORGE_PLUGIN"]
+SOURCE = os.environ.get("BLOCKFORGE_SOURCE_DIR",
+                        os.path.join(os.path.dirname(__file__), "..", ".."))
+OUTPUT = os.environ.get("BLOCKFORGE_TEST_OUTPUT", "/tmp/blockforge-test-output")
+DATA = os.path.join(SOURCE, "Testing", "Data")
+PASSAGE = os.path.join(DATA, "annular_passage.yaml")
+INF = os.path.join(SOURCE, "Data", "rotor37", "turbogrid", "BladeGen.inf")
+
+# Defines TurboPointSetsReader, BlockTemplate, BlockMesher, ... in this module.
+LoadPlugin(PLUGIN, remote=False, ns=globals())
+
+
+def leaves(multiblock):
+    result = []
+    iterator = multiblock.NewIterator()
+    iterator.InitTraversal()
+    while not iterator.IsDoneWithTraversal():
+        result.append(iterator.GetCurrentDataObject())
+        iterator.GoToNextItem()
+    return result
+
+
+def polyline(points):
+    data = vtkPolyData()
+    vtk_points = vtkPoints()
+    vtk_points.SetDataTypeToDouble()
+    for p in points:
+        vtk_points.InsertNextPoint(*p)
+    lines = vtkCellArray()
+    lines.InsertNextCell(len(points))
+    for k in range(len(points)):
+        lines.InsertCellPoint(k)
+    data.SetPoints(vtk_points)
+    data.SetLines(lines)
+    return data
+
+
+def hub_radius(z):
+    return 0.5 + 0.1 * z
+
+
+def point_sets(blade_count=12):
+    """Hub cone r = 0.5 + 0.1 z and shroud cylinder r = 1, at meridional angles 0.3 and
+    -0.2, as named polylines with the reader's machine field data."""
+    zs = [-0.2 + 1.4 * k / 7 for k in range(8)]
+    hub = [(hub_radius(z) * math.cos(0.3), hub_radius(z) * math.sin(0.3), z) for z in zs]
+    shroud = [(math.cos(-0.2), math.sin(-0.2), z) for z in zs]
+    root = vtkMultiBlockDataSet()
+    for index, (name, points) in enumerate((("Hub", hub), ("Shroud", shroud))):
+        root.SetBlock(index, polyline(points))
+        root.GetMetaData(index).Set(vtkMultiBlockDataSet.NAME(), name)
+    count = vtkIntArray()
+    count.SetName("BladeCount")
+    count.InsertNextValue(blade_count)
+    axis = vtkDoubleArray()
+    axis.SetName("Axis")
+    axis.SetNumberOfComponents(3)
+    axis.InsertNextTuple3(0.0, 0.0, 1.0)
+    root.GetFieldData().AddArray(count)
+    root.GetFieldData().AddArray(axis)
+    return root
+
+
+def save_point_sets(name, blade_count=12):
+    os.makedirs(OUTPUT, exist_ok=True)
+    path = os.path.join(OUTPUT, name)
+    writer = vtkXMLMultiBlockDataWriter()
+    writer.SetFileName(path)
+    writer.SetInputData(point_sets(blade_count))
+    writer.Write()
+    return path
+
+
+def rotate_z(points, angle):
+    c, s = math.cos(angle), math.sin(angle)
+    return np.column_stack((c * points[:, 0] - s * points[:, 1],
+                            s * points[:, 0] + c * points[:, 1], points[:, 2]))
+
+
+def block_array(block):
+    nx, ny, nz = block.GetDimensions()
+    return np.array(dsa.WrapDataObject(block).Points).reshape(nz, ny, nx, 3)
+
+
+class BlockTemplateTest(unittest.TestCase):
+    def check_passage(self, grid, pitch, hub_radius_of, shroud_radius, tolerance):
+        blocks = leaves(grid)
+        self.assertEqual(len(blocks), 2)
+        for block in blocks:
+            nodes = block_array(block)
+            hub, shroud = nodes[0].reshape(-1, 3), nodes[-1].reshape(-1, 3)
+            np.testing.assert_allclose(np.hypot(hub[:, 0], hub[:, 1]), hub_radius_of(hub[:, 2]),
+                                       rtol=0, atol=tolerance)
+            np.testing.assert_allclose(np.hypot(shroud[:, 0], shroud[:, 1]), shroud_radius(shroud[:, 2]),
+                                       rtol=0, atol=tolerance)
+            # periodic: the high side (i = max) is the low side (i = 0) rotated by a pitch
+            low = nodes[:, :, 0, :].reshape(-1, 3)
+            high = nodes[:, :, -1, :].reshape(-1, 3)
+            np.testing.assert_allclose(rotate_z(low, pitch), high, rtol=0, atol=tolerance)
+
+    def test_point_sets_to_grid(self):
+        path = save_point_sets("passage_point_sets.vtm")
+        points = OpenDataFile(path)
+        template = BlockTemplate(Input=points, TemplateFile=PASSAGE)
+        self.assertEqual(template.PreviewCells, 8)
+        template.Parameters = ["n_pitch", "8"]
+        template.UpdatePipeline()
+        preview = servermanager.Fetch(template)
+        self.assertEqual(preview.GetNumberOfBlocks(), 2)
+        document = preview.GetFieldData().GetAbstractArray("BlockForgeModel").GetValue(0)
+        self.assertIn("blockforge_model: 2", document)
+        self.assertIn("kind: revolve", document)
+
+        # port 1: the carriers the template declares, by name
+        carriers = servermanager.Fetch(template, idx=1)
+        names = [carriers.GetMetaData(i).Get(vtkMultiBlockDataSet.NAME())
+                 for i in range(carriers.GetNumberOfBlocks())]
+        self.assertEqual(names, ["hub_line", "shroud_line", "hub", "shroud", "radial_mid"])
+        hub = dsa.WrapDataObject(carriers.GetBlock(2)).Points
+        np.testing.assert_allclose(np.hypot(hub[:, 0], hub[:, 1]), hub_radius(hub[:, 2]),
+                                   rtol=0, atol=1e-9)
+        self.assertEqual(carriers.GetBlock(0).GetNumberOfPoints(), 257)
+
+        mesher = BlockMesher(Input=template, DensityMultiplier=1.0)
+        mesher.UpdatePipeline()
+        grid = servermanager.Fetch(mesher)
+        cells = sum(b.GetNumberOfCells() for b in leaves(grid))
+        self.assertEqual(cells, 2 * 8 * 5 * 4)
+        self.check_passage(grid, 2 * math.pi / 12, hub_radius, lambda z: np.ones_like(z), 1e-9)
+        for proxy in (mesher, template, points):
+            Delete(proxy)
+
+    def test_blade_count_from_input(self):
+        path = save_point_sets("passage_point_sets_9.vtm", blade_count=9)
+        points = OpenDataFile(path)
+        template = BlockTemplate(Input=points, TemplateFile=PASSAGE)
+        mesher = BlockMesher(Input=template)
+        mesher.UpdatePipeline()
+        grid = servermanager.Fetch(mesher)
+        self.check_passage(grid, 2 * math.pi / 9, hub_radius, lambda z: np.ones_like(z), 1e-9)
+        for proxy in (mesher, template, points):
+            Delete(proxy)
+
+    def test_rotor37_passage(self):
+        """The real Rotor 37 hub and shroud (cm, read in metres, 36 blades)."""
+        reader = TurboPointSetsReader(FileName=INF)
+        template = BlockTemplate(Input=reader, TemplateFile=PASSAGE)
+        template.Parameters = ["z_in", "0.0", "z_out", "0.04", "r_probe", "0.18", "r_outer", "0.25"]
+        mesher = BlockMesher(Input=template)
+        mesher.UpdatePipeline()
+        grid = servermanager.Fetch(mesher)
+        self.assertEqual(len(leaves(grid)), 2)
+        # radii against the contours read by the reader, interpolated linearly (the
+        # contours are dense: the spline and the polyline agree to well below 1e-4 m)
+        data = servermanager.Fetch(reader)
+        contours = {}
+        for i in range(data.GetNumberOfBlocks()):
+            name = data.GetMetaData(i).Get(vtkMultiBlockDataSet.NAME())
+            if name in ("Hub", "Shroud"):
+                p = np.array(dsa.WrapDataObject(data.GetBlock(i)).Points)
+                contours[name] = (p[:, 2], np.hypot(p[:, 0], p[:, 1]))
+
+        def radius_of(name):
+            z, r = contours[name]
+            return lambda q: np.interp(q, z, r)
+        self.check_passage(grid, 2 * math.pi / 36, radius_of("Hub"), radius_of("Shroud"), 1e-4)
+        for proxy in (mesher, template, reader):
+            Delete(proxy)
+
+    def test_rotor37_h_grid(self):
+        """Templates/axial_passage_h.yaml on the Rotor 37 export: 8 blocks, periodic, sound."""
+        reader = TurboPointSetsReader(FileName=INF)
+        template = BlockTemplate(Input=reader,
+                                 TemplateFile=os.path.join(SOURCE, "Templates", "axial_passage_h.yaml"))
+        mesher = BlockMesher(Input=template)
+        quality = GridQuality(Input=mesher)
+        quality.UpdatePipeline()
+        grid = servermanager.Fetch(quality)
+        blocks = {grid.GetMetaData(i).Get(vtkMultiBlockDataSet.NAME()): grid.GetBlock(i)
+                  for i in range(grid.GetNumberOfBlocks())}
+        self.assertEqual(sorted(blocks), ["AL", "AR", "BL", "BR", "DL", "DR", "UL", "UR"])
+        jacobian = grid.GetFieldData().GetArray("ScaledJacobianSummary").GetTuple(0)
+        self.assertGreater(jacobian[0], 0.0)
+        for low, high in (("UL", "UR"), ("BL", "BR"), ("AL", "AR"), ("DL", "DR")):
+            a, b = block_array(blocks[low]), block_array(blocks[high])
+            np.testing.assert_allclose(rotate_z(a[:, :, 0, :].reshape(-1, 3), 2 * math.pi / 36),
+                                       b[:, :, -1, :].reshape(-1, 3), rtol=0, atol=1e-12)
+        for proxy in (quality, mesher, template, reader):
+            Delete(proxy)
+
+    def test_errors_leave_empty_output(self):
+        path = save_point_sets("passage_point_sets_err.vtm")
+        points = OpenDataFile(path)
+        broken = os.path.join(OUTPUT, "passage_bad_input.yaml")
+        with open(PASSAGE) as source, open(broken, "w") as target:
+            target.write(source.read().replace("hub: Hub ", "hub: Hbu "))
+        template = BlockTemplate(Input=points, TemplateFile=broken)
+        mesher = BlockMesher(Input=template)
+        mesher.UpdatePipeline()
+        self.assertEqual(servermanager.Fetch(template).GetNumberOfBlocks(), 0)
+        self.assertEqual(servermanager.Fetch(mesher).GetNumberOfBlocks(), 0)
+        for proxy in (mesher, template, points):
+            Delete(proxy)
+
+
+if __name__ == "__main__":
+    result = unittest.main(verbosity=2, argv=[sys.argv[0]], exit=False).result
+    sys.exit(0 if result.wasSuccessful() else 1)
