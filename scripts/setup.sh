@@ -7,7 +7,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build="${BLOCKFORGE_BUILD_DIR:-$root/build}"
 
 packages=(cmake g++ make pkg-config
-  paraview paraview-dev python3-paraview libopenmpi-dev qtbase5-dev libutfcpp-dev
+  paraview paraview-dev python3-paraview python3-numpy libopenmpi-dev qtbase5-dev libutfcpp-dev
   libeigen3-dev libyaml-cpp-dev libmuparser-dev libgtest-dev xvfb "$@")
 missing=()
 for package in "${packages[@]}"; do
