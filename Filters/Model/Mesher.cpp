@@ -42,15 +42,7 @@ std::string faceText(const BlockModel& model, int block, int face)
   return model.blocks[block].name + "." + faceName(face);
 }
 
-/// Short form of a number for messages.
-std::string shortNumber(double value)
-{
-  std::ostringstream text;
-  text.imbue(std::locale::classic());
-  text.precision(6);
-  text << value;
-  return text.str();
-}
+using syntax::shortNumber;
 
 /// "w_ne-b_ne" or "'wall_n' (w_ne-b_ne)": how messages name the edge between a and b.
 std::string edgeText(const BlockModel& model, int a, int b)

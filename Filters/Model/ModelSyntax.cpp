@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <charconv>
+#include <sstream>
+#include <locale>
 #include <cmath>
 
 namespace blockforge
@@ -229,6 +231,34 @@ const MapEntry* findEntry(const std::vector<MapEntry>& entries, const std::strin
     }
   }
   return nullptr;
+}
+
+const MapEntry* findKind(const std::vector<MapEntry>& entries,
+  const std::vector<std::string>& kinds, const std::string& entity, const Reporter& reporter)
+{
+  const MapEntry* kind = nullptr;
+  for (const MapEntry& entry : entries)
+  {
+    if (std::find(kinds.begin(), kinds.end(), entry.key) != kinds.end())
+    {
+      if (kind)
+      {
+        reporter.fail(entry.line, entity,
+          "give one kind only, not both '" + kind->key + "' and '" + entry.key + "'");
+      }
+      kind = &entry;
+    }
+  }
+  return kind;
+}
+
+std::string shortNumber(double value)
+{
+  std::ostringstream text;
+  text.imbue(std::locale::classic());
+  text.precision(6);
+  text << value;
+  return text.str();
 }
 
 namespace

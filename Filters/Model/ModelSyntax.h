@@ -69,6 +69,12 @@ void checkKeys(const std::vector<MapEntry>& entries, const std::vector<std::stri
   const std::string& entity, const Reporter& reporter);
 /// The entry with `key`, or nullptr.
 const MapEntry* findEntry(const std::vector<MapEntry>& entries, const std::string& key);
+/// The one entry whose key is one of `kinds` (an entity's kind, e.g. `arc`), nullptr if
+/// none; fails when two kinds are given.
+const MapEntry* findKind(const std::vector<MapEntry>& entries,
+  const std::vector<std::string>& kinds, const std::string& entity, const Reporter& reporter);
+/// Short form of a number for messages (6 significant digits, C locale).
+std::string shortNumber(double value);
 
 /// Converts a scalar node to a number (a literal or an expression) or fails itself.
 using NumberReader = std::function<double(const YAML::Node& node, int line, const std::string& what)>;

@@ -353,15 +353,7 @@ std::string trailingComment(const std::string& line)
   return "";
 }
 
-/// Short form of a number for messages.
-std::string shortNumber(double value)
-{
-  std::ostringstream text;
-  text.imbue(std::locale::classic());
-  text.precision(6);
-  text << value;
-  return text.str();
-}
+using syntax::shortNumber;
 
 std::string fileStem(const std::string& path)
 {
@@ -1844,19 +1836,7 @@ private:
           " (e.g. {interpolate: hub} or {revolve: hub_line, axis: machine})");
     }
     const auto keys = syntax::mapEntries(entry.value, entry.line, entityText, "the carrier", Report);
-    const MapEntry* kind = nullptr;
-    for (const MapEntry& key : keys)
-    {
-      if (std::find(kinds.begin(), kinds.end(), key.key) != kinds.end())
-      {
-        if (kind)
-        {
-          fail(key.line, entityText,
-            "give one kind only, not both '" + kind->key + "' and '" + key.key + "'");
-        }
-        kind = &key;
-      }
-    }
+    const MapEntry* kind = syntax::findKind(keys, kinds, entityText, Report);
     if (!kind)
     {
       fail(entry.line, entityText, "needs one of: " + syntax::joinNames(kinds));
@@ -2519,19 +2499,7 @@ private:
         "expected a position [x, y, z] or a mapping with one of: " + syntax::joinNames(kinds));
     }
     const auto keys = syntax::mapEntries(entry.value, entry.line, entityText, "the vertex", Report);
-    const MapEntry* kind = nullptr;
-    for (const MapEntry& key : keys)
-    {
-      if (std::find(kinds.begin(), kinds.end(), key.key) != kinds.end())
-      {
-        if (kind)
-        {
-          fail(key.line, entityText,
-            "give one kind only, not both '" + kind->key + "' and '" + key.key + "'");
-        }
-        kind = &key;
-      }
-    }
+    const MapEntry* kind = syntax::findKind(keys, kinds, entityText, Report);
     if (!kind)
     {
       syntax::checkKeys(keys, kinds, entityText, Report);
@@ -2752,20 +2720,8 @@ private:
     syntax::checkKeys(
       keys, { "on_curve", "on_surface", "project", "periodic", "between", "at", "pitches" },
       entityText, Report);
-    const MapEntry* kind = nullptr;
-    for (const MapEntry& key : keys)
-    {
-      if (key.key == "on_curve" || key.key == "on_surface" || key.key == "project" ||
-        key.key == "periodic")
-      {
-        if (kind)
-        {
-          fail(key.line, entityText,
-            "give one kind only, not both '" + kind->key + "' and '" + key.key + "'");
-        }
-        kind = &key;
-      }
-    }
+    const MapEntry* kind = syntax::findKind(
+      keys, { "on_curve", "on_surface", "project", "periodic" }, entityText, Report);
     Edge edge;
     edge.name = entry.key;
     edge.where = where(entry.line);
