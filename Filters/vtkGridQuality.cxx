@@ -17,6 +17,7 @@
 #include <vtkObjectFactory.h>
 #include <vtkPoints.h>
 #include <vtkSmartPointer.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStringArray.h>
 #include <vtkStructuredGrid.h>
 #include <vtkTable.h>
@@ -201,9 +202,13 @@ int vtkGridQuality::RequestData(
     }
   }
 
+  // Reduce only when the pipeline runs in pieces: a plain serial pipeline inside an MPI
+  // program (e.g. on one rank of pvbatch) must not wait for ranks that never join.
+  const int pieceCount = outputVector->GetInformationObject(0)->Get(
+    vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
   if (auto* controller = vtkMultiProcessController::GetGlobalController())
   {
-    if (controller->GetNumberOfProcesses() > 1)
+    if (pieceCount > 1 && controller->GetNumberOfProcesses() > 1)
     {
       std::array<double, 5> classTotal{};
       std::array<double, 6> minTotal{}, maxTotal{}, sumTotal{};
