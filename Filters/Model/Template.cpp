@@ -895,15 +895,21 @@ private:
             "point " + std::to_string(p + 1)));
         }
       }
-      const int other = Model.findEdge(edge.from, edge.to);
-      if (other >= 0)
-      {
-        fail(entry.line, entityText,
-          "joins the same vertices as edge '" + Model.edges[other].name + "' (line " +
-            std::to_string(Model.edges[other].where.line) + ")");
-      }
-      Model.edges.push_back(edge);
+      addEdge(edge, entry.line, entityText);
     }
+  }
+
+  /// Adds an edge unless another one already joins the same two vertices.
+  void addEdge(const Edge& edge, int line, const std::string& entityText)
+  {
+    const int other = Model.findEdge(edge.from, edge.to);
+    if (other >= 0)
+    {
+      fail(line, entityText,
+        "joins the same vertices as edge '" + Model.edges[other].name + "' (line " +
+          std::to_string(Model.edges[other].where.line) + ")");
+    }
+    Model.edges.push_back(edge);
   }
 
   void readBlocks()
@@ -2825,14 +2831,7 @@ private:
         }
       }
     }
-    const int other = Model.findEdge(edge.from, edge.to);
-    if (other >= 0)
-    {
-      fail(entry.line, entityText,
-        "joins the same vertices as edge '" + Model.edges[other].name + "' (line " +
-          std::to_string(Model.edges[other].where.line) + ")");
-    }
-    Model.edges.push_back(edge);
+    addEdge(edge, entry.line, entityText);
   }
 
   /// Faces whose grids lie on surfaces: {on_surface: S, faces: [block.face | [4 vertices]]}.
