@@ -784,18 +784,14 @@ private:
     Vec3 origin = Vec3::Zero();
     if (const MapEntry* axisEntry = syntax::findEntry(keys, "axis"))
     {
-      axis = vector3(axisEntry->value, axisEntry->line, entityText, "axis");
+      axis = unitAxis(*axisEntry, entityText, "rotation axis");
     }
     if (const MapEntry* originEntry = syntax::findEntry(keys, "origin"))
     {
       origin = vector3(originEntry->value, originEntry->line, entityText, "origin");
     }
-    if (!(axis.norm() > 0.0))
-    {
-      fail(entry.line, entityText, "the rotation axis must not be zero");
-    }
     const double radians = number(angle->value, angle->line, entityText, "angle");
-    const Eigen::AngleAxisd rotation(radians, axis.normalized());
+    const Eigen::AngleAxisd rotation(radians, axis);
     return origin + rotation * (Model.vertices[source].position - origin);
   }
 
@@ -897,6 +893,18 @@ private:
       }
       addEdge(edge, entry.line, entityText);
     }
+  }
+
+  /// A rotation axis given as [x, y, z]: must not be zero; returned as a unit vector.
+  /// `what` names it in the message ("the machine axis must not be zero").
+  Vec3 unitAxis(const MapEntry& axis, const std::string& entityText, const std::string& what)
+  {
+    const Vec3 direction = vector3(axis.value, axis.line, entityText, "axis");
+    if (!(direction.norm() > 0.0))
+    {
+      fail(axis.line, entityText, "the " + what + " must not be zero");
+    }
+    return direction.normalized();
   }
 
   /// Adds an edge unless another one already joins the same two vertices.
@@ -1093,12 +1101,7 @@ private:
       }
       if (const MapEntry* axis = syntax::findEntry(keys, "axis"))
       {
-        patch.periodicAxis = vector3(axis->value, axis->line, entityText, "axis");
-        if (!(patch.periodicAxis.norm() > 0.0))
-        {
-          fail(axis->line, entityText, "the periodic axis must not be zero");
-        }
-        patch.periodicAxis.normalize();
+        patch.periodicAxis = unitAxis(*axis, entityText, "periodic axis");
       }
       if (const MapEntry* origin = syntax::findEntry(keys, "origin"))
       {
@@ -1331,12 +1334,7 @@ private:
       syntax::checkKeys(keys, { "axis", "origin", "blade_count" }, entityText, Report);
       if (const MapEntry* axis = syntax::findEntry(keys, "axis"))
       {
-        machine.axis = vector3(axis->value, axis->line, entityText, "axis");
-        if (!(machine.axis.norm() > 0.0))
-        {
-          fail(axis->line, entityText, "the machine axis must not be zero");
-        }
-        machine.axis.normalize();
+        machine.axis = unitAxis(*axis, entityText, "machine axis");
       }
       if (const MapEntry* origin = syntax::findEntry(keys, "origin"))
       {
@@ -1895,12 +1893,7 @@ private:
       const MapEntry* origin = syntax::findEntry(keys, "origin");
       if (axis && !(axis->value.IsScalar() && axis->value.Scalar() == "machine"))
       {
-        carrier.axis = vector3(axis->value, axis->line, entityText, "axis");
-        if (!(carrier.axis.norm() > 0.0))
-        {
-          fail(axis->line, entityText, "the axis must not be zero");
-        }
-        carrier.axis.normalize();
+        carrier.axis = unitAxis(*axis, entityText, "axis");
         carrier.axisPoint = Vec3::Zero();
       }
       if (origin)
