@@ -10,6 +10,9 @@
 
 #include "TurboPointSets.h"
 
+#include "TestHelpers.h"
+#include "TestTurboInputs.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -23,7 +26,7 @@ using namespace blockforge::model;
 
 namespace
 {
-const double Pi = 3.14159265358979323846;
+using test::Pi;
 
 std::string dataPath(const std::string& name)
 {
@@ -49,21 +52,7 @@ std::string replaced(std::string text, const std::string& from, const std::strin
   return text;
 }
 
-int lineContaining(const std::string& text, const std::string& needle)
-{
-  std::istringstream stream(text);
-  int number = 0;
-  for (std::string line; std::getline(stream, line);)
-  {
-    ++number;
-    if (line.find(needle) != std::string::npos)
-    {
-      return number;
-    }
-  }
-  ADD_FAILURE() << "no line contains " << needle;
-  return 0;
-}
+using test::lineContaining;
 
 void expectError(const std::function<void()>& action, const std::vector<std::string>& pieces)
 {
@@ -758,35 +747,8 @@ namespace
 /// The reader's data as vtkBlockTemplate passes it on (metres, machine data).
 TemplateInputs rotor37Inputs()
 {
-  const io::TurboPointSets sets = io::readTurboPointSets(
-    std::string(BLOCKFORGE_SOURCE_DIR) + "/Data/rotor37/turbogrid/BladeGen.inf");
-  TemplateInputs inputs;
-  auto curve = [&](const io::PointSet& set) {
-    InputCurve result;
-    result.name = set.name;
-    for (const Eigen::Vector3d& p : set.points)
-    {
-      result.points.push_back(p * sets.scale);
-    }
-    return result;
-  };
-  InputPointSet hub, shroud, profiles;
-  hub.name = "Hub";
-  hub.curves.push_back(curve(sets.hub));
-  shroud.name = "Shroud";
-  shroud.curves.push_back(curve(sets.shroud));
-  profiles.name = "Profiles";
-  profiles.isList = true;
-  for (const io::ProfileSection& section : sets.profiles)
-  {
-    profiles.curves.push_back(curve(section));
-    profiles.curves.back().span = section.spanPercent / 100.0;
-  }
-  inputs.pointSets = { hub, shroud, profiles };
-  inputs.hasMachine = true;
-  inputs.axis = sets.axis;
-  inputs.bladeCount = sets.bladeCount;
-  return inputs;
+  return test::readTemplateInputs(
+    test::sourcePath("Data/rotor37/turbogrid/BladeGen.inf"));
 }
 } // namespace
 

@@ -6,6 +6,8 @@
 #include "Template.h"
 
 #include <Eigen/Geometry>
+#include "TestHelpers.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -20,15 +22,11 @@ using namespace blockforge::model;
 
 namespace
 {
-const double Pi = 3.14159265358979323846;
+using test::Pi;
 
-std::string templatePath(const std::string& name)
-{
-  return std::string(BLOCKFORGE_SOURCE_DIR) + "/Templates/" + name;
-}
+using test::templatePath;
 
-const std::vector<std::string> ExampleTemplates = { "cylinder_in_box.yaml",
-  "annular_sector.yaml", "wedge_sector.yaml" };
+const std::vector<std::string>& ExampleTemplates = test::exampleTemplates();
 
 struct BlockGrid
 {

@@ -14,6 +14,9 @@
 #include "TurboPointSets.h"
 
 #include <Eigen/Geometry>
+#include "TestHelpers.h"
+#include "TestTurboInputs.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -28,7 +31,7 @@ using namespace blockforge::model;
 
 namespace
 {
-const double Pi = 3.14159265358979323846;
+using test::Pi;
 
 struct DataSet
 {
@@ -47,40 +50,10 @@ const std::vector<DataSet>& dataSets()
 
 std::string templatePath(const std::string& name)
 {
-  return std::string(BLOCKFORGE_SOURCE_DIR) + "/Templates/" + name + ".yaml";
+  return test::templatePath(name + ".yaml");
 }
 
-TemplateInputs readInputs(const std::string& inf)
-{
-  const io::TurboPointSets sets = io::readTurboPointSets(inf);
-  TemplateInputs inputs;
-  auto curve = [&](const io::PointSet& set) {
-    InputCurve result;
-    result.name = set.name;
-    for (const Eigen::Vector3d& p : set.points)
-    {
-      result.points.push_back(p * sets.scale);
-    }
-    return result;
-  };
-  InputPointSet hub, shroud, profiles;
-  hub.name = "Hub";
-  hub.curves.push_back(curve(sets.hub));
-  shroud.name = "Shroud";
-  shroud.curves.push_back(curve(sets.shroud));
-  profiles.name = "Profiles";
-  profiles.isList = true;
-  for (const io::ProfileSection& section : sets.profiles)
-  {
-    profiles.curves.push_back(curve(section));
-    profiles.curves.back().span = section.spanPercent / 100.0;
-  }
-  inputs.pointSets = { hub, shroud, profiles };
-  inputs.hasMachine = true;
-  inputs.axis = sets.axis;
-  inputs.bladeCount = sets.bladeCount;
-  return inputs;
-}
+using test::readTemplateInputs;
 
 struct Grid
 {
@@ -277,7 +250,7 @@ Checked checkPassage(const std::string& templateName, const DataSet& data,
 {
   Checked result;
   SCOPED_TRACE(templateName + " on " + data.name);
-  const TemplateInputs inputs = readInputs(data.inf);
+  const TemplateInputs inputs = readTemplateInputs(data.inf);
   const BlockModel model = loadTemplate(templatePath(templateName), overrides, &inputs);
   const double pitch = 2.0 * Pi / model.machine.bladeCount;
   const Grid grid = meshAll(model);
@@ -401,7 +374,7 @@ Checked checkPassage(const std::string& templateName, const DataSet& data,
 
 double medianLoadSeconds(const std::string& templateName, const DataSet& data)
 {
-  const TemplateInputs inputs = readInputs(data.inf);
+  const TemplateInputs inputs = readTemplateInputs(data.inf);
   std::vector<double> times;
   for (int run = 0; run < 5; ++run)
   {

@@ -4,6 +4,8 @@
 #include "ModelDocument.h"
 #include "Template.h"
 
+#include "TestHelpers.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,15 +19,11 @@ using namespace blockforge::model;
 
 namespace
 {
-const double Pi = 3.14159265358979323846;
+using test::Pi;
 
-std::string templatePath(const std::string& name)
-{
-  return std::string(BLOCKFORGE_SOURCE_DIR) + "/Templates/" + name;
-}
+using test::templatePath;
 
-const std::vector<std::string> ExampleTemplates = { "cylinder_in_box.yaml",
-  "annular_sector.yaml", "wedge_sector.yaml" };
+const std::vector<std::string>& ExampleTemplates = test::exampleTemplates();
 
 /// Two unit boxes side by side along x; the error tests each break one line of it.
 const std::string TwoBoxes = R"(blockforge: 1
@@ -68,22 +66,7 @@ std::string readText(const std::string& path)
   return text.str();
 }
 
-/// 1-based line of the first line containing `needle`.
-int lineContaining(const std::string& text, const std::string& needle)
-{
-  std::istringstream stream(text);
-  int number = 0;
-  for (std::string line; std::getline(stream, line);)
-  {
-    ++number;
-    if (line.find(needle) != std::string::npos)
-    {
-      return number;
-    }
-  }
-  ADD_FAILURE() << "no line contains " << needle;
-  return 0;
-}
+using test::lineContaining;
 
 /// `text` with the first occurrence of `from` replaced by `to` (which must exist).
 std::string replaced(std::string text, const std::string& from, const std::string& to)
