@@ -1119,3 +1119,171 @@ std::shared_ptr<SurfaceCurve> intersectWithRevolution(std::shared_ptr<const Gord
   return curve;
 }
 } // namespace blockforge
+
+namespace blockforge
+{
+namespace
+{
+struct OffsetSample
+{
+  double u;
+  Vec3 point;
+  Vec3 normal; // unit normal of the curve within the surface
+};
+
+Vec3 inSurfaceNormal(const Curve& curve, const Surface& surface,
+  const SurfaceParameterFunction& toParameters, double u, const Vec3& point)
+{
+  Vec3 tangent = curve.derivative(u);
+  if (!(tangent.norm() > 0.0) || !tangent.allFinite())
+  {
+    // a stationary point of the parametrisation: the chord through its neighbours
+    const double h = 1e-7;
+    tangent = curve.point(std::min(1.0, u + h)) - curve.point(std::max(0.0, u - h));
+  }
+  const Eigen::Vector2d st = toParameters(point);
+  SurfaceDerivatives d;
+  surface.derivatives(st[0], st[1], d);
+  const Vec3 surfaceNormal = d.Ps.cross(d.Pt);
+  const Vec3 normal = surfaceNormal.cross(tangent);
+  if (!(surfaceNormal.norm() > 0.0) || !(normal.norm() > 0.0) || !normal.allFinite())
+  {
+    std::ostringstream message;
+    message << "offset on a surface: the curve tangent or the surface normal vanishes at u = "
+            << u;
+    throw GeometryError(message.str());
+  }
+  return normal.normalized();
+}
+} // namespace
+
+std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
+  const Surface& surface, const SurfaceParameterFunction& toParameters, double distance)
+{
+  if (!std::isfinite(distance) || distance == 0.0)
+  {
+    throw GeometryError("offset on a surface: the distance must be finite and not zero");
+  }
+  constexpr int InitialSteps = 512;
+  constexpr std::size_t MaxSamples = 65536;
+  const double turnLimit = std::cos(3.0 * std::acos(-1.0) / 180.0);
+  auto sampleAt = [&](double u) {
+    OffsetSample sample{ u, curve.point(u), Vec3::Zero() };
+    sample.normal = inSurfaceNormal(curve, surface, toParameters, u, sample.point);
+    return sample;
+  };
+
+  std::vector<OffsetSample> coarse;
+  coarse.reserve(InitialSteps + 1);
+  for (int k = 0; k <= InitialSteps; ++k)
+  {
+    coarse.push_back(sampleAt(static_cast<double>(k) / InitialSteps));
+  }
+  if (closed)
+  {
+    // The seam of a closed curve may be only C0: one normal for both ends closes the loop.
+    const Vec3 seam = (coarse.front().normal + coarse.back().normal).normalized();
+    coarse.front().normal = seam;
+    coarse.back().normal = seam;
+    coarse.back().point = coarse.front().point;
+  }
+
+  // Halve the steps across which the normal turns too fast (depth-first, in order, so the
+  // result does not depend on anything but the curve).
+  std::vector<OffsetSample> samples;
+  samples.reserve(4 * InitialSteps);
+  samples.push_back(coarse.front());
+  std::function<void(const OffsetSample&, const OffsetSample&, int)> refine =
+    [&](const OffsetSample& a, const OffsetSample& b, int depth) {
+      if (depth < 16 && a.normal.dot(b.normal) < turnLimit && samples.size() < MaxSamples)
+      {
+        const OffsetSample middle = sampleAt(0.5 * (a.u + b.u));
+        refine(a, middle, depth + 1);
+        refine(middle, b, depth + 1);
+        return;
+      }
+      samples.push_back(b);
+    };
+  for (std::size_t k = 1; k < coarse.size(); ++k)
+  {
+    refine(coarse[k - 1], coarse[k], 0);
+  }
+
+  double side = 1.0;
+  if (closed)
+  {
+    Vec3 centroid = Vec3::Zero();
+    for (std::size_t k = 0; k + 1 < samples.size(); ++k)
+    {
+      centroid += samples[k].point;
+    }
+    centroid /= static_cast<double>(samples.size() - 1);
+    std::size_t farthest = 0;
+    for (std::size_t k = 1; k + 1 < samples.size(); ++k)
+    {
+      if ((samples[k].point - centroid).norm() > (samples[farthest].point - centroid).norm())
+      {
+        farthest = k;
+      }
+    }
+    if (samples[farthest].normal.dot(samples[farthest].point - centroid) < 0.0)
+    {
+      side = -1.0;
+    }
+  }
+
+  std::vector<Vec3> offset(samples.size());
+  for (std::size_t k = 0; k < samples.size(); ++k)
+  {
+    offset[k] = samples[k].point + side * distance * samples[k].normal;
+  }
+  for (std::size_t k = 1; k < samples.size(); ++k)
+  {
+    const Vec3 along = samples[k].point - samples[k - 1].point;
+    if (along.norm() > 0.0 && (offset[k] - offset[k - 1]).dot(along) <= 0.0)
+    {
+      std::ostringstream message;
+      message << "offset on a surface: the offset by " << distance
+              << " folds back near u = " << samples[k].u
+              << " (the curve bends there with a radius of curvature smaller than the "
+                 "distance); use a smaller distance";
+      throw GeometryError(message.str());
+    }
+  }
+
+  std::vector<Eigen::Vector2d> parameters;
+  parameters.reserve(samples.size());
+  Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d high = -low;
+  std::vector<Eigen::Vector2d> all(samples.size());
+  for (std::size_t k = 0; k < samples.size(); ++k)
+  {
+    all[k] = toParameters(offset[k]);
+    low = low.cwiseMin(all[k]);
+    high = high.cwiseMax(all[k]);
+  }
+  if (closed)
+  {
+    all.back() = all.front();
+  }
+  // Drop samples that coincide in (s, t) (interpolation needs distinct points).
+  const double tiny = 1e-12 * std::max((high - low).norm(), 1e-300);
+  for (std::size_t k = 0; k < all.size(); ++k)
+  {
+    if (!parameters.empty() && (all[k] - parameters.back()).norm() <= tiny)
+    {
+      if (k + 1 == all.size())
+      {
+        parameters.back() = all[k]; // keep the exact last point
+      }
+      continue;
+    }
+    parameters.push_back(all[k]);
+  }
+  if (parameters.size() < 2)
+  {
+    throw GeometryError("offset on a surface: the curve has no length");
+  }
+  return parameters;
+}
+} // namespace blockforge

@@ -16,6 +16,8 @@
 
 #include <Eigen/Core>
 
+#include <functional>
+
 namespace blockforge
 {
 /**
@@ -207,4 +209,33 @@ private:
 std::shared_ptr<SurfaceCurve> intersectWithRevolution(std::shared_ptr<const GordonSurface> surface,
   const SurfaceOfRevolution& revolution, double tMin = -0.5, double tMax = 1.5,
   int samples = 64);
+
+/// Closest point of a surface to p, as its parameters (s, t): how offsetOnSurface maps the
+/// offset points back onto the surface.
+using SurfaceParameterFunction = std::function<Eigen::Vector2d(const Vec3& p)>;
+
+/**
+ * The offset of a curve lying on a surface, within that surface (the outer boundary of an
+ * O-grid around a blade section on the hub): for each sample u of the curve, the point
+ * P(u) + distance * n(u), where n = N x T / |N x T| is the unit normal of the curve in the
+ * surface's tangent plane (N the surface normal Ps x Pt at P, T the curve tangent),
+ * mapped back onto the surface by `toParameters`. Returns the offset as (s, t) points of
+ * the surface, in the order of u, to be interpolated (SurfaceCurve).
+ *
+ * `closed` curves (P(0) == P(1)) are offset outwards for distance > 0, whatever their
+ * orientation (the side n points to at the curve point farthest from the centroid of the
+ * samples decides), and the returned loop closes exactly (the seam normal is the mean of
+ * the normals at u = 0 and 1). Open curves are offset towards +n.
+ *
+ * Sampling starts with 512 equal steps of u and halves every step across which the normal
+ * turns by more than 3 degrees, so a leading edge whose radius is 1e-3 of the curve's
+ * length is followed closely (at most 65536 samples). Deterministic.
+ *
+ * Throws GeometryError when |distance| is zero, not finite or at least the radius of
+ * curvature of the curve on the side it is offset to (the offset would fold back:
+ * consecutive offset points run against the curve), naming the parameter u where it
+ * folds; and when the tangent or the surface normal vanish.
+ */
+std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
+  const Surface& surface, const SurfaceParameterFunction& toParameters, double distance);
 } // namespace blockforge

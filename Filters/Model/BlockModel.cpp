@@ -4,6 +4,13 @@ namespace blockforge
 {
 namespace model
 {
+const std::vector<std::string>& carrierKindNames()
+{
+  static const std::vector<std::string> names = { "interpolate", "revolve", "gordon", "network",
+    "coons", "surface_curve", "intersect", "offset" };
+  return names;
+}
+
 int BlockModel::findVertex(const std::string& vertexName) const
 {
   for (std::size_t i = 0; i < vertices.size(); ++i)

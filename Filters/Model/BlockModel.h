@@ -50,6 +50,11 @@ struct Machine
  * carriers. Carriers are stored with their complete definition (input points with 17
  * digits in the model document), so every stage rebuilds the same geometry bit for bit.
  */
+struct Carrier;
+
+/// The names of the carrier kinds in templates and model documents, in Carrier::Kind order.
+const std::vector<std::string>& carrierKindNames();
+
 struct Carrier
 {
   enum class Kind
@@ -61,7 +66,8 @@ struct Carrier
                   ///< crossRefs at s = crossNodes
     Coons,        ///< surface: Coons patch (eq. 3) from refs = bottom, right, top, left
     SurfaceCurve, ///< curve: through parameterPoints in the (s, t) space of surface refs[0]
-    Intersect     ///< curve: surface refs[0] (Gordon) cut by revolution surface refs[1]
+    Intersect,    ///< curve: surface refs[0] (Gordon) cut by revolution surface refs[1]
+    Offset        ///< curve: curve refs[0] offset within surface refs[1] by `distance`
   };
   enum class Blending
   {
@@ -87,6 +93,8 @@ struct Carrier
   std::vector<Eigen::Vector2d> parameterPoints;
   double rangeMin = -0.5, rangeMax = 1.5; ///< Intersect: t range searched on refs[0]
   int samples = 64;                       ///< Intersect: s samples
+  /// Offset: distance within the surface, in model units (> 0: outwards for closed curves).
+  double distance = 0.0;
   SourceLocation where;
 
   bool isSurface() const

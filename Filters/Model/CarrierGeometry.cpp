@@ -398,6 +398,37 @@ void CarrierGeometry::buildEntry(const BlockModel& model, int index, int depth)
           cut.gordon, *by.revolution, carrier.rangeMin, carrier.rangeMax, carrier.samples);
         break;
       }
+      case Carrier::Kind::Offset:
+      {
+        refCount(2, 2);
+        checkRef(carrier.refs[0], false, "offset");
+        checkRef(carrier.refs[1], true, "base");
+        const int base = carrier.refs[1];
+        const Entry& curve = Entries[carrier.refs[0]];
+        const double tolerance = 1e-6 * std::max(curve.size, Entries[base].size);
+        auto toParameters = [&](const Vec3& p) {
+          double s = 0.0, t = 0.0, distance = 0.0;
+          project(base, p, s, t, distance);
+          return Eigen::Vector2d(s, t);
+        };
+        // The curve must lie on the surface it is offset in (checked at a few points).
+        for (int k = 0; k <= 8; ++k)
+        {
+          double s = 0.0, t = 0.0, distance = 0.0;
+          project(base, curve.curve->point(k / 8.0), s, t, distance);
+          if (distance > tolerance)
+          {
+            fail("curve '" + model.carriers[carrier.refs[0]].name + "' does not lie on '" +
+              model.carriers[base].name + "' (a point is " + syntax::shortNumber(distance) +
+              " away from it); offset a curve on its own surface");
+          }
+        }
+        const std::vector<Eigen::Vector2d> points = offsetOnSurface(
+          *curve.curve, curve.closedS, *Entries[base].surface, toParameters, carrier.distance);
+        built.curve = std::make_shared<SurfaceCurve>(Entries[base].surface, points);
+        built.closedS = curve.closedS;
+        break;
+      }
     }
   }
   catch (const GeometryError& error)

@@ -626,14 +626,13 @@ private:
     const std::string entityText = entity("carrier", name);
     const MapEntry& kind = required(keys, "kind", node, entityText);
     const std::string kindName = text(kind.value, kind.line, entityText, "kind");
-    static const char* const kinds[] = { "interpolate", "revolve", "gordon", "network", "coons",
-      "surface_curve", "intersect" };
+    const std::vector<std::string>& kinds = carrierKindNames();
     int found = -1;
-    for (int k = 0; k < 7; ++k)
+    for (std::size_t k = 0; k < kinds.size(); ++k)
     {
       if (kindName == kinds[k])
       {
-        found = k;
+        found = static_cast<int>(k);
       }
     }
     if (found < 0)
@@ -719,6 +718,10 @@ private:
     {
       carrier.samples = integer(samples->value, samples->line, entityText, "samples");
     }
+    if (const MapEntry* distance = syntax::findEntry(keys, "distance"))
+    {
+      carrier.distance = number(distance->value, distance->line, entityText, "distance");
+    }
   }
 
   void resolvePeriodicSource(Vertex& vertex)
@@ -738,7 +741,7 @@ private:
 
   const std::vector<std::string> CarrierKeys = { "kind", "points", "degree", "parameters",
     "refs", "cross_refs", "at", "cross_at", "blending", "closed", "axis", "origin", "angle",
-    "range", "samples" };
+    "range", "samples", "distance" };
   std::vector<std::string> PeriodicSources;
   std::size_t NextPeriodic = 0;
 
@@ -785,8 +788,7 @@ std::string writeModelDocument(const BlockModel& model)
   }
   if (!model.carriers.empty())
   {
-    static const char* const kinds[] = { "interpolate", "revolve", "gordon", "network", "coons",
-      "surface_curve", "intersect" };
+    const std::vector<std::string>& kinds = carrierKindNames();
     static const char* const methods[] = { "uniform", "chord", "centripetal" };
     out << YAML::Key << "carriers" << YAML::Value << YAML::BeginSeq;
     for (const Carrier& carrier : model.carriers)
@@ -866,6 +868,10 @@ std::string writeModelDocument(const BlockModel& model)
           refList("refs", carrier.refs);
           numberList("range", { carrier.rangeMin, carrier.rangeMax });
           out << YAML::Key << "samples" << YAML::Value << carrier.samples;
+          break;
+        case Carrier::Kind::Offset:
+          refList("refs", carrier.refs);
+          out << YAML::Key << "distance" << YAML::Value << formatNumber(carrier.distance);
           break;
       }
       emitWhere(out, carrier.where, model);

@@ -87,8 +87,8 @@ public:
     Parser.DefineConst("deg", Pi / 180.0);
   }
 
-  /// Called with every `name.attribute` token of an expression before it is evaluated
-  /// (resolves vertices defined further down the template).
+  /// Called with every `name.attribute` token (and every plain name, attribute "") of an
+  /// expression before it is evaluated (resolves vertices and definitions further down).
   std::function<void(const std::string& name, const std::string& attribute)> OnReference;
   /// Names that are not available, with the reason (shown instead of "unknown name").
   std::map<std::string, std::string> Unavailable;
@@ -131,7 +131,7 @@ public:
     }
     if (OnReference)
     {
-      for (const auto& reference : dottedNames(expanded))
+      for (const auto& reference : referencedNames(expanded))
       {
         OnReference(reference.first, reference.second);
       }
@@ -194,6 +194,52 @@ public:
         (std::isnan(value) ? std::string("NaN") : std::string(value > 0 ? "inf" : "-inf")) };
     }
     return value;
+  }
+
+  /**
+   * A function of a point: `expression` may use everything a template expression may and
+   * the variables x, y, z, axial, radius, theta of the point (set through `variables`,
+   * six doubles in that order, before each call). Referenced vertices and definitions are
+   * resolved first.
+   */
+  std::function<double()> pointFunction(const std::string& expression, double* variables)
+  {
+    const std::string expanded = expandDegrees(expression);
+    if (!parenthesesBalance(expression))
+    {
+      throw ExpressionError{ "unbalanced parentheses in '" + expression + "'" };
+    }
+    if (OnReference)
+    {
+      for (const auto& reference : referencedNames(expanded))
+      {
+        OnReference(reference.first, reference.second);
+      }
+    }
+    auto parser = std::make_shared<mu::Parser>(Parser);
+    static const char* const names[6] = { "x", "y", "z", "axial", "radius", "theta" };
+    try
+    {
+      for (int k = 0; k < 6; ++k)
+      {
+        if (std::find(Names.begin(), Names.end(), names[k]) != Names.end())
+        {
+          throw ExpressionError{ std::string("'") + names[k] +
+            "' is a parameter or definition of this template, so it cannot be the point "
+            "variable of '" + expression + "'; rename it" };
+        }
+        parser->DefineVar(names[k], variables + k);
+      }
+      parser->SetExpr(expanded);
+      parser->Eval(); // reports unknown names and syntax errors here, once
+    }
+    catch (const mu::ParserError& error)
+    {
+      throw ExpressionError{ "cannot evaluate '" + expression + "' (a function of the point "
+                                                               "x, y, z, axial, radius, theta): " +
+        error.GetMsg() };
+    }
+    return [parser]() { return parser->Eval(); };
   }
 
   /// `45deg` -> `(45*deg)`; identifiers that merely contain digits (x2deg) are untouched.
@@ -269,7 +315,9 @@ public:
   }
 
   /// The `name.attribute` tokens of an expression (names start with a letter or '_').
-  static std::vector<std::pair<std::string, std::string>> dottedNames(const std::string& text)
+  /// The names an expression refers to: (vertex, attribute) for `vertex.attribute`, (name, "")
+  /// for plain names (parameters, definitions, constants); functions are left out.
+  static std::vector<std::pair<std::string, std::string>> referencedNames(const std::string& text)
   {
     std::vector<std::pair<std::string, std::string>> names;
     auto isStart = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; };
@@ -295,6 +343,15 @@ public:
           names.emplace_back(text.substr(i, j - i), text.substr(j + 1, k - j - 1));
           i = k;
           continue;
+        }
+        std::size_t next = j;
+        while (next < n && (text[next] == ' ' || text[next] == '\t'))
+        {
+          ++next;
+        }
+        if (next >= n || text[next] != '(') // a function call is not a name
+        {
+          names.emplace_back(text.substr(i, j - i), std::string());
         }
         i = j;
         continue;
@@ -551,8 +608,8 @@ private:
     }
     Sections = syntax::mapEntries(root, 1, "", "the template", Report);
     syntax::checkKeys(Sections,
-      { "blockforge", "name", "description", "inputs", "machine", "parameters", "carriers",
-        "vertices", "edges", "blocks", "faces", "patches" },
+      { "blockforge", "name", "description", "inputs", "machine", "parameters", "definitions",
+        "carriers", "vertices", "edges", "blocks", "faces", "patches" },
       "", Report);
     const MapEntry* version = syntax::findEntry(Sections, "blockforge");
     if (!version)
@@ -578,7 +635,7 @@ private:
     Version = static_cast<int>(versionNumber);
     if (Version < 2)
     {
-      for (const char* key : { "inputs", "machine", "carriers", "faces" })
+      for (const char* key : { "inputs", "machine", "definitions", "carriers", "faces" })
       {
         if (const MapEntry* entry = syntax::findEntry(Sections, key))
         {
@@ -1499,13 +1556,27 @@ private:
       VertexEntries.push_back(entry);
     }
     VertexState.assign(VertexEntries.size(), 0);
-    Evaluator.OnReference = [this](const std::string& vertexName, const std::string&) {
-      const int index = Model.findVertex(vertexName);
+    readDefinitionNames();
+    Evaluator.OnReference = [this](const std::string& referenced, const std::string& attribute) {
+      if (attribute.empty())
+      {
+        const auto definition = DefinitionIndex.find(referenced);
+        if (definition != DefinitionIndex.end())
+        {
+          ensureDefinition(definition->second);
+        }
+        return;
+      }
+      const int index = Model.findVertex(referenced);
       if (index >= 0)
       {
         ensureVertex(index);
       }
     };
+    for (std::size_t d = 0; d < DefinitionEntries.size(); ++d)
+    {
+      ensureDefinition(static_cast<int>(d));
+    }
     for (std::size_t v = 0; v < VertexEntries.size(); ++v)
     {
       ensureVertex(static_cast<int>(v));
@@ -1514,6 +1585,67 @@ private:
     {
       ensureCarrier(static_cast<int>(c));
     }
+  }
+
+  /// Format 2 `definitions`: named expressions that may use parameters, machine values,
+  /// vertex queries and other definitions, resolved when first used (in any order).
+  void readDefinitionNames()
+  {
+    const MapEntry* definitions = section("definitions");
+    if (!definitions || definitions->value.IsNull())
+    {
+      return;
+    }
+    for (const MapEntry& entry : syntax::mapEntries(definitions->value, definitions->line, "",
+           "the definitions section", Report, "definition"))
+    {
+      const std::string entityText = entity("definition", entry.key);
+      if (!syntax::isIdentifier(entry.key))
+      {
+        fail(entry.line, entityText,
+          "definition names may contain letters, digits and '_' and must start with a "
+          "letter or '_' (they are used in expressions)");
+      }
+      if (ExpressionEvaluator::isReserved(entry.key) || isMachineName(entry.key))
+      {
+        fail(entry.line, entityText,
+          "'" + entry.key + "' is a built-in constant, function or machine value; choose "
+                            "another name");
+      }
+      const auto& parameters = Evaluator.names();
+      if (std::find(parameters.begin(), parameters.end(), entry.key) != parameters.end())
+      {
+        fail(entry.line, entityText, "a parameter has this name already");
+      }
+      if (!entry.value.IsScalar())
+      {
+        fail(entry.line, entityText, "expected an expression (a number or a quoted formula)");
+      }
+      DefinitionIndex[entry.key] = static_cast<int>(DefinitionEntries.size());
+      DefinitionEntries.push_back(entry);
+    }
+    DefinitionState.assign(DefinitionEntries.size(), 0);
+  }
+
+  void ensureDefinition(int index)
+  {
+    if (DefinitionState[index] == 2)
+    {
+      return;
+    }
+    const MapEntry& entry = DefinitionEntries[index];
+    const std::string entityText = entity("definition", entry.key);
+    if (DefinitionState[index] == 1)
+    {
+      fail(entry.line, entityText,
+        "is defined in terms of itself: " + resolvingChain("definition '" + entry.key + "'"));
+    }
+    DefinitionState[index] = 1;
+    Resolving.push_back("definition '" + entry.key + "'");
+    const double value = number(entry.value, entry.line, entityText, "");
+    Resolving.pop_back();
+    DefinitionState[index] = 2;
+    Evaluator.define(entry.key, value);
   }
 
   void ensureVertex(int index)
@@ -1831,8 +1963,7 @@ private:
 
   void readCarrier(const MapEntry& entry, const std::string& entityText, int index, Carrier& carrier)
   {
-    static const std::vector<std::string> kinds = { "interpolate", "revolve", "gordon",
-      "network", "coons", "surface_curve", "intersect" };
+    const std::vector<std::string>& kinds = carrierKindNames();
     if (!entry.value.IsMap())
     {
       fail(entry.line, entityText,
@@ -2153,6 +2284,28 @@ private:
       return;
     }
 
+    if (kind->key == "offset")
+    {
+      syntax::checkKeys(keys, { "offset", "on", "distance" }, entityText, Report);
+      carrier.kind = Carrier::Kind::Offset;
+      const MapEntry* on = syntax::findEntry(keys, "on");
+      const MapEntry* distance = syntax::findEntry(keys, "distance");
+      if (!on || !distance)
+      {
+        fail(entry.line, entityText,
+          "offset needs 'on: <surface the curve lies on>' and 'distance: <length>', e.g. "
+          "{offset: blade_hub, on: hub, distance: 0.01}");
+      }
+      carrier.refs = { carrierRef(kind->value, kind->line, entityText, "offset", Want::Curve),
+        carrierRef(on->value, on->line, entityText, "on", Want::Surface) };
+      carrier.distance = number(distance->value, distance->line, entityText, "distance");
+      if (carrier.distance == 0.0)
+      {
+        fail(distance->line, entityText, "the offset distance must not be zero");
+      }
+      return;
+    }
+
     // intersect
     syntax::checkKeys(keys, { "intersect", "range", "samples" }, entityText, Report);
     carrier.kind = Carrier::Kind::Intersect;
@@ -2278,47 +2431,42 @@ private:
     return fromCylindrical(axial, radius, theta);
   }
 
-  /// The value of a quantity at a point: x, y, z, axial, radius, theta.
-  double quantity(const std::string& which, const Vec3& p) const
+  /// The values x, y, z, axial, radius, theta of a point, in that order.
+  void pointVariables(const Vec3& p, double* values) const
   {
-    double axial = 0.0, radius = 0.0, theta = 0.0;
-    cylindrical(p, axial, radius, theta);
-    if (which == "x")
-      return p.x();
-    if (which == "y")
-      return p.y();
-    if (which == "z")
-      return p.z();
-    if (which == "axial")
-      return axial;
-    if (which == "radius")
-      return radius;
-    return theta;
+    values[0] = p.x();
+    values[1] = p.y();
+    values[2] = p.z();
+    cylindrical(p, values[3], values[4], values[5]);
   }
 
-  /// Parameter u of curve `carrier` where `which` is smallest (sign = 1) or largest (-1):
-  /// a sample of 512 points, then golden-section search in the bracketing interval.
-  double extremum(int carrier, const std::string& which, double sign)
+  /// Parameter u of curve `carrier` in [from, to] (which may pass the seam of a closed
+  /// curve) where `value` is smallest (sign = 1) or largest (-1): a sample of 512 points,
+  /// then golden-section search in the bracketing interval.
+  double extremum(int carrier, const std::function<double(const Vec3&)>& value, double sign,
+    double from, double to)
   {
     const int samples = 512;
     const bool closed = Geometry.closedS(carrier);
-    auto f = [&](double u) { return sign * quantity(which, Geometry.point(carrier, u)); };
+    auto f = [&](double u) { return sign * value(Geometry.point(carrier, u)); };
+    auto at = [&](int k) { return from + (to - from) * static_cast<double>(k) / samples; };
     int best = 0;
-    double bestValue = f(0.0);
+    double bestValue = f(from);
     for (int k = 1; k <= samples; ++k)
     {
-      const double value = f(static_cast<double>(k) / samples);
-      if (value < bestValue)
+      const double v = f(at(k));
+      if (v < bestValue)
       {
-        bestValue = value;
+        bestValue = v;
         best = k;
       }
     }
-    double a = static_cast<double>(best - 1) / samples, b = static_cast<double>(best + 1) / samples;
-    if (!closed)
+    const bool whole = closed && to - from >= 1.0;
+    double a = at(best - 1), b = at(best + 1);
+    if (!whole)
     {
-      a = std::max(a, 0.0);
-      b = std::min(b, 1.0);
+      a = std::max(a, from);
+      b = std::min(b, to);
     }
     const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
     double c = b - ratio * (b - a), d = a + ratio * (b - a);
@@ -2343,13 +2491,13 @@ private:
       }
     }
     double u = 0.5 * (a + b);
-    if (!closed && f(0.0) <= f(u))
+    if (!whole && f(from) <= f(u))
     {
-      u = 0.0;
+      u = from;
     }
-    if (!closed && f(1.0) < f(u))
+    if (!whole && f(to) < f(u))
     {
-      u = 1.0;
+      u = to;
     }
     return closed ? wrapUnit(u) : u;
   }
@@ -2483,6 +2631,85 @@ private:
     return best;
   }
 
+  /// `at: {length: f}`, `at: {min: q}` or `at: {max: q}` (q: x, y, z, axial, radius, theta
+  /// or an expression of them), optionally `within: [u0, u1]`: a parameter of `curve`.
+  double curveParameterQuery(const MapEntry& at, int curve, const std::string& entityText)
+  {
+    const auto how = syntax::mapEntries(at.value, at.line, entityText, "'at'", Report);
+    syntax::checkKeys(how, { "length", "min", "max", "within" }, entityText, Report);
+    const MapEntry* within = syntax::findEntry(how, "within");
+    const MapEntry* length = syntax::findEntry(how, "length");
+    const MapEntry* minimum = syntax::findEntry(how, "min");
+    const MapEntry* maximum = syntax::findEntry(how, "max");
+    if ((length ? 1 : 0) + (minimum ? 1 : 0) + (maximum ? 1 : 0) != 1 || (length && within))
+    {
+      fail(at.line, entityText,
+        "'at' takes one of length, min or max (min and max may add 'within: [u0, u1]')");
+    }
+    if (length)
+    {
+      const double fraction = number(length->value, length->line, entityText, "length");
+      if (fraction < 0.0 || fraction > 1.0)
+      {
+        fail(length->line, entityText, "the length fraction must be in [0, 1]");
+      }
+      return ArcLengthTable(Geometry.curve(curve)).parameterAtFraction(fraction);
+    }
+    const MapEntry& extreme = minimum ? *minimum : *maximum;
+    const bool closed = Geometry.closedS(curve);
+    double from = 0.0, to = 1.0;
+    if (within)
+    {
+      if (!within->value.IsSequence() || within->value.size() != 2)
+      {
+        fail(within->line, entityText, "'within' expects [u0, u1], parameters of the curve");
+      }
+      from = number(within->value[0], within->line, entityText, "within u0");
+      to = number(within->value[1], within->line, entityText, "within u1");
+      const bool ordered = to > from;
+      if (!ordered || (closed && to - from > 1.0) || (!closed && (from < 0.0 || to > 1.0)))
+      {
+        fail(within->line, entityText,
+          "'within: [" + shortNumber(from) + ", " + shortNumber(to) + "]' must have u0 < u1 " +
+            (closed ? std::string("and span at most the whole closed curve (1)")
+                    : std::string("inside the curve's parameter range [0, 1]")));
+      }
+    }
+    double variables[6] = {};
+    std::function<double()> objective;
+    static const std::vector<std::string> quantities = { "x", "y", "z", "axial", "radius",
+      "theta" };
+    const std::string text = extreme.value.IsScalar() ? extreme.value.Scalar() : std::string();
+    const auto named = std::find(quantities.begin(), quantities.end(), text);
+    if (named != quantities.end())
+    {
+      const std::size_t index = static_cast<std::size_t>(named - quantities.begin());
+      objective = [&variables, index]() { return variables[index]; };
+    }
+    else
+    {
+      if (!extreme.value.IsScalar())
+      {
+        fail(extreme.line, entityText,
+          extreme.key + ": expected a quantity (x y z axial radius theta) or an expression "
+                        "of them");
+      }
+      try
+      {
+        objective = Evaluator.pointFunction(text, variables);
+      }
+      catch (const ExpressionError& error)
+      {
+        fail(extreme.line, entityText, extreme.key + ": " + error.message);
+      }
+    }
+    auto value = [&](const Vec3& p) {
+      pointVariables(p, variables);
+      return objective();
+    };
+    return extremum(curve, value, extreme.key == "min" ? 1.0 : -1.0, from, to);
+  }
+
   void readVertexV2(const MapEntry& entry, const std::string& entityText, Vertex& vertex)
   {
     if (entry.value.IsSequence())
@@ -2531,34 +2758,7 @@ private:
       double u = 0.0;
       if (at->value.IsMap())
       {
-        const auto how = syntax::mapEntries(at->value, at->line, entityText, "'at'", Report);
-        syntax::checkKeys(how, { "length", "min", "max" }, entityText, Report);
-        if (how.size() != 1)
-        {
-          fail(at->line, entityText, "'at' takes one of length, min or max");
-        }
-        if (how[0].key == "length")
-        {
-          const double fraction = number(how[0].value, how[0].line, entityText, "length");
-          if (fraction < 0.0 || fraction > 1.0)
-          {
-            fail(how[0].line, entityText, "the length fraction must be in [0, 1]");
-          }
-          u = ArcLengthTable(Geometry.curve(curve)).parameterAtFraction(fraction);
-        }
-        else
-        {
-          static const std::vector<std::string> quantities = { "x", "y", "z", "axial", "radius",
-            "theta" };
-          const std::string which = name(how[0].value, how[0].line, entityText, how[0].key);
-          if (std::find(quantities.begin(), quantities.end(), which) == quantities.end())
-          {
-            fail(how[0].line, entityText,
-              how[0].key + ": unknown quantity '" + which + "'; use one of " +
-                syntax::joinNames(quantities));
-          }
-          u = extremum(curve, which, how[0].key == "min" ? 1.0 : -1.0);
-        }
+        u = curveParameterQuery(*at, curve, entityText);
       }
       else
       {
@@ -2924,7 +3124,9 @@ private:
   std::map<std::string, BoundInput> BoundInputs;
   CarrierGeometry Geometry;
   std::vector<MapEntry> CarrierEntries, VertexEntries;
-  std::vector<int> CarrierState, VertexState; // 0 pending, 1 in progress, 2 done
+  std::vector<MapEntry> DefinitionEntries;
+  std::map<std::string, int> DefinitionIndex;
+  std::vector<int> CarrierState, VertexState, DefinitionState; // 0 pending, 1 in progress, 2 done
   std::vector<std::string> Resolving;         // entities being resolved, for cycles
   syntax::Reporter Report;
   ExpressionEvaluator Evaluator;
