@@ -1164,6 +1164,12 @@ std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
   {
     throw GeometryError("offset on a surface: the distance must be finite and not zero");
   }
+  if (closed && (curve.point(0.0) - curve.point(1.0)).norm() >
+      1e-9 * std::max({ (curve.point(0.5) - curve.point(0.0)).norm(), 1e-300 }))
+  {
+    throw GeometryError("offset on a surface: the curve is said to be closed but its ends "
+                        "do not meet");
+  }
   constexpr int InitialSteps = 512;
   constexpr std::size_t MaxSamples = 65536;
   const double turnLimit = std::cos(3.0 * std::acos(-1.0) / 180.0);

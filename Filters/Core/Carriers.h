@@ -219,7 +219,10 @@ using SurfaceParameterFunction = std::function<Eigen::Vector2d(const Vec3& p)>;
  * O-grid around a blade section on the hub): for each sample u of the curve, the point
  * P(u) + distance * n(u), where n = N x T / |N x T| is the unit normal of the curve in the
  * surface's tangent plane (N the surface normal Ps x Pt at P, T the curve tangent),
- * mapped back onto the surface by `toParameters`. Returns the offset as (s, t) points of
+ * mapped back onto the surface by `toParameters`. The distance is thus measured in the
+ * tangent plane: on a surface curved across the curve (a hub of radius r offset along
+ * theta) the offset lies r atan(distance / r) away along the surface, 1 % short for
+ * distance = r / 6. Returns the offset as (s, t) points of
  * the surface, in the order of u, to be interpolated (SurfaceCurve).
  *
  * `closed` curves (P(0) == P(1)) are offset outwards for distance > 0, whatever their
@@ -229,12 +232,14 @@ using SurfaceParameterFunction = std::function<Eigen::Vector2d(const Vec3& p)>;
  *
  * Sampling starts with 512 equal steps of u and halves every step across which the normal
  * turns by more than 3 degrees, so a leading edge whose radius is 1e-3 of the curve's
- * length is followed closely (at most 65536 samples). Deterministic.
+ * length is followed closely (up to 16 halvings per step and about 65536 samples in all;
+ * past that the remaining steps are not refined). Deterministic.
  *
- * Throws GeometryError when |distance| is zero, not finite or at least the radius of
- * curvature of the curve on the side it is offset to (the offset would fold back:
- * consecutive offset points run against the curve), naming the parameter u where it
- * folds; and when the tangent or the surface normal vanish.
+ * Throws GeometryError when |distance| is zero or not finite, when a `closed` curve's ends
+ * do not meet, when the offset folds back between two samples (|distance| above the
+ * radius of curvature on the side it is offset to: consecutive offset points run against
+ * the curve), naming the parameter u where it folds, and when the tangent or the surface
+ * normal vanish.
  */
 std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
   const Surface& surface, const SurfaceParameterFunction& toParameters, double distance);

@@ -2631,6 +2631,75 @@ private:
     return best;
   }
 
+  /// Parameters (s, t) of the point of a surface of revolution about the machine axis at
+  /// the given axial position and angle theta: the contour's first crossing of the axial
+  /// plane (bisection to rounding), then the exact meridional projection.
+  void onRevolutionAt(int surface, double axial, double theta, const std::string& entityText,
+    int line, double& s, double& t)
+  {
+    const SurfaceOfRevolution* revolution = Geometry.revolution(surface);
+    const Machine& machine = Model.machine;
+    if (!revolution || (revolution->axisDirection() - machine.axis).norm() > 1e-12)
+    {
+      fail(line, entityText,
+        "'axial' and 'theta' place a vertex on a surface of revolution about the machine "
+        "axis; '" + Model.carriers[surface].name + "' is not one");
+    }
+    auto f = [&](double u) {
+      double a = 0.0, r = 0.0, th = 0.0;
+      cylindrical(Geometry.point(surface, u, 0.5), a, r, th);
+      return a - axial;
+    };
+    const int samples = 256;
+    double a = 0.0, fa = f(0.0);
+    bool found = fa == 0.0;
+    double root = 0.0;
+    for (int k = 1; k <= samples && !found; ++k)
+    {
+      const double b = static_cast<double>(k) / samples, fb = f(b);
+      if (fb == 0.0)
+      {
+        root = b;
+        found = true;
+      }
+      else if ((fa < 0.0) != (fb < 0.0))
+      {
+        double low = a, high = b, flow = fa;
+        for (int iteration = 0; iteration < 200 && high - low > 1e-16; ++iteration)
+        {
+          const double middle = 0.5 * (low + high), fm = f(middle);
+          if ((fm < 0.0) == (flow < 0.0))
+          {
+            low = middle;
+            flow = fm;
+          }
+          else
+          {
+            high = middle;
+          }
+        }
+        root = 0.5 * (low + high);
+        found = true;
+      }
+      a = b;
+      fa = fb;
+    }
+    if (!found)
+    {
+      double a0 = 0.0, a1 = 0.0, r = 0.0, th = 0.0;
+      cylindrical(Geometry.point(surface, 0.0, 0.5), a0, r, th);
+      cylindrical(Geometry.point(surface, 1.0, 0.5), a1, r, th);
+      fail(line, entityText,
+        "surface '" + Model.carriers[surface].name + "' does not reach axial = " +
+          shortNumber(axial) + " (its contour spans axial " + shortNumber(std::min(a0, a1)) +
+          " to " + shortNumber(std::max(a0, a1)) + ")");
+    }
+    double ignored = 0.0, radius = 0.0;
+    cylindrical(Geometry.point(surface, root, 0.5), ignored, radius, ignored);
+    double distance = 0.0;
+    Geometry.project(surface, fromCylindrical(axial, radius, theta), s, t, distance);
+  }
+
   /// `at: {length: f}`, `at: {min: q}` or `at: {max: q}` (q: x, y, z, axial, radius, theta
   /// or an expression of them), optionally `within: [u0, u1]`: a parameter of `curve`.
   double curveParameterQuery(const MapEntry& at, int curve, const std::string& entityText)
@@ -2776,6 +2845,27 @@ private:
       constraint.carrier = curve;
       constraint.s = u;
       vertex.position = Geometry.point(curve, u);
+      return;
+    }
+    if (kind->key == "on_surface" && syntax::findEntry(keys, "axial"))
+    {
+      syntax::checkKeys(keys, { "on_surface", "axial", "theta" }, entityText, Report);
+      const int surface =
+        carrierRef(kind->value, kind->line, entityText, "on_surface", Want::Surface);
+      const MapEntry* axialEntry = syntax::findEntry(keys, "axial");
+      const MapEntry* thetaEntry = syntax::findEntry(keys, "theta");
+      if (!thetaEntry)
+      {
+        fail(entry.line, entityText, "on_surface with 'axial' needs 'theta' too");
+      }
+      const double axial = number(axialEntry->value, axialEntry->line, entityText, "axial");
+      const double theta = number(thetaEntry->value, thetaEntry->line, entityText, "theta");
+      double s = 0.0, t = 0.0;
+      onRevolutionAt(surface, axial, theta, entityText, axialEntry->line, s, t);
+      constraint.carrier = surface;
+      constraint.s = s;
+      constraint.t = t;
+      vertex.position = Geometry.point(surface, s, t);
       return;
     }
     if (kind->key == "on_surface")

@@ -1021,3 +1021,348 @@ TEST(Carriers, EvaluationDoesNotAllocate)
   EXPECT_EQ(AllocationCount.load() - before, 0);
   EXPECT_TRUE(std::isfinite(sink));
 }
+
+// ---------------------------------------------------------------------------------------
+// Offsets of curves within a surface
+
+namespace
+{
+/// Full ellipse (a cos phi, b sin phi, 0) about the origin, phi = 2 pi direction u
+/// (direction -1: clockwise). u is wrapped into [0, 1) first, so P(1) == P(0) bit for bit.
+class EllipseCurve : public Curve
+{
+public:
+  EllipseCurve(double a, double b, double direction = 1.0)
+    : A(a)
+    , B(b)
+    , Omega(2 * Pi * direction)
+  {
+  }
+  Vec3 point(double u) const override
+  {
+    const double phi = angle(u);
+    return Vec3(A * std::cos(phi), B * std::sin(phi), 0.0);
+  }
+  Vec3 derivative(double u, int order = 1) const override
+  {
+    const double phi = angle(u);
+    switch (order)
+    {
+      case 1:
+        return Omega * Vec3(-A * std::sin(phi), B * std::cos(phi), 0.0);
+      case 2:
+        return Omega * Omega * Vec3(-A * std::cos(phi), -B * std::sin(phi), 0.0);
+      default:
+        return Vec3::Zero();
+    }
+  }
+  double angle(double u) const { return Omega * (u - std::floor(u)); }
+
+private:
+  double A, B, Omega;
+};
+
+/// The square [-2, 2]^2 of the plane z = 0 as a Coons patch: P(s, t) = (4s - 2, 4t - 2, 0).
+std::shared_ptr<const CoonsPatch> squarePlane()
+{
+  const Vec3 c00(-2, -2, 0), c10(2, -2, 0), c01(-2, 2, 0), c11(2, 2, 0);
+  return std::make_shared<CoonsPatch>(std::make_shared<LineCurve>(c00, c10),
+    std::make_shared<LineCurve>(c10, c11), std::make_shared<LineCurve>(c01, c11),
+    std::make_shared<LineCurve>(c00, c01));
+}
+
+Eigen::Vector2d squarePlaneParameters(const Vec3& p)
+{
+  return Eigen::Vector2d((p.x() + 2) / 4, (p.y() + 2) / 4);
+}
+
+/// Distance of q (in z = 0) from the ellipse (a cos phi, b sin phi): dense sampling, then
+/// Newton on (E(phi) - q) . E'(phi) = 0.
+double distanceToEllipse(const Vec3& q, double a, double b)
+{
+  auto e = [&](double phi) { return Vec3(a * std::cos(phi), b * std::sin(phi), 0.0); };
+  const int n = 4096;
+  double phi = 0, best = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < n; ++i)
+  {
+    const double trial = 2 * Pi * i / n;
+    const double d = (e(trial) - q).norm();
+    if (d < best)
+    {
+      best = d;
+      phi = trial;
+    }
+  }
+  for (int iteration = 0; iteration < 50; ++iteration)
+  {
+    const Vec3 d1(-a * std::sin(phi), b * std::cos(phi), 0.0);
+    const Vec3 d2(-a * std::cos(phi), -b * std::sin(phi), 0.0);
+    const Vec3 r = e(phi) - q;
+    const double step = r.dot(d1) / (d1.dot(d1) + r.dot(d2));
+    phi -= step;
+    if (std::abs(step) < 1e-15)
+    {
+      break;
+    }
+  }
+  return std::min(best, (e(phi) - q).norm());
+}
+
+/// Largest angle (degrees) between consecutive chords of a polyline of (s, t) points.
+double largestChordTurn(const std::vector<Eigen::Vector2d>& st)
+{
+  double worst = 0;
+  for (std::size_t k = 2; k < st.size(); ++k)
+  {
+    const Eigen::Vector2d a = st[k - 1] - st[k - 2], b = st[k] - st[k - 1];
+    const double c = std::clamp(a.dot(b) / (a.norm() * b.norm()), -1.0, 1.0);
+    worst = std::max(worst, std::acos(c) * 180 / Pi);
+  }
+  return worst;
+}
+
+/// Signed area of a closed polyline of (s, t) points (> 0: counterclockwise).
+double signedArea(const std::vector<Eigen::Vector2d>& st)
+{
+  double area = 0;
+  for (std::size_t k = 1; k < st.size(); ++k)
+  {
+    area += st[k - 1].x() * st[k].y() - st[k].x() * st[k - 1].y();
+  }
+  return 0.5 * area;
+}
+} // namespace
+
+TEST(OffsetOnSurface, CircleOnPlaneOutwardWhateverOrientationAndInward)
+{
+  const auto plane = squarePlane();
+  for (double direction : { 1.0, -1.0 })
+  {
+    const EllipseCurve circle(1.0, 1.0, direction);
+    ASSERT_EQ(circle.point(0.0), circle.point(1.0));
+    for (double distance : { 0.2, -0.2 })
+    {
+      const double expected = 1.0 + distance; // > 0 outwards for closed curves
+      const auto st =
+        offsetOnSurface(circle, true, *plane, squarePlaneParameters, distance);
+      // The normal turns by 360/512 degrees per step: no refinement, one point per step.
+      ASSERT_EQ(st.size(), 513u) << direction << ", " << distance;
+      EXPECT_EQ(st.front(), st.back()) << "the loop closes exactly";
+      double worstRadius = 0, worstPoint = 0;
+      for (std::size_t k = 0; k < st.size(); ++k)
+      {
+        const Vec3 p = plane->point(st[k].x(), st[k].y());
+        worstRadius = std::max(worstRadius, std::abs(radiusAboutZ(p) - expected));
+        // In the order of u: the k-th sample of the circle pushed along its radius.
+        const double phi = circle.angle(k / 512.0);
+        const Vec3 exact(expected * std::cos(phi), expected * std::sin(phi), 0.0);
+        worstPoint = std::max(worstPoint, maxError(p, exact));
+      }
+      EXPECT_LT(worstRadius, 1e-9 * expected) << direction << ", " << distance;
+      EXPECT_LT(worstPoint, 1e-9) << direction << ", " << distance;
+      // Same orientation as the curve (the plane maps (x, y) to (s, t) preserving it).
+      EXPECT_GT(signedArea(st) * direction, 0.0);
+      std::printf("circle direction %+.0f, distance %+.1f: %zu points, radius error %.2e, "
+                  "point error %.2e\n",
+        direction, distance, st.size(), worstRadius, worstPoint);
+    }
+  }
+}
+
+TEST(OffsetOnSurface, SurfaceCurveThroughCircleOffsetKeepsTheRadius)
+{
+  const auto plane = squarePlane();
+  const EllipseCurve circle(1.0, 1.0);
+  const SurfaceCurve curve(
+    plane, offsetOnSurface(circle, true, *plane, squarePlaneParameters, 0.2));
+  for (double u : { 0.1, 0.37, 0.8 })
+  {
+    EXPECT_NEAR(radiusAboutZ(curve.point(u)), 1.2, 1e-6) << u;
+    EXPECT_EQ(curve.point(u).z(), 0.0);
+  }
+  double worst = 0;
+  for (int i = 0; i <= 4000; ++i)
+  {
+    worst = std::max(worst, std::abs(radiusAboutZ(curve.point(i / 4000.0)) - 1.2));
+  }
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_EQ(curve.point(0.0), curve.point(1.0));
+  std::printf("surface curve through the offset circle: radius error %.2e\n", worst);
+}
+
+TEST(OffsetOnSurface, CircularArcOnCylinderMovesAxially)
+{
+  const double radius = 0.5, z0 = 0.3;
+  const SurfaceOfRevolution cylinder(
+    std::make_shared<LineCurve>(Vec3(radius, 0, -1), Vec3(radius, 0, 1)), Vec3::Zero(),
+    Vec3::UnitZ(), -Pi, Pi);
+  const SurfaceParameterFunction toParameters = [&cylinder](const Vec3& p) {
+    return Eigen::Vector2d(
+      cylinder.contourParameter(p), (std::atan2(p.y(), p.x()) + Pi) / (2 * Pi));
+  };
+  for (double sense : { 1.0, -1.0 })
+  {
+    // The arc theta = sense * (2u - 1) at z = 0.3 (open).
+    const FunctionCurve arc([=](double u, int order) {
+      const double theta = sense * (2 * u - 1), w = 2 * sense;
+      switch (order)
+      {
+        case 0:
+          return Vec3(radius * std::cos(theta), radius * std::sin(theta), z0);
+        case 1:
+          return Vec3(-w * radius * std::sin(theta), w * radius * std::cos(theta), 0.0);
+        default:
+          return Vec3(-w * w * radius * std::cos(theta), -w * w * radius * std::sin(theta), 0.0);
+      }
+    });
+    // n = N x T with N = Ps x Pt, at the middle of the arc: axial, its sign is the side.
+    const Vec3 middle = arc.point(0.5);
+    const Eigen::Vector2d stMiddle = toParameters(middle);
+    EXPECT_LT(maxError(cylinder.point(stMiddle.x(), stMiddle.y()), middle), 1e-12);
+    SurfaceDerivatives d;
+    cylinder.derivatives(stMiddle.x(), stMiddle.y(), d);
+    const Vec3 n = d.Ps.cross(d.Pt).cross(arc.derivative(0.5)).normalized();
+    EXPECT_LT(maxError(n, Vec3(0, 0, n.z() > 0 ? 1 : -1)), 1e-14);
+    for (double distance : { 0.2, -0.2, 0.05 })
+    {
+      const double expectedZ = z0 + distance * n.z();
+      const auto st = offsetOnSurface(arc, false, cylinder, toParameters, distance);
+      ASSERT_EQ(st.size(), 513u); // 2 rad in 512 steps: no refinement
+      double worstZ = 0, worstRadius = 0, worstAngle = 0;
+      for (std::size_t k = 0; k < st.size(); ++k)
+      {
+        const Vec3 p = cylinder.point(st[k].x(), st[k].y());
+        worstZ = std::max(worstZ, std::abs(p.z() - expectedZ));
+        worstRadius = std::max(worstRadius, std::abs(radiusAboutZ(p) - radius));
+        // Straight up or down: the angle of the k-th sample of the arc.
+        const double theta = sense * (2 * (k / 512.0) - 1);
+        worstAngle = std::max(worstAngle, std::abs(std::atan2(p.y(), p.x()) - theta));
+      }
+      EXPECT_LT(worstZ, 1e-9) << sense << ", " << distance;
+      EXPECT_LT(worstRadius, 1e-9 * radius) << sense << ", " << distance;
+      EXPECT_LT(worstAngle, 1e-9) << sense << ", " << distance;
+      std::printf("cylinder arc sense %+.0f, distance %+.2f (n.z %+.0f): z error %.2e, radius "
+                  "error %.2e, angle error %.2e\n",
+        sense, distance, n.z(), worstZ, worstRadius, worstAngle);
+    }
+  }
+}
+
+TEST(OffsetOnSurface, EllipseOffsetIsAtTheDistanceAndRefinedAtTheEnds)
+{
+  const auto plane = squarePlane();
+  struct Case
+  {
+    double b, distance;
+  };
+  // b = 0.3: the normal turns by at most (a/b) 360/512 = 2.3 degrees per step (no
+  // refinement needed); b = 0.1: 7 degrees at the ends, where steps are halved.
+  for (const Case c : { Case{ 0.3, 0.05 }, Case{ 0.3, -0.05 }, Case{ 0.1, 0.05 } })
+  {
+    const EllipseCurve ellipse(1.0, c.b);
+    const auto st = offsetOnSurface(ellipse, true, *plane, squarePlaneParameters, c.distance);
+    EXPECT_EQ(st.front(), st.back());
+    double worst = 0;
+    bool allOutside = true, allInside = true;
+    for (const Eigen::Vector2d& x : st)
+    {
+      const Vec3 p = plane->point(x.x(), x.y());
+      worst = std::max(worst, std::abs(distanceToEllipse(p, 1.0, c.b) - std::abs(c.distance)));
+      const double level = std::pow(p.x(), 2) + std::pow(p.y() / c.b, 2);
+      allOutside = allOutside && level > 1;
+      allInside = allInside && level < 1;
+    }
+    EXPECT_LT(worst, 1e-9) << c.b << ", " << c.distance;
+    EXPECT_TRUE(c.distance > 0 ? allOutside : allInside) << c.b << ", " << c.distance;
+    // Consecutive offset chords turn as the normal does: within about 3 degrees.
+    const double turn = largestChordTurn(st);
+    EXPECT_LT(turn, 3.0) << c.b << ", " << c.distance;
+    if (c.b < 0.2)
+    {
+      EXPECT_GT(st.size(), 513u) << "refined at the sharp ends";
+    }
+    else
+    {
+      EXPECT_EQ(st.size(), 513u);
+    }
+    std::printf("ellipse b = %.1f, distance %+.2f: %zu points, distance error %.2e, largest "
+                "chord turn %.2f deg\n",
+      c.b, c.distance, st.size(), worst, turn);
+  }
+}
+
+TEST(OffsetOnSurface, InvalidDistanceAndFoldingBackThrow)
+{
+  const auto plane = squarePlane();
+  const EllipseCurve ellipse(1.0, 0.3);
+  for (double distance : { 0.0, -0.0, std::numeric_limits<double>::quiet_NaN(),
+         std::numeric_limits<double>::infinity() })
+  {
+    EXPECT_THROW(offsetOnSurface(ellipse, true, *plane, squarePlaneParameters, distance),
+      GeometryError)
+      << distance;
+  }
+  // The smallest radius of curvature is b^2 / a = 0.09 (at u = 0 and 0.5): inwards by 0.2
+  // the offset folds back there; outwards it does not.
+  try
+  {
+    offsetOnSurface(ellipse, true, *plane, squarePlaneParameters, -0.2);
+    FAIL() << "folding back expected";
+  }
+  catch (const GeometryError& e)
+  {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("folds back"), std::string::npos) << message;
+    const std::size_t at = message.find("u = ");
+    ASSERT_NE(at, std::string::npos) << message;
+    const double u = std::atof(message.c_str() + at + 4);
+    // Where the radius of curvature is below 0.2: |phi| < 0.27 about either end.
+    const double fromEnd = std::min({ u, std::abs(u - 0.5), 1 - u });
+    EXPECT_LT(fromEnd, 0.27 / (2 * Pi)) << message;
+  }
+  EXPECT_NO_THROW(offsetOnSurface(ellipse, true, *plane, squarePlaneParameters, 0.2));
+}
+
+TEST(OffsetOnSurface, Deterministic)
+{
+  const auto plane = squarePlane();
+  const EllipseCurve ellipse(1.0, 0.1, -1.0);
+  const auto first = offsetOnSurface(ellipse, true, *plane, squarePlaneParameters, 0.05);
+  const auto second = offsetOnSurface(ellipse, true, *plane, squarePlaneParameters, 0.05);
+  ASSERT_EQ(first.size(), second.size());
+  EXPECT_TRUE(first == second);
+  EXPECT_GT(first.size(), 513u);
+}
+
+TEST(OffsetOnSurface, OpenCurveCalledClosedIsAnError)
+{
+  // Three quarters of a circle: its ends are sqrt(2) apart, so "closed" is wrong.
+  class ThreeQuarters : public Curve
+  {
+  public:
+    Vec3 point(double u) const override
+    {
+      return Vec3(std::cos(1.5 * Pi * u), std::sin(1.5 * Pi * u), 0.0);
+    }
+    Vec3 derivative(double u, int = 1) const override
+    {
+      return 1.5 * Pi * Vec3(-std::sin(1.5 * Pi * u), std::cos(1.5 * Pi * u), 0.0);
+    }
+  } arc;
+  const auto plane = squarePlane();
+  try
+  {
+    offsetOnSurface(arc, true, *plane, squarePlaneParameters, 0.1);
+    FAIL() << "an open curve passed as closed must be refused";
+  }
+  catch (const GeometryError& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("ends do not meet"), std::string::npos) << e.what();
+  }
+  const auto open = offsetOnSurface(arc, false, *plane, squarePlaneParameters, 0.1);
+  for (const Eigen::Vector2d& st : open)
+  {
+    const double r = std::hypot(4 * st[0] - 2, 4 * st[1] - 2);
+    EXPECT_TRUE(std::abs(r - 1.1) < 1e-12 || std::abs(r - 0.9) < 1e-12) << r;
+  }
+}

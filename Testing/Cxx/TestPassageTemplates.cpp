@@ -409,14 +409,12 @@ TEST(PassageTemplates, AxialPassageHDistributor)
   report("axial_passage_h", dataSets()[1], checkPassage("axial_passage_h", dataSets()[1]));
 }
 
-// axial_passage_oh is work in progress: everything but "no inverted cell" holds on both data
-// sets; run with --gtest_also_run_disabled_tests to see which blocks still fold.
-TEST(PassageTemplates, DISABLED_AxialPassageOHRotor37)
+TEST(PassageTemplates, AxialPassageOHRotor37)
 {
   report("axial_passage_oh", dataSets()[0], checkPassage("axial_passage_oh", dataSets()[0]));
 }
 
-TEST(PassageTemplates, DISABLED_AxialPassageOHDistributor)
+TEST(PassageTemplates, AxialPassageOHDistributor)
 {
   report("axial_passage_oh", dataSets()[1], checkPassage("axial_passage_oh", dataSets()[1]));
 }
