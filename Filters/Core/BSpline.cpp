@@ -458,8 +458,39 @@ BSplineCurve BSplineCurve::interpolate(const std::vector<Vec3>& points, int degr
     }
   }
 
+  return interpolateAt(points, bspline::interpolationParameters(points, method), degree);
+}
+
+BSplineCurve BSplineCurve::interpolateAt(const std::vector<Vec3>& points,
+  const std::vector<double>& parameters, int degree)
+{
+  const int count = static_cast<int>(points.size());
+  if (count < 2)
+  {
+    throw GeometryError("curve interpolation needs at least 2 points, got " +
+      std::to_string(count));
+  }
+  requireDegree(degree, "curve interpolation");
+  requireFinitePoints(points, "curve interpolation");
+  if (parameters.size() != points.size())
+  {
+    throw GeometryError("curve interpolation: " + std::to_string(parameters.size()) +
+      " parameters for " + std::to_string(count) + " points");
+  }
+  if (parameters.front() != 0.0 || parameters.back() != 1.0)
+  {
+    throw GeometryError("curve interpolation: the parameters must run from 0 to 1");
+  }
+  for (int i = 1; i < count; ++i)
+  {
+    if (!(parameters[i] > parameters[i - 1]))
+    {
+      throw GeometryError("curve interpolation: the parameters must increase strictly (" +
+        std::to_string(parameters[i - 1]) + " then " + std::to_string(parameters[i]) + ")");
+    }
+  }
   const int usedDegree = std::min(degree, count - 1);
-  std::vector<double> params = bspline::interpolationParameters(points, method);
+  std::vector<double> params = parameters;
   std::vector<double> knots = bspline::averagedKnots(params, usedDegree);
 
   Eigen::MatrixXd rhs(count, 3);

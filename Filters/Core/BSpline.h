@@ -60,6 +60,16 @@ public:
   static BSplineCurve interpolate(const std::vector<Vec3>& points, int degree = 3,
     ParameterMethod method = ParameterMethod::ChordLength);
 
+  /**
+   * Global interpolation at given parameters: the curve passes through points[k] at
+   * parameters[k] (strictly increasing from 0 to 1, one per point). Used to give curves a
+   * common parametrisation (blade sections with the leading edge at 0 and the trailing
+   * edge at 0.5). Throws GeometryError as interpolate() does, and for parameters that are
+   * not one per point, not strictly increasing or not from 0 to 1.
+   */
+  static BSplineCurve interpolateAt(const std::vector<Vec3>& points,
+    const std::vector<double>& parameters, int degree = 3);
+
   Vec3 point(double t) const override;
   Vec3 derivative(double t, int order = 1) const override;
   /// Point and derivatives up to `order`: out[0] = P(t), out[k] = d^k P / dt^k.

@@ -59,7 +59,8 @@ struct Carrier
 {
   enum class Kind
   {
-    Interpolate,  ///< curve: B-spline through `points` (degree, parameter method)
+    Interpolate,  ///< curve: B-spline through `points` (degree, parameter method, or
+                  ///< explicit parameters `nodes` when not empty)
     Revolve,      ///< surface: refs[0] (a curve) swept about axis, t -> angleStart..angleEnd
     Gordon,       ///< surface: lofted through section curves refs at t = nodes (eqs. 4-5)
     Network,      ///< surface: Gordon through s-curves refs at t = nodes and t-curves

@@ -267,8 +267,10 @@ void CarrierGeometry::buildEntry(const BlockModel& model, int index, int depth)
           ? ParameterMethod::Uniform
           : carrier.parameterMethod == 2 ? ParameterMethod::Centripetal
                                          : ParameterMethod::ChordLength;
-        built.curve = std::make_shared<BSplineCurve>(
-          BSplineCurve::interpolate(carrier.points, carrier.degree, method));
+        // Explicit parameters (nodes) give sections a common parametrisation (align).
+        built.curve = std::make_shared<BSplineCurve>(carrier.nodes.empty()
+            ? BSplineCurve::interpolate(carrier.points, carrier.degree, method)
+            : BSplineCurve::interpolateAt(carrier.points, carrier.nodes, carrier.degree));
         built.closedS = carrier.points.size() > 2 && carrier.points.front() == carrier.points.back();
         break;
       }

@@ -829,6 +829,10 @@ std::string writeModelDocument(const BlockModel& model)
             emitVector(out, point);
           }
           out << YAML::EndSeq;
+          if (!carrier.nodes.empty())
+          {
+            numberList("at", carrier.nodes);
+          }
           break;
         case Carrier::Kind::Revolve:
           refList("refs", carrier.refs);

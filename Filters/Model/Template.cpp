@@ -2102,7 +2102,8 @@ private:
     if (kind->key == "gordon" || kind->key == "network")
     {
       syntax::checkKeys(keys,
-        { kind->key, "blending", "at", "closed", "degree", "parameters" }, entityText, Report);
+        { kind->key, "blending", "at", "closed", "align", "degree", "parameters" }, entityText,
+        Report);
       carrier.kind = kind->key == "gordon" ? Carrier::Kind::Gordon : Carrier::Kind::Network;
       carrier.blending = Carrier::Blending::Spline;
       if (const MapEntry* blending = syntax::findEntry(keys, "blending"))
@@ -2119,6 +2120,20 @@ private:
         }
       }
       carrier.closed = flag(keys, "closed", false, entityText);
+      const MapEntry* align = syntax::findEntry(keys, "align");
+      if (align)
+      {
+        const std::string how = name(align->value, align->line, entityText, "align");
+        if (how != "axial")
+        {
+          fail(align->line, entityText, "align: expected 'axial', got '" + how + "'");
+        }
+        if (!carrier.closed || kind->key != "gordon" || kind->value.IsSequence())
+        {
+          fail(align->line, entityText,
+            "align needs closed: true and sections from an input (a blade)");
+        }
+      }
       Carrier sectionTemplate;
       sectionTemplate.kind = Carrier::Kind::Interpolate;
       sectionTemplate.where = carrier.where;
@@ -2160,7 +2175,17 @@ private:
             }
             try
             {
+              if (align)
+              {
+                alignSection(section);
+              }
               carrier.refs.push_back(addHiddenCarrier(section));
+            }
+            catch (const GeometryError& error)
+            {
+              fail(here, entityText,
+                "section " + std::to_string(k + 1) + " of input '" + source + "': " +
+                  error.what());
             }
             catch (const TemplateError& error)
             {
@@ -2340,6 +2365,88 @@ private:
     }
   }
 
+  /**
+   * `align: axial`: re-parametrises a closed section so that s = 0.25 is its leading edge
+   * (the smallest axial coordinate) and s = 0.75 its trailing edge (the largest), by chord
+   * length between them and the seam s = 0 (half-way along the second side). Every section of the blade then has its edges at the same s, so lines of
+   * constant s on the Gordon surface follow the edges from hub to shroud, and so do block
+   * edges straight in the blade's (s, t) space.
+   */
+  void alignSection(Carrier& section)
+  {
+    const ParameterMethod method = section.parameterMethod == 0 ? ParameterMethod::Uniform
+      : section.parameterMethod == 2                          ? ParameterMethod::Centripetal
+                                                              : ParameterMethod::ChordLength;
+    const BSplineCurve curve = BSplineCurve::interpolate(section.points, section.degree, method);
+    auto point = [&](double u) { return curve.point(u); };
+    auto axialOf = [&](const Vec3& p) {
+      double axial = 0.0, radius = 0.0, theta = 0.0;
+      cylindrical(p, axial, radius, theta);
+      return axial;
+    };
+    const double leading = extremum(point, true, axialOf, 1.0, 0.0, 1.0);
+    const double trailing = extremum(point, true, axialOf, -1.0, 0.0, 1.0);
+    const std::vector<double>& u = curve.dataParameters(); // u[0] = 0 ... u[n-1] = 1
+    const std::size_t n = u.size() - 1;                    // distinct points (closed loop)
+    // The data points strictly between two parameters (cyclic), leaving out those closer
+    // to an end than a quarter of their neighbouring data spacing (no sliver segments).
+    auto between = [&](double from, double to, std::vector<Vec3>& out) {
+      const double span = to > from ? to - from : to + 1.0 - from;
+      std::vector<std::pair<double, std::size_t>> inside;
+      for (std::size_t k = 0; k < n; ++k)
+      {
+        double offset = u[k] - from;
+        offset -= std::floor(offset);
+        const double before = k > 0 ? u[k] - u[k - 1] : u[n] - u[n - 1];
+        const double after = u[k + 1] - u[k];
+        if (offset >= 0.25 * before && span - offset >= 0.25 * after && offset < span)
+        {
+          inside.emplace_back(offset, k);
+        }
+      }
+      std::sort(inside.begin(), inside.end());
+      for (const auto& item : inside)
+      {
+        out.push_back(section.points[item.second]);
+      }
+    };
+    // Start (the seam) half-way along the side from the trailing to the leading edge, so
+    // that neither edge lies on the seam, where the curves through the blade are only C0.
+    const double back = trailing + 0.5 * (leading - trailing - std::floor(leading - trailing));
+    const double seam = back - std::floor(back);
+    std::vector<Vec3> points{ curve.point(seam) };
+    between(seam, leading, points);
+    const std::size_t leadingIndex = points.size();
+    points.push_back(curve.point(leading));
+    between(leading, trailing, points);
+    const std::size_t trailingIndex = points.size();
+    points.push_back(curve.point(trailing));
+    between(trailing, seam, points);
+    points.push_back(points.front());
+    std::vector<double> length(points.size(), 0.0);
+    for (std::size_t k = 1; k < points.size(); ++k)
+    {
+      length[k] = length[k - 1] + (points[k] - points[k - 1]).norm();
+    }
+    // chord length within each piece: [0, 0.25] seam -> LE, [0.25, 0.75] LE -> TE (one
+    // side), [0.75, 1] TE -> seam
+    const std::size_t ends[4] = { 0, leadingIndex, trailingIndex, points.size() - 1 };
+    const double at[4] = { 0.0, 0.25, 0.75, 1.0 };
+    std::vector<double> parameters(points.size());
+    for (int piece = 0; piece < 3; ++piece)
+    {
+      const double from = length[ends[piece]], to = length[ends[piece + 1]];
+      for (std::size_t k = ends[piece]; k <= ends[piece + 1]; ++k)
+      {
+        parameters[k] = at[piece] + (at[piece + 1] - at[piece]) * (length[k] - from) / (to - from);
+      }
+      parameters[ends[piece + 1]] = at[piece + 1];
+    }
+    parameters.front() = 0.0;
+    section.points = std::move(points);
+    section.nodes = std::move(parameters);
+  }
+
   void checkClosedSection(const std::vector<Vec3>& points, const std::string& entityText,
     int line, const std::string& what)
   {
@@ -2446,9 +2553,16 @@ private:
   double extremum(int carrier, const std::function<double(const Vec3&)>& value, double sign,
     double from, double to)
   {
+    return extremum([&](double u) { return Geometry.point(carrier, u); },
+      Geometry.closedS(carrier), value, sign, from, to);
+  }
+
+  /// The same on any curve point(u) (u wraps when `closed`).
+  static double extremum(const std::function<Vec3(double)>& point, bool closed,
+    const std::function<double(const Vec3&)>& value, double sign, double from, double to)
+  {
     const int samples = 512;
-    const bool closed = Geometry.closedS(carrier);
-    auto f = [&](double u) { return sign * value(Geometry.point(carrier, u)); };
+    auto f = [&](double u) { return sign * value(point(closed ? wrapUnit(u) : u)); };
     auto at = [&](int k) { return from + (to - from) * static_cast<double>(k) / samples; };
     int best = 0;
     double bestValue = f(from);
