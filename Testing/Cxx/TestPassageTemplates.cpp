@@ -334,9 +334,8 @@ Checked checkPassage(const std::string& templateName, const DataSet& data,
   result.classes = minAngleClasses(quality);
 
   // volume against the independent passage volume, between the inlet and outlet planes
-  // (the template finds the hub and shroud radii at the inlet and outlet planes by a
-  // fixed-point iteration of projections, so the planes are axial to 1e-4 of the chord;
-  // the mean z is used)
+  // (their corners are placed on the hub and shroud at the plane's axial position, and the
+  // edges and faces between them are straight lines / TFI, so the patches are planar)
   double z0 = 0.0, z1 = 0.0;
   const auto inletNodes = patchNodes("inlet"), outletNodes = patchNodes("outlet");
   for (const Vec3& p : inletNodes)
@@ -344,9 +343,9 @@ Checked checkPassage(const std::string& templateName, const DataSet& data,
   for (const Vec3& p : outletNodes)
     z1 += p.z() / static_cast<double>(outletNodes.size());
   for (const Vec3& p : inletNodes)
-    EXPECT_NEAR(p.z(), z0, 1e-4 * chord) << "inlet is nearly an axial plane";
+    EXPECT_NEAR(p.z(), z0, 1e-9 * chord) << "inlet is an axial plane";
   for (const Vec3& p : outletNodes)
-    EXPECT_NEAR(p.z(), z1, 1e-4 * chord) << "outlet is nearly an axial plane";
+    EXPECT_NEAR(p.z(), z1, 1e-9 * chord) << "outlet is an axial plane";
   const double expectedVolume = passageVolume(inputs, pitch, z0, z1);
   const double volume = gridVolume(grid);
   result.volumeError = volume / expectedVolume - 1.0;
