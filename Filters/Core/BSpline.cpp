@@ -426,17 +426,25 @@ BSplineCurve::BSplineCurve(int degree, std::vector<double> knots,
   requireFinitePoints(ControlPoints, "B-spline curve control points");
 }
 
-BSplineCurve BSplineCurve::interpolate(const std::vector<Vec3>& points, int degree,
-  ParameterMethod method)
+namespace
 {
-  const int count = static_cast<int>(points.size());
-  if (count < 2)
+void requireInterpolationInput(const std::vector<Vec3>& points, int degree)
+{
+  if (points.size() < 2)
   {
     throw GeometryError("curve interpolation needs at least 2 points, got " +
-      std::to_string(count));
+      std::to_string(points.size()));
   }
   requireDegree(degree, "curve interpolation");
   requireFinitePoints(points, "curve interpolation");
+}
+} // namespace
+
+BSplineCurve BSplineCurve::interpolate(const std::vector<Vec3>& points, int degree,
+  ParameterMethod method)
+{
+  requireInterpolationInput(points, degree);
+  const int count = static_cast<int>(points.size());
 
   // Coincidence is judged relative to the size of the point set, so that the check works
   // the same in metres and millimetres.
@@ -464,14 +472,8 @@ BSplineCurve BSplineCurve::interpolate(const std::vector<Vec3>& points, int degr
 BSplineCurve BSplineCurve::interpolateAt(const std::vector<Vec3>& points,
   const std::vector<double>& parameters, int degree)
 {
+  requireInterpolationInput(points, degree);
   const int count = static_cast<int>(points.size());
-  if (count < 2)
-  {
-    throw GeometryError("curve interpolation needs at least 2 points, got " +
-      std::to_string(count));
-  }
-  requireDegree(degree, "curve interpolation");
-  requireFinitePoints(points, "curve interpolation");
   if (parameters.size() != points.size())
   {
     throw GeometryError("curve interpolation: " + std::to_string(parameters.size()) +

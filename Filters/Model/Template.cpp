@@ -1627,52 +1627,54 @@ private:
     DefinitionState.assign(DefinitionEntries.size(), 0);
   }
 
+  /**
+   * Resolves entity `entries[index]` of kind `kind` once (format 2 names resolve in any
+   * order): `resolve(entry, entityText)` runs with the entity marked in progress, so a
+   * reference back to it is reported as a cycle with the chain of entities being resolved.
+   */
+  template <typename Resolve>
+  void resolveOnce(std::vector<int>& state, const std::vector<MapEntry>& entries, int index,
+    const char* kind, Resolve&& resolve)
+  {
+    if (index < 0 || index >= static_cast<int>(state.size()) || state[index] == 2)
+    {
+      return; // done, or (carriers) hidden ones, complete when created
+    }
+    const MapEntry& entry = entries[index];
+    const std::string entityText = entity(kind, entry.key);
+    const std::string item = std::string(kind) + " '" + entry.key + "'";
+    if (state[index] == 1)
+    {
+      fail(entry.line, entityText, "is defined in terms of itself: " + resolvingChain(item));
+    }
+    state[index] = 1;
+    Resolving.push_back(item);
+    resolve(entry, entityText);
+    Resolving.pop_back();
+    state[index] = 2;
+  }
+
   void ensureDefinition(int index)
   {
-    if (DefinitionState[index] == 2)
-    {
-      return;
-    }
-    const MapEntry& entry = DefinitionEntries[index];
-    const std::string entityText = entity("definition", entry.key);
-    if (DefinitionState[index] == 1)
-    {
-      fail(entry.line, entityText,
-        "is defined in terms of itself: " + resolvingChain("definition '" + entry.key + "'"));
-    }
-    DefinitionState[index] = 1;
-    Resolving.push_back("definition '" + entry.key + "'");
-    const double value = number(entry.value, entry.line, entityText, "");
-    Resolving.pop_back();
-    DefinitionState[index] = 2;
-    Evaluator.define(entry.key, value);
+    resolveOnce(DefinitionState, DefinitionEntries, index, "definition",
+      [&](const MapEntry& entry, const std::string& entityText) {
+        Evaluator.define(entry.key, number(entry.value, entry.line, entityText, ""));
+      });
   }
 
   void ensureVertex(int index)
   {
-    if (index < 0 || index >= static_cast<int>(VertexState.size()) || VertexState[index] == 2)
-    {
-      return;
-    }
-    const MapEntry& entry = VertexEntries[index];
-    const std::string entityText = entity("vertex", entry.key);
-    if (VertexState[index] == 1)
-    {
-      fail(entry.line, entityText,
-        "is defined in terms of itself: " + resolvingChain("vertex '" + entry.key + "'"));
-    }
-    VertexState[index] = 1;
-    Resolving.push_back("vertex '" + entry.key + "'");
-    Vertex vertex = Model.vertices[index];
-    readVertexV2(entry, entityText, vertex);
-    if (!vertex.position.allFinite())
-    {
-      fail(entry.line, entityText, "the position is not finite");
-    }
-    Model.vertices[index] = vertex;
-    Resolving.pop_back();
-    VertexState[index] = 2;
-    defineVertexQueries(vertex);
+    resolveOnce(VertexState, VertexEntries, index, "vertex",
+      [&](const MapEntry& entry, const std::string& entityText) {
+        Vertex vertex = Model.vertices[index];
+        readVertexV2(entry, entityText, vertex);
+        if (!vertex.position.allFinite())
+        {
+          fail(entry.line, entityText, "the position is not finite");
+        }
+        Model.vertices[index] = vertex;
+        defineVertexQueries(vertex);
+      });
   }
 
   void defineVertexQueries(const Vertex& vertex)
@@ -1706,25 +1708,13 @@ private:
 
   void ensureCarrier(int index)
   {
-    if (index >= static_cast<int>(CarrierState.size()) || CarrierState[index] == 2)
-    {
-      return; // hidden carriers are complete when created
-    }
-    const MapEntry& entry = CarrierEntries[index];
-    const std::string entityText = entity("carrier", entry.key);
-    if (CarrierState[index] == 1)
-    {
-      fail(entry.line, entityText,
-        "is defined in terms of itself: " + resolvingChain("carrier '" + entry.key + "'"));
-    }
-    CarrierState[index] = 1;
-    Resolving.push_back("carrier '" + entry.key + "'");
-    Carrier carrier = Model.carriers[index];
-    readCarrier(entry, entityText, index, carrier);
-    Model.carriers[index] = carrier;
-    Geometry.build(Model, index);
-    Resolving.pop_back();
-    CarrierState[index] = 2;
+    resolveOnce(CarrierState, CarrierEntries, index, "carrier",
+      [&](const MapEntry& entry, const std::string& entityText) {
+        Carrier carrier = Model.carriers[index];
+        readCarrier(entry, entityText, index, carrier);
+        Model.carriers[index] = carrier;
+        Geometry.build(Model, index);
+      });
   }
 
   /// A carrier named in the template (declared or hidden), resolved; -1 if there is none.
