@@ -1587,6 +1587,12 @@ void checkModel(const BlockModel& model)
   checkModelWith(model, geometry);
 }
 
+void checkModel(const BlockModel& model, const CarrierGeometry& geometry)
+{
+  checkBasics(model);
+  checkModelWith(model, geometry);
+}
+
 struct MultiBlockMesher::Impl
 {
   BlockModel Model; // a copy: the mesher may outlive the caller's model

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "BlockModel.h"
+#include "CarrierGeometry.h"
 #include "Template.h"
 
 #include <functional>
@@ -32,6 +33,11 @@ namespace model
  * Edge geometry is validated too (arc radii, spline points).
  */
 void checkModel(const BlockModel& model);
+
+/// The same check with the model's carriers already built (the template engine's, which
+/// are the same bit for bit as CarrierGeometry(model) would build): saves building them
+/// again (the blade intersections are most of the time to apply a template).
+void checkModel(const BlockModel& model, const CarrierGeometry& geometry);
 
 /**
  * @class MultiBlockMesher

@@ -454,6 +454,9 @@ public:
     return std::move(Model);
   }
 
+  /// The carriers built while reading (valid after readModel()).
+  const CarrierGeometry& geometry() const { return Geometry; }
+
   std::vector<ParameterInfo> readParameterInfos()
   {
     InfoOnly = true;
@@ -3353,7 +3356,7 @@ BlockModel parseTemplate(const std::string& text, const std::string& fileName,
   BlockModel model = reader.readModel();
   // Topology and geometry problems are template errors too: report them now, with the
   // template's lines, rather than when the mesher runs.
-  checkModel(model);
+  checkModel(model, reader.geometry());
   return model;
 }
 
