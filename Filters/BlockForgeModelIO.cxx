@@ -191,6 +191,9 @@ std::string findModelDocument(vtkDataObject* object)
 #include "../Core/Quality.h"
 #include "../Model/Mesher.h"
 
+#include <deque>
+#include <mutex>
+
 #include <vtkCellData.h>
 #include <vtkCompositeDataSet.h>
 #include <vtkDoubleArray.h>
@@ -247,11 +250,81 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
   }
 }
 
+namespace
+{
+/**
+ * The carriers of the last few model documents meshed in this process. A BlockTemplate
+ * and the BlockMesher below it see the same document: building its carriers (the blade
+ * intersections) once is enough. Documents are compared whole, and carriers are built
+ * from the document's numbers alone, so a hit gives the same grid bit for bit.
+ */
+class CarrierCache
+{
+public:
+  static CarrierCache& instance()
+  {
+    static CarrierCache cache;
+    return cache;
+  }
+  bool find(const std::string& document, model::CarrierGeometry& carriers)
+  {
+    std::lock_guard<std::mutex> lock(Mutex);
+    for (const auto& entry : Entries)
+    {
+      if (entry.first == document)
+      {
+        carriers = entry.second;
+        return true;
+      }
+    }
+    return false;
+  }
+  void store(const std::string& document, const model::CarrierGeometry& carriers)
+  {
+    std::lock_guard<std::mutex> lock(Mutex);
+    for (const auto& entry : Entries)
+    {
+      if (entry.first == document)
+      {
+        return;
+      }
+    }
+    Entries.emplace_back(document, carriers);
+    if (Entries.size() > 4)
+    {
+      Entries.pop_front();
+    }
+  }
+
+private:
+  std::mutex Mutex;
+  std::deque<std::pair<std::string, model::CarrierGeometry>> Entries;
+};
+} // namespace
+
 void meshModel(const model::BlockModel& blockModel, const std::string& document,
   double densityMultiplier, int cellCap, int piece, int pieceCount,
-  vtkMultiBlockDataSet* output, const std::function<void(double)>& progress)
+  vtkMultiBlockDataSet* output, const std::function<void(double)>& progress,
+  const model::CarrierGeometry* carriers)
 {
-  model::MultiBlockMesher mesher(blockModel, densityMultiplier);
+  model::CarrierGeometry known;
+  bool haveCarriers = false;
+  if (carriers)
+  {
+    known = *carriers;
+    haveCarriers = true;
+  }
+  else if (!blockModel.carriers.empty())
+  {
+    haveCarriers = CarrierCache::instance().find(document, known);
+  }
+  model::MultiBlockMesher mesher = haveCarriers
+    ? model::MultiBlockMesher(blockModel, known, densityMultiplier)
+    : model::MultiBlockMesher(blockModel, densityMultiplier);
+  if (!blockModel.carriers.empty())
+  {
+    CarrierCache::instance().store(document, mesher.carriers());
+  }
   mesher.setCellCap(cellCap);
   mesher.computeBoundaries();
   if (progress)

@@ -18,6 +18,7 @@ namespace blockforge
 namespace model
 {
 struct TemplateInputs;
+class CarrierGeometry;
 }
 namespace vtkglue
 {
@@ -66,6 +67,7 @@ void fillMultiBlock(const model::BlockModel& model, const model::MultiBlockMeshe
  */
 void meshModel(const model::BlockModel& model, const std::string& document,
   double densityMultiplier, int cellCap, int piece, int pieceCount,
-  vtkMultiBlockDataSet* output, const std::function<void(double)>& progress);
+  vtkMultiBlockDataSet* output, const std::function<void(double)>& progress,
+  const model::CarrierGeometry* carriers = nullptr);
 } // namespace vtkglue
 } // namespace blockforge

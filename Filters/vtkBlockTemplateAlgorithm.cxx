@@ -79,9 +79,9 @@ namespace
 {
 /// One block per carrier declared in the template (not the sections and contours made
 /// along the way): curves as polylines of 257 points, surfaces as 65 x 65 grids.
-void fillCarriers(const blockforge::model::BlockModel& model, vtkMultiBlockDataSet* output)
+void fillCarriers(const blockforge::model::BlockModel& model,
+  const blockforge::model::CarrierGeometry& geometry, vtkMultiBlockDataSet* output)
 {
-  const blockforge::model::CarrierGeometry geometry(model);
   unsigned int block = 0;
   for (std::size_t c = 0; c < model.carriers.size(); ++c)
   {
@@ -170,15 +170,17 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
       blockforge::vtkglue::readTemplateInputs(input, inputs);
     }
     this->UpdateProgress(0.05);
+    blockforge::model::CarrierGeometry geometry;
     const blockforge::model::BlockModel blockModel = blockforge::model::loadTemplate(
-      this->TemplateFile, this->Parameters, hasInput ? &inputs : nullptr);
+      this->TemplateFile, this->Parameters, hasInput ? &inputs : nullptr, &geometry);
     this->UpdateProgress(0.4);
     const std::string document = blockforge::model::writeModelDocument(blockModel);
     blockforge::vtkglue::meshModel(blockModel, document, 1.0, this->PreviewCells, piece,
-      pieceCount, output, [this](double fraction) { this->UpdateProgress(0.4 + 0.55 * fraction); });
+      pieceCount, output, [this](double fraction) { this->UpdateProgress(0.4 + 0.55 * fraction); },
+      &geometry);
     if (carriers && piece == 0)
     {
-      fillCarriers(blockModel, carriers);
+      fillCarriers(blockModel, geometry, carriers);
     }
     this->ModelDocument = document;
   }

@@ -1621,6 +1621,18 @@ struct MultiBlockMesher::Impl
 };
 
 MultiBlockMesher::MultiBlockMesher(const BlockModel& model, double densityMultiplier)
+  : MultiBlockMesher(model, nullptr, densityMultiplier)
+{
+}
+
+MultiBlockMesher::MultiBlockMesher(
+  const BlockModel& model, const CarrierGeometry& carriers, double densityMultiplier)
+  : MultiBlockMesher(model, &carriers, densityMultiplier)
+{
+}
+
+MultiBlockMesher::MultiBlockMesher(
+  const BlockModel& model, const CarrierGeometry* carriers, double densityMultiplier)
   : P(new Impl)
 {
   if (!std::isfinite(densityMultiplier) || !(densityMultiplier > 0.0))
@@ -1632,12 +1644,17 @@ MultiBlockMesher::MultiBlockMesher(const BlockModel& model, double densityMultip
   checkBasics(model);
   P->Model = model;
   P->Multiplier = densityMultiplier;
-  P->Geometry = CarrierGeometry(P->Model);
+  P->Geometry = carriers ? *carriers : CarrierGeometry(P->Model);
   checkModelWith(P->Model, P->Geometry);
   P->Curves = buildNamedCurves(P->Model, P->Geometry);
 }
 
 MultiBlockMesher::~MultiBlockMesher() = default;
+
+const CarrierGeometry& MultiBlockMesher::carriers() const
+{
+  return P->Geometry;
+}
 
 void MultiBlockMesher::setCellCap(int cap)
 {

@@ -49,6 +49,9 @@ public:
   /// `densityMultiplier` scales every cell count: cells = max(1, round(cells * m)).
   /// Calls checkModel(); throws TemplateError on any problem.
   MultiBlockMesher(const BlockModel& model, double densityMultiplier = 1.0);
+  /// Same with the model's carriers already built (loadTemplate's `carriers`).
+  MultiBlockMesher(const BlockModel& model, const CarrierGeometry& carriers,
+    double densityMultiplier = 1.0);
   ~MultiBlockMesher();
 
   /// Cell count cap for previews: each direction uses min(cells, cap) cells (0 = off).
@@ -59,6 +62,8 @@ public:
   void computeBoundaries();
 
   int blockCount() const;
+  /// The model's carriers as built for meshing.
+  const CarrierGeometry& carriers() const;
   /// Node counts (ni, nj, nk) of block b.
   std::array<int, 3> nodeCounts(int block) const;
   /// Writes the nodes of block b (ni*nj*nk*3 doubles, i fastest) into `out`.
@@ -66,6 +71,8 @@ public:
   void meshBlock(int block, double* out) const;
 
 private:
+  MultiBlockMesher(const BlockModel& model, const CarrierGeometry* carriers,
+    double densityMultiplier);
   struct Impl;
   std::unique_ptr<Impl> P;
 };

@@ -3350,20 +3350,24 @@ std::string readFile(const std::string& path)
 } // namespace
 
 BlockModel parseTemplate(const std::string& text, const std::string& fileName,
-  const ParameterOverrides& overrides, const TemplateInputs* inputs)
+  const ParameterOverrides& overrides, const TemplateInputs* inputs, CarrierGeometry* carriers)
 {
   TemplateReader reader(text, fileName, overrides, inputs);
   BlockModel model = reader.readModel();
   // Topology and geometry problems are template errors too: report them now, with the
   // template's lines, rather than when the mesher runs.
   checkModel(model, reader.geometry());
+  if (carriers)
+  {
+    *carriers = reader.geometry();
+  }
   return model;
 }
 
-BlockModel loadTemplate(
-  const std::string& path, const ParameterOverrides& overrides, const TemplateInputs* inputs)
+BlockModel loadTemplate(const std::string& path, const ParameterOverrides& overrides,
+  const TemplateInputs* inputs, CarrierGeometry* carriers)
 {
-  return parseTemplate(readFile(path), path, overrides, inputs);
+  return parseTemplate(readFile(path), path, overrides, inputs, carriers);
 }
 
 std::vector<ParameterInfo> templateParameters(const std::string& path,

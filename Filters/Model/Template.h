@@ -66,15 +66,20 @@ struct TemplateInputs
   std::string origin = "the filter input"; ///< for messages
 };
 
+class CarrierGeometry;
+
 /// Reads and applies a template file. Throws TemplateError (missing file, YAML syntax
 /// error, bad expression, unknown name, wrong count of vertices, ...). Templates with an
-/// `inputs:` section need `inputs`.
+/// `inputs:` section need `inputs`. With `carriers`, the carriers built on the way are
+/// handed over (the same bit for bit as CarrierGeometry(model); the blade intersections
+/// are most of the work, so the caller need not build them again).
 BlockModel loadTemplate(const std::string& path, const ParameterOverrides& overrides = {},
-  const TemplateInputs* inputs = nullptr);
+  const TemplateInputs* inputs = nullptr, CarrierGeometry* carriers = nullptr);
 
 /// Same, from text; `fileName` is used in messages only.
 BlockModel parseTemplate(const std::string& text, const std::string& fileName,
-  const ParameterOverrides& overrides = {}, const TemplateInputs* inputs = nullptr);
+  const ParameterOverrides& overrides = {}, const TemplateInputs* inputs = nullptr,
+  CarrierGeometry* carriers = nullptr);
 
 /// A template parameter as declared (for GUIs and --help style listings).
 struct ParameterInfo
