@@ -8,6 +8,7 @@
 // to apply each template (medians of 5) for the report.
 #include "CarrierGeometry.h"
 #include "Mesher.h"
+#include "ModelDocument.h"
 #include "Quality.h"
 #include "Template.h"
 
@@ -416,4 +417,30 @@ TEST(PassageTemplates, AxialPassageOHRotor37)
 TEST(PassageTemplates, AxialPassageOHDistributor)
 {
   report("axial_passage_oh", dataSets()[1], checkPassage("axial_passage_oh", dataSets()[1]));
+}
+
+// The carriers loadTemplate hands over (used by the BlockTemplate preview and, through the
+// document cache, by BlockMesher) give the grid a fresh build of the carriers gives, bit for
+// bit, and the model document read back gives it too.
+TEST(PassageTemplates, HandedOverCarriersGiveTheSameGrid)
+{
+  const TemplateInputs inputs = readTemplateInputs(dataSets()[1].inf);
+  CarrierGeometry carriers;
+  const BlockModel model =
+    loadTemplate(templatePath("axial_passage_oh"), {}, &inputs, &carriers);
+  const BlockModel reread = readModelDocument(writeModelDocument(model));
+  MultiBlockMesher handed(model, carriers, 1.0), fresh(reread, 1.0);
+  handed.computeBoundaries();
+  fresh.computeBoundaries();
+  ASSERT_EQ(handed.blockCount(), fresh.blockCount());
+  for (int b = 0; b < handed.blockCount(); ++b)
+  {
+    const auto n = handed.nodeCounts(b);
+    ASSERT_EQ(n, fresh.nodeCounts(b));
+    std::vector<double> a(3 * static_cast<std::size_t>(n[0]) * n[1] * n[2]), c(a.size());
+    handed.meshBlock(b, a.data());
+    fresh.meshBlock(b, c.data());
+    EXPECT_EQ(std::memcmp(a.data(), c.data(), a.size() * sizeof(double)), 0)
+      << "block " << model.blocks[b].name;
+  }
 }
