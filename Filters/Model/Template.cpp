@@ -1461,7 +1461,8 @@ private:
         fail(entry.line, entityText,
           "this template reads the point set '" + setName +
             "' from a filter input: apply it with the BlockTemplate filter to the output of "
-            "a TurboPointSetsReader (BlockTemplateSource has no input)");
+            "a TurboPointSetsReader (BlockTemplateSource has no input); from Python, "
+            "mesh_template(..., input_file=...) or python3 -m blockforge TEMPLATE -i FILE");
       }
       const InputPointSet* found = nullptr;
       std::vector<std::string> available;

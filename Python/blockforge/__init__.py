@@ -35,39 +35,92 @@ __all__ = [
 MIN_ANGLE_CLASSES = ("0-20", "20-40", "40-60", "60-80", "80-90")
 
 
-def mesh_template(template_file, parameters=None, density_multiplier=1.0):
-    """Applies a template, meshes it and measures the grid.
+def _message(text):
+    """The text of a VTK error message without VTK's "ERROR: In file, line N" and
+    "Class (0x...): " header."""
+    text = text.strip()
+    if text.startswith("ERROR: In "):
+        text = text.partition("\n")[2]
+    head, sep, rest = text.partition("): ")
+    if sep and " (0x" in head and "\n" not in head:
+        text = rest
+    return text.strip()
 
-    :param template_file: path of a BlockForge template (.yaml)
-    :param parameters: dict of parameter overrides, name -> number or expression
-    :param density_multiplier: scales every cell count of the template
-    :returns: the vtkGridQuality algorithm after its update (port 0: the grid with the
-        quality arrays; port 1: MinAngle class table; port 2: statistics table)
-    :raises RuntimeError: with the template error message when a stage fails
-    """
+
+def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_file=None,
+                  timings=None):
+    """:func:`mesh_template`; with a dict *timings*, also records the seconds of each
+    stage under "read" (only with an input file), "template" and "mesh + quality"."""
+    import time
+
     from vtkmodules.util.misc import calldata_type
     from vtkmodules.util.vtkConstants import VTK_STRING
     from vtkmodules.vtkCommonCore import vtkCommand
 
-    source = vtkBlockTemplateSource()
-    source.SetTemplateFile(str(template_file))
+    stages = []  # (timing key, the algorithm whose update runs that stage)
+    if input_file is not None:
+        reader = vtkTurboPointSetsReader()
+        reader.SetFileName(str(input_file))
+        template = vtkBlockTemplate()
+        template.SetInputConnection(reader.GetOutputPort())
+        stages.append(("read", reader))
+    else:
+        template = vtkBlockTemplateSource()
+    template.SetTemplateFile(str(template_file))
     for name, value in (parameters or {}).items():
-        source.SetParameter(str(name), str(value))
+        template.SetParameter(str(name), str(value))
+    stages.append(("template", template))
     mesher = vtkBlockMesher()
     mesher.SetDensityMultiplier(float(density_multiplier))
-    mesher.SetInputConnection(source.GetOutputPort())
+    mesher.SetInputConnection(template.GetOutputPort())
     quality = vtkGridQuality()
     quality.SetInputConnection(mesher.GetOutputPort())
+    stages.append(("mesh + quality", quality))
 
     errors = []
+    failures = []  # the executives' "Algorithm ... returned failure" follow-ups
 
     @calldata_type(VTK_STRING)
     def collect(_caller, _event, message):
         errors.append(message)
 
-    for algorithm in (source, mesher, quality):
+    @calldata_type(VTK_STRING)
+    def collect_failure(_caller, _event, message):
+        failures.append(message)
+
+    for algorithm in [stage for _, stage in stages] + [mesher]:
         algorithm.AddObserver(vtkCommand.ErrorEvent, collect)
-    quality.Update()
-    if errors:
-        raise RuntimeError(errors[0].strip())
+        algorithm.GetExecutive().AddObserver(vtkCommand.ErrorEvent, collect_failure)
+    # Stage by stage, so that a failing stage stops the pipeline with its own message.
+    for key, algorithm in stages:
+        start = time.perf_counter()
+        algorithm.Update()
+        if timings is not None:
+            timings[key] = time.perf_counter() - start
+        if errors or failures:
+            raise RuntimeError(_message((errors or failures)[0]))
     return quality
+
+
+def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None):
+    """Applies a template, meshes it and measures the grid.
+
+    Without *input_file* the pipeline is vtkBlockTemplateSource -> vtkBlockMesher ->
+    vtkGridQuality (templates without inputs); with it, vtkTurboPointSetsReader(input_file)
+    -> vtkBlockTemplate -> vtkBlockMesher -> vtkGridQuality (templates whose ``inputs:``
+    name point sets, e.g. Templates/axial_passage_oh.yaml).
+
+    :param template_file: path of a BlockForge template (.yaml)
+    :param parameters: dict of parameter overrides, name -> number or expression
+    :param density_multiplier: scales every cell count of the template
+    :param input_file: point data for a template with inputs: a file the
+        vtkTurboPointSetsReader reads (a BladeGen .inf, an Info.txt or a point file);
+        None for a template without inputs
+    :returns: the vtkGridQuality algorithm after its update (port 0: the grid with the
+        quality arrays; port 1: MinAngle class table; port 2: statistics table)
+    :raises RuntimeError: when a stage (reader, template, mesher or quality) reports an
+        error; the message is the first error reported, without VTK's
+        "ERROR: In file, line" header (e.g. "<file>: no such file", or the template's
+        "<template>:<line>: ..." message). No later stage runs after a failing one.
+    """
+    return _run_pipeline(template_file, parameters, density_multiplier, input_file)

@@ -1,12 +1,18 @@
-"""Command line: ``python3 -m blockforge TEMPLATE [-o grid.vtm] [-p NAME=EXPR ...]``.
+"""Command line: ``python3 -m blockforge TEMPLATE [-i POINTS] [-o grid.vtm] [-p NAME=EXPR ...]
+[-d DENSITY]``.
 
-Applies a template, meshes it, writes the grid with its quality arrays and prints a
-quality summary (cell count, the paper's MinAngle classes, min/mean/max of every
-measure). Exit status 1 with the error message on failure.
+Applies a template (to the point data of -i, read by the TurboPointSetsReader, for a
+template with inputs), meshes it, prints a quality summary (cell count, the paper's
+MinAngle classes, min/mean/max of every measure) and writes the grid with its quality
+arrays. The grid file (x.vtm and its directory of pieces x/) is written next to the
+target first and then moved into place, replacing older ones: a failing run leaves no
+partial grid and keeps an older one. Exit status 1 with the error message on failure.
 """
 import argparse
 import os
+import shutil
 import sys
+import tempfile
 import time
 
 import blockforge
@@ -49,10 +55,58 @@ def summary_lines(quality):
     return lines
 
 
+def write_grid(data_object, path):
+    """Writes *data_object* (a vtkMultiBlockDataSet) as the .vtm *path* plus the directory
+    of its pieces (``x.vtm`` -> ``x/``), atomically per file: both are written into a
+    temporary directory beside *path*, then moved into place, replacing older ones.
+    :raises RuntimeError: when the writer fails (nothing at *path* is touched then)."""
+    from vtkmodules.util.misc import calldata_type
+    from vtkmodules.util.vtkConstants import VTK_STRING
+    from vtkmodules.vtkCommonCore import vtkCommand
+    from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataWriter
+
+    path = os.path.abspath(path)
+    directory, name = os.path.split(path)
+    pieces = os.path.splitext(path)[0]  # the writer's directory of pieces
+    os.makedirs(directory, exist_ok=True)
+    staging = tempfile.mkdtemp(prefix=f".{name}.", suffix=".tmp", dir=directory)
+    try:
+        errors = []
+
+        @calldata_type(VTK_STRING)
+        def collect(_caller, _event, message):
+            errors.append(message)
+
+        writer = vtkXMLMultiBlockDataWriter()
+        writer.AddObserver(vtkCommand.ErrorEvent, collect)
+        writer.SetInputData(data_object)
+        writer.SetFileName(os.path.join(staging, name))
+        writer.SetDataModeToAppended()
+        writer.EncodeAppendedDataOff()
+        if not writer.Write() or errors:
+            detail = f": {blockforge._message(errors[0])}" if errors else ""
+            raise RuntimeError(f"could not write {path}{detail}")
+        staged_pieces = os.path.join(staging, os.path.basename(pieces))
+        # Pieces first, then the .vtm that references them; an older pieces directory is
+        # moved into the staging directory and removed with it.
+        if os.path.isdir(pieces) and not os.path.islink(pieces):
+            os.rename(pieces, os.path.join(staging, ".old-pieces"))
+        elif os.path.lexists(pieces):
+            os.remove(pieces)
+        if os.path.isdir(staged_pieces):
+            os.rename(staged_pieces, pieces)
+        os.replace(os.path.join(staging, name), path)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m blockforge", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("template", help="BlockForge template file (.yaml)")
+    parser.add_argument("-i", "--input", metavar="FILE",
+                        help="point data for a template with inputs (BladeGen .inf, Info.txt "
+                             "or point file, read by the TurboPointSetsReader)")
     parser.add_argument("-o", "--output", help="grid file to write (.vtm)")
     parser.add_argument("-p", "--parameter", action="append", type=_parse_parameter,
                         default=[], metavar="NAME=EXPR", help="override a template parameter")
@@ -60,30 +114,28 @@ def main(argv=None):
                         help="grid density multiplier (scales every cell count)")
     args = parser.parse_args(argv)
 
-    start = time.perf_counter()
+    timings = {}
     try:
-        quality = blockforge.mesh_template(args.template, dict(args.parameter), args.density)
+        quality = blockforge._run_pipeline(args.template, dict(args.parameter), args.density,
+                                           args.input, timings)
     except RuntimeError as error:
         print(f"error: {error}", file=sys.stderr)
         return 1
-    elapsed = time.perf_counter() - start
     print(f"template: {args.template}")
+    if args.input:
+        print(f"input: {args.input}")
     for line in summary_lines(quality):
         print(line)
-    print(f"template + mesh + quality: {elapsed:.3f} s")
+    print("time [s]: " + ", ".join(f"{key} {seconds:.3f}" for key, seconds in timings.items())
+          + f", total {sum(timings.values()):.3f}")
     if args.output:
-        from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataWriter
-        directory = os.path.dirname(os.path.abspath(args.output))
-        os.makedirs(directory, exist_ok=True)
-        writer = vtkXMLMultiBlockDataWriter()
-        writer.SetInputConnection(quality.GetOutputPort(0))
-        writer.SetFileName(args.output)
-        writer.SetDataModeToAppended()
-        writer.EncodeAppendedDataOff()
-        if not writer.Write():
-            print(f"error: could not write {args.output}", file=sys.stderr)
+        start = time.perf_counter()
+        try:
+            write_grid(quality.GetOutputDataObject(0), args.output)
+        except (RuntimeError, OSError) as error:
+            print(f"error: {error}", file=sys.stderr)
             return 1
-        print(f"grid written to {args.output}")
+        print(f"grid written to {args.output} ({time.perf_counter() - start:.3f} s)")
     return 0
 
 

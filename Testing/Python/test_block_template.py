@@ -24,6 +24,7 @@ OUTPUT = os.environ.get("BLOCKFORGE_TEST_OUTPUT", "/tmp/blockforge-test-output")
 DATA = os.path.join(SOURCE, "Testing", "Data")
 PASSAGE = os.path.join(DATA, "annular_passage.yaml")
 INF = os.path.join(SOURCE, "Data", "rotor37", "turbogrid", "BladeGen.inf")
+DISTRIBUTOR_INF = os.path.join(SOURCE, "Data", "distributor", "BladeGen.inf")
 
 # Defines TurboPointSetsReader, BlockTemplate, BlockMesher, ... in this module.
 LoadPlugin(PLUGIN, remote=False, ns=globals())
@@ -204,6 +205,32 @@ class BlockTemplateTest(unittest.TestCase):
             a, b = block_array(blocks[low]), block_array(blocks[high])
             np.testing.assert_allclose(rotate_z(a[:, :, 0, :].reshape(-1, 3), 2 * math.pi / 36),
                                        b[:, :, -1, :].reshape(-1, 3), rtol=0, atol=1e-12)
+        for proxy in (quality, mesher, template, reader):
+            Delete(proxy)
+
+    def test_distributor_oh_grid(self):
+        """Templates/axial_passage_oh.yaml on the distributor (16 vanes) through the proxies:
+        TurboPointSetsReader -> BlockTemplate -> BlockMesher -> GridQuality."""
+        reader = TurboPointSetsReader(FileName=DISTRIBUTOR_INF)
+        template = BlockTemplate(Input=reader,
+                                 TemplateFile=os.path.join(SOURCE, "Templates", "axial_passage_oh.yaml"))
+        mesher = BlockMesher(Input=template, DensityMultiplier=1.0)
+        quality = GridQuality(Input=mesher)
+        quality.UpdatePipeline()
+        grid = servermanager.Fetch(quality)
+        blocks = leaves(grid)
+        self.assertEqual(len(blocks), 12)
+        cells = sum(b.GetNumberOfCells() for b in blocks)
+        self.assertEqual(cells, 9600)
+        jacobian = np.concatenate([np.array(dsa.WrapDataObject(b).CellData["ScaledJacobian"])
+                                   for b in blocks])
+        self.assertEqual(len(jacobian), cells)
+        self.assertGreater(jacobian.min(), 0.0)
+        summary = grid.GetFieldData().GetArray("ScaledJacobianSummary").GetTuple(0)
+        self.assertGreater(summary[0], 0.0)
+        self.assertAlmostEqual(summary[0], jacobian.min(), places=12)
+        counts = grid.GetFieldData().GetArray("MinAngleClassCounts")
+        self.assertEqual(sum(counts.GetValue(i) for i in range(5)), cells)
         for proxy in (quality, mesher, template, reader):
             Delete(proxy)
 

@@ -2,12 +2,16 @@
 
 Run by CTest with /usr/bin/python3 and PYTHONPATH pointing at the build tree.
 """
+import contextlib
+import io
 import math
 import os
+import shutil
 import sys
 import unittest
 
 import blockforge
+from blockforge.__main__ import main as blockforge_main
 from vtkmodules.numpy_interface import dataset_adapter as dsa
 from vtkmodules.vtkCommonCore import vtkCommand
 from vtkmodules.vtkFiltersVerdict import vtkMeshQuality
@@ -20,7 +24,10 @@ SOURCE = os.environ.get("BLOCKFORGE_SOURCE_DIR",
                         os.path.join(os.path.dirname(__file__), "..", ".."))
 OUTPUT = os.environ.get("BLOCKFORGE_TEST_OUTPUT", "/tmp/blockforge-test-output")
 CYLINDER = os.path.join(SOURCE, "Templates", "cylinder_in_box.yaml")
+AXIAL_OH = os.path.join(SOURCE, "Templates", "axial_passage_oh.yaml")
 DATA = os.path.join(SOURCE, "Testing", "Data")
+DISTRIBUTOR = os.path.join(SOURCE, "Data", "distributor", "BladeGen.inf")
+ROTOR37 = os.path.join(SOURCE, "Data", "rotor37", "turbogrid", "BladeGen.inf")
 
 
 def leaves(multiblock):
@@ -37,6 +44,20 @@ def leaves(multiblock):
 
 def points(dataset):
     return np.array(dsa.WrapDataObject(dataset).Points)
+
+
+def node_array(block):
+    """The nodes of a structured block as an array [k, j, i, xyz]."""
+    dimensions = [0, 0, 0]
+    block.GetDimensions(dimensions)
+    nx, ny, nz = dimensions
+    return points(block).reshape(nz, ny, nx, 3)
+
+
+def rotate_z(xyz, angle):
+    c, s = math.cos(angle), math.sin(angle)
+    return np.column_stack((c * xyz[:, 0] - s * xyz[:, 1], s * xyz[:, 0] + c * xyz[:, 1],
+                            xyz[:, 2]))
 
 
 class ErrorCollector:
@@ -201,6 +222,140 @@ class GridQualityTest(unittest.TestCase):
             np.testing.assert_allclose(data["Skewness"], 0.0, atol=1e-9)
         counts = grid.GetFieldData().GetArray("MinAngleClassCounts")
         self.assertEqual([counts.GetValue(i) for i in range(5)], [0, 0, 0, 0, 2 * 64])
+
+
+class AxialPassageOHTest(unittest.TestCase):
+    """mesh_template with input_file: TurboPointSetsReader -> BlockTemplate -> BlockMesher ->
+    GridQuality on Templates/axial_passage_oh.yaml, for both bundled data sets."""
+    BLOCKS = ["D_L", "D_M", "D_R", "M_L", "M_R", "O_a", "O_b", "O_le", "O_te",
+              "U_L", "U_M", "U_R"]
+    CELLS = 9600  # at density 1: the default cell counts of the template
+
+    def check_grid(self, input_file, blade_count):
+        quality = blockforge.mesh_template(AXIAL_OH, input_file=input_file)
+        grid = quality.GetOutputDataObject(0)
+        blocks = dict(leaves(grid))
+        self.assertEqual(sorted(blocks), self.BLOCKS)
+        cells = sum(block.GetNumberOfCells() for block in blocks.values())
+        self.assertEqual(cells, self.CELLS)
+        # no inverted or degenerate cell
+        jacobian = np.concatenate([np.array(dsa.WrapDataObject(block).CellData["ScaledJacobian"])
+                                   for block in blocks.values()])
+        self.assertEqual(len(jacobian), cells)
+        self.assertGreater(jacobian.min(), 0.0)
+        low, _, high = grid.GetFieldData().GetArray("ScaledJacobianSummary").GetTuple3(0)
+        self.assertAlmostEqual(low, jacobian.min(), places=12)
+        self.assertLessEqual(high, 1.0 + 1e-12)
+        # the MinAngle classes count every cell once (field data and table alike)
+        counts = grid.GetFieldData().GetArray("MinAngleClassCounts")
+        self.assertEqual(sum(counts.GetValue(i) for i in range(5)), cells)
+        table = quality.GetOutputDataObject(1)
+        self.assertEqual([table.GetValue(r, 1).ToInt() for r in range(5)],
+                         [counts.GetValue(i) for i in range(5)])
+        # inlet (j = 0 of the U blocks) and outlet (j = max of the D blocks): axial planes at
+        # the ends of the grid; H blocks run i with theta, j with the axis
+        z = np.concatenate([points(block)[:, 2] for block in blocks.values()])
+        tolerance = 1e-9 * (z.max() - z.min())
+        for name in ("U_L", "U_M", "U_R"):
+            np.testing.assert_allclose(node_array(blocks[name])[:, 0, :, 2], z.min(),
+                                       rtol=0, atol=tolerance)
+        for name in ("D_L", "D_M", "D_R"):
+            np.testing.assert_allclose(node_array(blocks[name])[:, -1, :, 2], z.max(),
+                                       rtol=0, atol=tolerance)
+        # periodic: i = max of the right H blocks is i = 0 of the left ones rotated by a pitch
+        for low_name, high_name in (("U_L", "U_R"), ("M_L", "M_R"), ("D_L", "D_R")):
+            low_side = node_array(blocks[low_name])[:, :, 0, :].reshape(-1, 3)
+            high_side = node_array(blocks[high_name])[:, :, -1, :].reshape(-1, 3)
+            np.testing.assert_allclose(rotate_z(low_side, 2 * math.pi / blade_count), high_side,
+                                       rtol=0, atol=1e-12)
+
+    def test_distributor(self):
+        self.check_grid(DISTRIBUTOR, 16)
+
+    def test_rotor37(self):
+        self.check_grid(ROTOR37, 36)
+
+    def test_bad_input_path_raises(self):
+        missing = os.path.join(OUTPUT, "no_such_dir", "BladeGen.inf")
+        with self.assertRaises(RuntimeError) as context:
+            blockforge.mesh_template(AXIAL_OH, input_file=missing)
+        self.assertIn(os.path.join("no_such_dir", "BladeGen.inf"), str(context.exception))
+
+    def test_template_with_inputs_needs_input_file(self):
+        with self.assertRaises(RuntimeError) as context:
+            blockforge.mesh_template(AXIAL_OH)
+        self.assertIn("axial_passage_oh.yaml", str(context.exception))
+
+
+class CommandLineTest(unittest.TestCase):
+    """python3 -m blockforge, run in-process through its main()."""
+
+    def setUp(self):
+        self.directory = os.path.join(OUTPUT, "command_line")
+        shutil.rmtree(self.directory, ignore_errors=True)
+        os.makedirs(self.directory)
+
+    def run_main(self, *arguments):
+        out, err = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            status = blockforge_main(list(arguments))
+        return status, out.getvalue(), err.getvalue()
+
+    def read_grid(self, path):
+        reader = vtkXMLMultiBlockDataReader()
+        reader.SetFileName(path)
+        reader.Update()
+        return reader.GetOutput()
+
+    def test_input_writes_vtm_atomically(self):
+        path = os.path.join(self.directory, "oh.vtm")
+        status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-o", path)
+        self.assertEqual(status, 0, err)
+        self.assertIn("cells: 9600", out)
+        self.assertIn("grid written to", out)
+        # the .vtm and its pieces, nothing else (no temporary left behind)
+        self.assertEqual(sorted(os.listdir(self.directory)), ["oh", "oh.vtm"])
+        self.assertEqual(len(os.listdir(os.path.join(self.directory, "oh"))), 12)
+        grid = self.read_grid(path)
+        self.assertEqual(len(leaves(grid)), 12)
+        self.assertEqual(sum(block.GetNumberOfCells() for _, block in leaves(grid)), 9600)
+        for _, block in leaves(grid):
+            self.assertIsNotNone(block.GetCellData().GetArray("ScaledJacobian"))
+
+        # a failing run over an existing grid leaves it untouched
+        with open(path, "rb") as file:
+            before = file.read()
+        status, _, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-p", "nosuch=1", "-o", path)
+        self.assertEqual(status, 1)
+        self.assertIn("nosuch", err)
+        with open(path, "rb") as file:
+            self.assertEqual(file.read(), before)
+        self.assertEqual(sorted(os.listdir(self.directory)), ["oh", "oh.vtm"])
+        self.assertEqual(len(os.listdir(os.path.join(self.directory, "oh"))), 12)
+
+        # a successful run replaces the older grid with its pieces (4 blocks, not 12)
+        status, _, err = self.run_main(CYLINDER, "-o", path)
+        self.assertEqual(status, 0, err)
+        self.assertEqual(sorted(os.listdir(self.directory)), ["oh", "oh.vtm"])
+        self.assertEqual(len(os.listdir(os.path.join(self.directory, "oh"))), 4)
+        self.assertEqual(len(leaves(self.read_grid(path))), 4)
+
+    def test_failing_run_writes_nothing(self):
+        path = os.path.join(self.directory, "failed.vtm")
+        status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-p", "nosuch=1",
+                                         "-o", path)
+        self.assertEqual(status, 1)
+        self.assertIn("nosuch", err)
+        self.assertNotIn("grid written", out)
+        self.assertEqual(os.listdir(self.directory), [])
+
+    def test_bad_input_path(self):
+        path = os.path.join(self.directory, "bad_input.vtm")
+        missing = os.path.join(self.directory, "no_such.inf")
+        status, _, err = self.run_main(AXIAL_OH, "-i", missing, "-o", path)
+        self.assertEqual(status, 1)
+        self.assertIn("no_such.inf", err)
+        self.assertEqual(os.listdir(self.directory), [])
 
 
 class BadInputTest(unittest.TestCase):
