@@ -425,8 +425,17 @@ void CarrierGeometry::buildEntry(const BlockModel& model, int index, int depth)
               " away from it); offset a curve on its own surface");
           }
         }
-        const std::vector<Eigen::Vector2d> points = offsetOnSurface(
+        std::vector<Eigen::Vector2d> points = offsetOnSurface(
           *curve.curve, curve.closedS, *Entries[base].surface, toParameters, carrier.distance);
+        // Across the seam of a full surface of revolution t jumps by 1: unwrap it, so the
+        // curve is interpolated the short way round (the surface rotates on past t = 1).
+        if (Entries[base].revolution && Entries[base].closedT)
+        {
+          for (std::size_t k = 1; k < points.size(); ++k)
+          {
+            points[k][1] -= std::round(points[k][1] - points[k - 1][1]);
+          }
+        }
         built.curve = std::make_shared<SurfaceCurve>(Entries[base].surface, points);
         built.closedS = curve.closedS;
         break;

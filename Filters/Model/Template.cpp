@@ -235,6 +235,20 @@ public:
     }
     catch (const mu::ParserError& error)
     {
+      if (error.GetCode() == mu::ecUNASSIGNABLE_TOKEN)
+      {
+        std::vector<std::string> known(Names);
+        known.insert(known.end(), std::begin(names), std::end(names));
+        std::string message = "unknown name '" + error.GetToken() + "' in '" + expression + "'";
+        const std::string suggestion = syntax::closestName(error.GetToken(), known);
+        if (!suggestion.empty())
+        {
+          message += " (did you mean '" + suggestion + "'?)";
+        }
+        throw ExpressionError{ message +
+          "; a function of the point may use x, y, z, axial, radius, theta and the "
+          "parameters and definitions: " + syntax::joinNames(Names) };
+      }
       throw ExpressionError{ "cannot evaluate '" + expression + "' (a function of the point "
                                                                "x, y, z, axial, radius, theta): " +
         error.GetMsg() };
@@ -2382,41 +2396,94 @@ private:
     const double trailing = extremum(point, true, axialOf, -1.0, 0.0, 1.0);
     const std::vector<double>& u = curve.dataParameters(); // u[0] = 0 ... u[n-1] = 1
     const std::size_t n = u.size() - 1;                    // distinct points (closed loop)
-    // The data points strictly between two parameters (cyclic), leaving out those closer
-    // to an end than a quarter of their neighbouring data spacing (no sliver segments).
-    auto between = [&](double from, double to, std::vector<Vec3>& out) {
-      const double span = to > from ? to - from : to + 1.0 - from;
-      std::vector<std::pair<double, std::size_t>> inside;
+    auto offsetFrom = [](double from, double x) { return x - from - std::floor(x - from); };
+    // An edge within a quarter of the neighbouring data spacing of a data point is moved
+    // onto that point (rather than dropping the point: the blade passes through every
+    // input point); otherwise it is inserted between the data points.
+    auto snap = [&](double edge, std::size_t& index) {
       for (std::size_t k = 0; k < n; ++k)
       {
-        double offset = u[k] - from;
-        offset -= std::floor(offset);
         const double before = k > 0 ? u[k] - u[k - 1] : u[n] - u[n - 1];
         const double after = u[k + 1] - u[k];
-        if (offset >= 0.25 * before && span - offset >= 0.25 * after && offset < span)
+        const double ahead = offsetFrom(edge, u[k]); // from the edge forward to the point
+        if (ahead <= 0.25 * before || 1.0 - ahead <= 0.25 * after)
         {
-          inside.emplace_back(offset, k);
+          index = k;
+          return true;
         }
       }
-      std::sort(inside.begin(), inside.end());
-      for (const auto& item : inside)
-      {
-        out.push_back(section.points[item.second]);
-      }
+      return false;
     };
-    // Start (the seam) half-way along the side from the trailing to the leading edge, so
-    // that neither edge lies on the seam, where the curves through the blade are only C0.
-    const double back = trailing + 0.5 * (leading - trailing - std::floor(leading - trailing));
-    const double seam = back - std::floor(back);
-    std::vector<Vec3> points{ curve.point(seam) };
-    between(seam, leading, points);
-    const std::size_t leadingIndex = points.size();
-    points.push_back(curve.point(leading));
-    between(leading, trailing, points);
-    const std::size_t trailingIndex = points.size();
-    points.push_back(curve.point(trailing));
-    between(trailing, seam, points);
+    // Start (the seam) at the data point half-way along the side from the trailing to the
+    // leading edge, so that neither edge lies on the seam, where the curves through the
+    // blade are only C0.
+    const double back = trailing + 0.5 * offsetFrom(trailing, leading);
+    std::size_t seamIndex = 0;
+    double nearest = 2.0;
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      const double d = std::min(offsetFrom(back, u[k]), offsetFrom(u[k], back));
+      if (d < nearest)
+      {
+        nearest = d;
+        seamIndex = k;
+      }
+    }
+    struct Mark
+    {
+      double at;         // parameter on the original curve
+      bool isData;       // a data point (else an inserted edge point)
+      std::size_t index; // data index
+      int role;          // 0 data, 1 leading edge, 2 trailing edge
+    };
+    std::vector<Mark> marks;
+    std::size_t snapped = n;
+    const bool leadingOnData = snap(leading, snapped);
+    const std::size_t leadingData = snapped;
+    const bool trailingOnData = snap(trailing, snapped);
+    const std::size_t trailingData = snapped;
+    if (leadingOnData && trailingOnData && leadingData == trailingData)
+    {
+      throw GeometryError("align: the section's leading and trailing edges coincide");
+    }
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      const int role = leadingOnData && k == leadingData ? 1
+        : trailingOnData && k == trailingData          ? 2
+                                                        : 0;
+      marks.push_back({ u[k], true, k, role });
+    }
+    if (!leadingOnData)
+    {
+      marks.push_back({ leading, false, 0, 1 });
+    }
+    if (!trailingOnData)
+    {
+      marks.push_back({ trailing, false, 0, 2 });
+    }
+    const double seamAt = u[seamIndex];
+    std::sort(marks.begin(), marks.end(), [&](const Mark& x, const Mark& y) {
+      return offsetFrom(seamAt, x.at) < offsetFrom(seamAt, y.at);
+    });
+    std::vector<Vec3> points;
+    std::size_t leadingIndex = 0, trailingIndex = 0;
+    for (const Mark& mark : marks)
+    {
+      if (mark.role == 1)
+      {
+        leadingIndex = points.size();
+      }
+      if (mark.role == 2)
+      {
+        trailingIndex = points.size();
+      }
+      points.push_back(mark.isData ? section.points[mark.index] : curve.point(mark.at));
+    }
     points.push_back(points.front());
+    if (!(leadingIndex > 0 && trailingIndex > leadingIndex))
+    {
+      throw GeometryError("align: the section's edges are not in order around it");
+    }
     std::vector<double> length(points.size(), 0.0);
     for (std::size_t k = 1; k < points.size(); ++k)
     {
@@ -2747,7 +2814,9 @@ private:
   {
     const SurfaceOfRevolution* revolution = Geometry.revolution(surface);
     const Machine& machine = Model.machine;
-    if (!revolution || (revolution->axisDirection() - machine.axis).norm() > 1e-12)
+    const double size = std::max(Geometry.size(surface), 1e-300);
+    if (!revolution || revolution->axisDirection().cross(machine.axis).norm() > 1e-12 ||
+      (revolution->axisPoint() - machine.axisPoint).cross(machine.axis).norm() > 1e-12 * size)
     {
       fail(line, entityText,
         "'axial' and 'theta' place a vertex on a surface of revolution about the machine "
@@ -2805,7 +2874,14 @@ private:
     double ignored = 0.0, radius = 0.0;
     cylindrical(Geometry.point(surface, root, 0.5), ignored, radius, ignored);
     double distance = 0.0;
-    Geometry.project(surface, fromCylindrical(axial, radius, theta), s, t, distance);
+    const Vec3 target = fromCylindrical(axial, radius, theta);
+    Geometry.project(surface, target, s, t, distance);
+    if ((Geometry.point(surface, s, t) - target).norm() > 1e-9 * size)
+    {
+      fail(line, entityText,
+        "theta = " + shortNumber(theta) + " is outside the angle range of surface '" +
+          Model.carriers[surface].name + "'");
+    }
   }
 
   /// `at: {length: f}`, `at: {min: q}` or `at: {max: q}` (q: x, y, z, axial, radius, theta
