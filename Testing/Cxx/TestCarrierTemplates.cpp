@@ -262,27 +262,37 @@ TEST(CarrierTemplates, ControlPointsLieOnTheirCarriers)
     1e-15);
 }
 
+namespace
+{
+/// Writes the model document and reads it back: the same document again, and the same
+/// carrier definitions to the bit (points, parameters, distances). Returns the model read.
+BlockModel documentRoundTrip(const BlockModel& model)
+{
+  const std::string document = writeModelDocument(model);
+  BlockModel reread = readModelDocument(document);
+  EXPECT_EQ(writeModelDocument(reread), document);
+  EXPECT_EQ(reread.carriers.size(), model.carriers.size());
+  for (std::size_t c = 0; c < std::min(model.carriers.size(), reread.carriers.size()); ++c)
+  {
+    const Carrier &a = model.carriers[c], &b = reread.carriers[c];
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.kind, b.kind);
+    EXPECT_EQ(a.refs, b.refs) << a.name;
+    EXPECT_EQ(a.distance, b.distance) << a.name;
+    EXPECT_EQ(a.nodes, b.nodes) << a.name; // the aligned sections' parameters
+    EXPECT_EQ(a.points, b.points) << a.name;
+  }
+  return reread;
+}
+} // namespace
+
 TEST(CarrierTemplates, DocumentRoundTripAndDeterminism)
 {
   const BlockModel model = loadPassage();
   const std::string document = writeModelDocument(model);
   EXPECT_NE(document.find("blockforge_model: 2"), std::string::npos);
   EXPECT_NE(document.find("carriers:"), std::string::npos);
-  const BlockModel reread = readModelDocument(document);
-  EXPECT_EQ(writeModelDocument(reread), document);
-  ASSERT_EQ(reread.carriers.size(), model.carriers.size());
-  for (std::size_t c = 0; c < model.carriers.size(); ++c)
-  {
-    const Carrier &a = model.carriers[c], &b = reread.carriers[c];
-    EXPECT_EQ(a.name, b.name);
-    EXPECT_EQ(a.kind, b.kind);
-    EXPECT_EQ(a.refs, b.refs);
-    ASSERT_EQ(a.points.size(), b.points.size());
-    for (std::size_t p = 0; p < a.points.size(); ++p)
-    {
-      EXPECT_EQ(0, std::memcmp(a.points[p].data(), b.points[p].data(), 3 * sizeof(double)));
-    }
-  }
+  const BlockModel reread = documentRoundTrip(model);
   const Grid original = meshAll(model);
   const Grid again = meshAll(loadPassage());
   const Grid fromDocument = meshAll(reread);
@@ -944,69 +954,52 @@ TEST(CarrierTemplates, DefinitionsResolveLazilyInAnyOrder)
 TEST(CarrierTemplates, DefinitionErrors)
 {
   const std::string head = "parameters:\n  R: 2\n";
+  // The error of a template with these vertices and definitions, expected on the line
+  // that starts with `marker`; `edit` may change the text first.
+  auto check = [&](const std::string& vertices, const std::string& definitions,
+                 const std::string& marker, const std::string& expected,
+                 const std::function<std::string(const std::string&)>& edit = nullptr) {
+    std::string text = featureText(head, vertices, definitions);
+    if (edit)
+    {
+      text = edit(text);
+    }
+    EXPECT_EQ(errorOf([&] { parseFeature(text); }), featureLine(text, marker) + expected);
+  };
   // d1 uses d2 uses d1: the chain, with d1's line (d1 is resolved first)
-  {
-    const std::string text =
-      featureText(head, "  p: [d1, 0, 0]\n", "definitions:\n  d1: \"d2 + 1\"\n  d2: \"2*d1\"\n");
-    EXPECT_EQ(errorOf([&] { parseFeature(text); }),
-      featureLine(text, "  d1:") +
-        "definition 'd1': is defined in terms of itself: definition 'd1' -> definition 'd2' "
-        "-> definition 'd1'");
-  }
+  check("  p: [d1, 0, 0]\n", "definitions:\n  d1: \"d2 + 1\"\n  d2: \"2*d1\"\n", "  d1:",
+    "definition 'd1': is defined in terms of itself: definition 'd1' -> definition 'd2' "
+    "-> definition 'd1'");
   // a definition through a vertex query of a vertex that uses the definition
-  {
-    const std::string text =
-      featureText(head, "  p: [d, 0, 0]\n", "definitions:\n  d: \"p.x + 1\"\n");
-    EXPECT_EQ(errorOf([&] { parseFeature(text); }),
-      featureLine(text, "  d: \"") +
-        "definition 'd': is defined in terms of itself: definition 'd' -> vertex 'p' -> "
-        "definition 'd'");
-  }
+  check("  p: [d, 0, 0]\n", "definitions:\n  d: \"p.x + 1\"\n", "  d: \"",
+    "definition 'd': is defined in terms of itself: definition 'd' -> vertex 'p' -> "
+    "definition 'd'");
   // the name of a parameter, of a function, of a machine value
-  {
-    const std::string text = featureText(head, "  p: [R, 0, 0]\n", "definitions:\n  R: 3\n");
-    EXPECT_EQ(errorOf([&] { parseFeature(text); }),
-      featureLine(text, "  R: 3") + "definition 'R': a parameter has this name already");
-  }
+  check("  p: [R, 0, 0]\n", "definitions:\n  R: 3\n", "  R: 3",
+    "definition 'R': a parameter has this name already");
   for (const std::string reserved : { "sin", "pi", "pitch" })
   {
-    const std::string text =
-      featureText(head, "  p: [R, 0, 0]\n", "definitions:\n  " + reserved + ": 3\n");
-    EXPECT_EQ(errorOf([&] { parseFeature(text); }),
-      featureLine(text, "  " + reserved + ": 3") + "definition '" + reserved + "': '" + reserved +
+    check("  p: [R, 0, 0]\n", "definitions:\n  " + reserved + ": 3\n", "  " + reserved + ": 3",
+      "definition '" + reserved + "': '" + reserved +
         "' is a built-in constant, function or machine value; choose another name");
   }
   // an unknown name inside a definition
-  {
-    const std::string text =
-      featureText(head, "  p: [d, 0, 0]\n", "definitions:\n  d: \"R + foo\"\n");
-    EXPECT_EQ(errorOf([&] { parseFeature(text); }),
-      featureLine(text, "  d: \"") +
-        "definition 'd': unknown name 'foo' in 'R + foo'; parameters available here: axis_x, "
-        "axis_y, axis_z, R");
-  }
+  check("  p: [d, 0, 0]\n", "definitions:\n  d: \"R + foo\"\n", "  d: \"",
+    "definition 'd': unknown name 'foo' in 'R + foo'; parameters available here: axis_x, "
+    "axis_y, axis_z, R");
   // a definition given twice, a definition that is not an expression
   {
-    const std::string text =
-      featureText(head, "  p: [d, 0, 0]\n", "definitions:\n  d: 3\n  d: 4\n");
-    EXPECT_EQ(errorOf([&] { parseFeature(text); }),
-      featureLine(text, "  d: 4") + "definition 'd': defined twice (first on line " +
-        std::to_string(lineContaining(text, "  d: 3")) + ")");
+    const std::string twice = featureText(head, "  p: [d, 0, 0]\n", "definitions:\n  d: 3\n  d: 4\n");
+    check("  p: [d, 0, 0]\n", "definitions:\n  d: 3\n  d: 4\n", "  d: 4",
+      "definition 'd': defined twice (first on line " +
+        std::to_string(lineContaining(twice, "  d: 3")) + ")");
   }
-  {
-    const std::string text = featureText(head, "  p: [d, 0, 0]\n", "definitions:\n  d: [1, 2]\n");
-    EXPECT_EQ(errorOf([&] { parseFeature(text); }),
-      featureLine(text, "  d: [1, 2]") +
-        "definition 'd': expected an expression (a number or a quoted formula)");
-  }
+  check("  p: [d, 0, 0]\n", "definitions:\n  d: [1, 2]\n", "  d: [1, 2]",
+    "definition 'd': expected an expression (a number or a quoted formula)");
   // format 1 has no definitions
-  {
-    std::string text = featureText(head, "  p: [R, 0, 0]\n", "definitions:\n  d: 3\n");
-    text = replaced(text, "blockforge: 2", "blockforge: 1");
-    EXPECT_EQ(errorOf([&] { parseFeature(text); }),
-      featureLine(text, "definitions:") +
-        "the 'definitions' section needs template format 2: write 'blockforge: 2' at the top");
-  }
+  check("  p: [R, 0, 0]\n", "definitions:\n  d: 3\n", "definitions:",
+    "the 'definitions' section needs template format 2: write 'blockforge: 2' at the top",
+    [](const std::string& text) { return replaced(text, "blockforge: 2", "blockforge: 1"); });
 }
 
 namespace
@@ -1812,21 +1805,8 @@ TEST(CarrierTemplates, OffsetAndAlignedCarriersSurviveTheDocument)
   {
     SCOPED_TRACE(data.first);
     const BlockModel model = loadAlignedBlade(data.second);
-    const std::string document = writeModelDocument(model);
-    EXPECT_NE(document.find("kind: offset"), std::string::npos);
-    const BlockModel reread = readModelDocument(document);
-    EXPECT_EQ(writeModelDocument(reread), document);
-    ASSERT_EQ(reread.carriers.size(), model.carriers.size());
-    for (std::size_t c = 0; c < model.carriers.size(); ++c)
-    {
-      const Carrier &a = model.carriers[c], &b = reread.carriers[c];
-      EXPECT_EQ(a.name, b.name);
-      EXPECT_EQ(a.kind, b.kind);
-      EXPECT_EQ(a.refs, b.refs);
-      EXPECT_EQ(a.distance, b.distance) << a.name;
-      EXPECT_EQ(a.nodes, b.nodes) << a.name; // the aligned sections' parameters
-      EXPECT_EQ(a.points, b.points) << a.name;
-    }
+    EXPECT_NE(writeModelDocument(model).find("kind: offset"), std::string::npos);
+    const BlockModel reread = documentRoundTrip(model);
     const CarrierGeometry original(model), again(reread);
     const std::vector<double> us = { 0.0, 0.1, 0.2500001, 0.37, 0.5, 0.75, 0.999 };
     std::vector<std::string> curves = { "o_h", "o_s", "blade_h", "blade_s" };
