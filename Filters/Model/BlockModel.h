@@ -139,7 +139,10 @@ struct Edge
     OnCurve,   ///< the piece of curve carrier `carrier` between the ends' parameters
     OnSurface, ///< straight in the (s, t) space of surface carrier `carrier`
     Project,   ///< straight line from -> to with its nodes projected onto `carrier`
-    Periodic   ///< the nodes of edge `source` rotated by `pitches` machine pitches
+    Periodic,  ///< the nodes of edge `source` rotated by `pitches` machine pitches
+    Follow     ///< edge `source` moved by the blend (1 - f) (from - source.from) +
+               ///< f (to - source.to) at each fraction f: parallel to it, e.g. the
+               ///< O-grid's outer spanwise edges following the blade's
   };
   std::string name;
   Kind kind = Kind::Line;
@@ -153,7 +156,7 @@ struct Edge
   /// the end vertices (their constraint on this carrier, else their projection). Values
   /// outside [0, 1] wrap around a closed carrier.
   std::vector<double> at;
-  int source = -1; ///< Periodic: index of the edge this one is the image of
+  int source = -1; ///< Periodic: the edge this one is the image of; Follow: the one it follows
   int pitches = 0; ///< Periodic
   SourceLocation where;
 };

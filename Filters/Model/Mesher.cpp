@@ -81,6 +81,32 @@ struct NamedCurve
   int projectOnto = -1; ///< Project: the nodes of the straight line are projected onto it
 };
 
+/// A curve moved parallel to itself: base(t) + (1 - t) startShift + t endShift (a `follow`
+/// edge: the source edge's shape between other ends).
+class FollowCurve : public Curve
+{
+public:
+  FollowCurve(CurvePtr base, const Vec3& startShift, const Vec3& endShift)
+    : Base(std::move(base))
+    , StartShift(startShift)
+    , EndShift(endShift)
+  {
+  }
+  Vec3 point(double t) const override
+  {
+    return Base->point(t) + (1.0 - t) * StartShift + t * EndShift;
+  }
+  Vec3 derivative(double t, int order = 1) const override
+  {
+    return order == 1 ? Vec3(Base->derivative(t, 1) + EndShift - StartShift)
+                      : Vec3(Base->derivative(t, order));
+  }
+
+private:
+  CurvePtr Base;
+  Vec3 StartShift, EndShift;
+};
+
 /// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.
 double carrierTolerance(const CarrierGeometry& geometry, int carrier, double size)
 {
@@ -216,6 +242,27 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
         }
       }
       named.length = previous[edge.source].length;
+      break;
+    }
+    case Edge::Kind::Follow:
+    {
+      const int self = static_cast<int>(&edge - model.edges.data());
+      if (edge.source < 0 || edge.source >= self)
+      {
+        throw GeometryError("the source of a follow edge must be an edge defined before it");
+      }
+      const Edge& source = model.edges[edge.source];
+      const NamedCurve& base = previous[edge.source];
+      if (!base.curve || base.projectOnto >= 0 || source.kind == Edge::Kind::Periodic ||
+        source.kind == Edge::Kind::Follow)
+      {
+        throw GeometryError("edge '" + source.name +
+          "' cannot be followed: follow a line, arc, spline, on_curve or on_surface edge");
+      }
+      named.curve = std::make_shared<FollowCurve>(base.curve,
+        start - model.vertices[source.from].position, end - model.vertices[source.to].position);
+      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve);
+      named.length = named.lengthTable->totalLength();
       break;
     }
     default:
@@ -680,8 +727,39 @@ Eigen::Matrix3d trilinearJacobian(const std::array<Vec3, 8>& p, double s, double
   return jacobian;
 }
 
-void checkOrientation(const BlockModel& model, double size)
+/**
+ * The direction in which the edge from vertex a to vertex b leaves a: along the named
+ * edge's curve when there is one (a curved block, e.g. an O-grid block around a blade's
+ * nose, can be right-handed at its corners while the straight lines between its vertices
+ * are not), else the straight line.
+ */
+Vec3 edgeDirectionAt(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const std::map<std::pair<int, int>, int>& named, int a, int b)
 {
+  const Vec3 straight = model.vertices[b].position - model.vertices[a].position;
+  const auto found = named.find({ std::min(a, b), std::max(a, b) });
+  if (found == named.end() || !curves[found->second].curve)
+  {
+    return straight;
+  }
+  const Curve& curve = *curves[found->second].curve;
+  const bool forward = model.edges[found->second].from == a;
+  const double h = 1e-6;
+  const Vec3 step = forward ? Vec3(curve.point(h) - curve.point(0.0))
+                            : Vec3(curve.point(1.0 - h) - curve.point(1.0));
+  const double length = step.norm();
+  return length > 0.0 && std::isfinite(length) ? Vec3(step * (straight.norm() / length))
+                                               : straight;
+}
+
+void checkOrientation(const BlockModel& model, const std::vector<NamedCurve>& curves, double size)
+{
+  std::map<std::pair<int, int>, int> named;
+  for (std::size_t e = 0; e < model.edges.size(); ++e)
+  {
+    const Edge& edge = model.edges[e];
+    named[{ std::min(edge.from, edge.to), std::max(edge.from, edge.to) }] = static_cast<int>(e);
+  }
   const std::string advice = "; list its vertices in Fig. 7 order so that V0->V1 (i), V0->V3 "
                              "(j) and V0->V4 (k) form a right-handed system";
   for (int b = 0; b < static_cast<int>(model.blocks.size()); ++b)
@@ -712,6 +790,14 @@ void checkOrientation(const BlockModel& model, double size)
       fail(block.where, blockEntity(model, b),
         "the block has no volume (its vertices lie in a plane or on a line)");
     }
+    // A corner is folded when the frame of the straight lines to its neighbours and the
+    // frame of its edges as they leave it (curved edges: their tangents) are both
+    // left-handed: a wrong vertex order flips both, while a curved block (an O-grid block
+    // wrapping a blade's nose, whose straight frame flips) or a slightly turned tangent at
+    // a corner that meshes well is not rejected here; the cells' quality tells the rest.
+    auto along = [&](int from, int to) {
+      return edgeDirectionAt(model, curves, named, block.vertices[from], block.vertices[to]);
+    };
     for (int v = 0; v < 8; ++v)
     {
       const int s = CornerS[v], t = CornerT[v], u = CornerU[v];
@@ -723,8 +809,13 @@ void checkOrientation(const BlockModel& model, double size)
       {
         continue; // a collapsed edge meets here: degenerate corners are allowed
       }
+      const int si = cornerAt(1 - s, t, u), ti = cornerAt(s, 1 - t, u), ui = cornerAt(s, t, 1 - u);
+      const Vec3 es = s == 0 ? along(v, si) : Vec3(-along(v, si));
+      const Vec3 et = t == 0 ? along(v, ti) : Vec3(-along(v, ti));
+      const Vec3 eu = u == 0 ? along(v, ui) : Vec3(-along(v, ui));
       const double jacobian = ds.dot(dt.cross(du));
-      if (jacobian < -1e-10 * scale)
+      const double curved = es.dot(et.cross(eu));
+      if (jacobian < -1e-10 * scale && curved < -1e-10 * es.norm() * et.norm() * eu.norm())
       {
         fail(block.where, blockEntity(model, b),
           "the block is inside-out or folded: negative Jacobian at V" + std::to_string(v) +
@@ -1574,7 +1665,7 @@ void checkModelWith(const BlockModel& model, const CarrierGeometry& geometry)
   const Topology topology = buildTopology(model, curves, baseNodeCounts(model), false);
   checkNamedEdgesUsed(model, topology);
   checkSurfaceFaces(model, geometry, topology, size);
-  checkOrientation(model, size);
+  checkOrientation(model, curves, size);
   checkPatches(model, topology, size);
   periodicImages(model, topology, size); // the rotated copies must match node for node
 }

@@ -390,9 +390,9 @@ private:
         }
       }
     }
-    else if (kindName == "periodic")
+    else if (kindName == "periodic" || kindName == "follow")
     {
-      edge.kind = Edge::Kind::Periodic;
+      edge.kind = kindName == "periodic" ? Edge::Kind::Periodic : Edge::Kind::Follow;
       const MapEntry& source = required(keys, "source", node, entityText);
       const std::string sourceName = text(source.value, source.line, entityText, "source");
       for (std::size_t e = 0; e < Model.edges.size(); ++e)
@@ -406,14 +406,17 @@ private:
       {
         fail(source.line, entityText, "unknown source edge '" + sourceName + "'");
       }
-      const MapEntry& pitches = required(keys, "pitches", node, entityText);
-      edge.pitches = integer(pitches.value, pitches.line, entityText, "pitches");
+      if (edge.kind == Edge::Kind::Periodic)
+      {
+        const MapEntry& pitches = required(keys, "pitches", node, entityText);
+        edge.pitches = integer(pitches.value, pitches.line, entityText, "pitches");
+      }
     }
     else
     {
       fail(kind.line, entityText,
         "unknown edge kind '" + kindName +
-          "' (line, arc, spline, on_curve, on_surface, project, periodic)");
+          "' (line, arc, spline, on_curve, on_surface, project, periodic, follow)");
     }
     Model.edges.push_back(edge);
   }
@@ -917,7 +920,7 @@ std::string writeModelDocument(const BlockModel& model)
     out << YAML::Flow << YAML::BeginMap;
     out << YAML::Key << "name" << YAML::Value << edge.name;
     static const char* const edgeKinds[] = { "line", "arc", "spline", "on_curve", "on_surface",
-      "project", "periodic" };
+      "project", "periodic", "follow" };
     out << YAML::Key << "kind" << YAML::Value << edgeKinds[static_cast<int>(edge.kind)];
     out << YAML::Key << "from" << YAML::Value << vertexName(model, edge.from, user);
     out << YAML::Key << "to" << YAML::Value << vertexName(model, edge.to, user);
@@ -949,14 +952,17 @@ std::string writeModelDocument(const BlockModel& model)
         out << YAML::EndSeq;
       }
     }
-    if (edge.kind == Edge::Kind::Periodic)
+    if (edge.kind == Edge::Kind::Periodic || edge.kind == Edge::Kind::Follow)
     {
       if (edge.source < 0 || edge.source >= static_cast<int>(model.edges.size()))
       {
         throw TemplateError(DocumentFile, 0, user, "refers to an edge that does not exist");
       }
       out << YAML::Key << "source" << YAML::Value << model.edges[edge.source].name;
-      out << YAML::Key << "pitches" << YAML::Value << edge.pitches;
+      if (edge.kind == Edge::Kind::Periodic)
+      {
+        out << YAML::Key << "pitches" << YAML::Value << edge.pitches;
+      }
     }
     emitWhere(out, edge.where, model);
     out << YAML::EndMap;

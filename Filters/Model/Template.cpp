@@ -3177,7 +3177,7 @@ private:
     {
       return false;
     }
-    for (const char* key : { "on_curve", "on_surface", "project", "periodic" })
+    for (const char* key : { "on_curve", "on_surface", "project", "periodic", "follow" })
     {
       if (entry.value[key])
       {
@@ -3190,11 +3190,11 @@ private:
   void readEdgeV2(const MapEntry& entry, const std::string& entityText)
   {
     const auto keys = syntax::mapEntries(entry.value, entry.line, entityText, "the edge", Report);
-    syntax::checkKeys(
-      keys, { "on_curve", "on_surface", "project", "periodic", "between", "at", "pitches" },
+    syntax::checkKeys(keys,
+      { "on_curve", "on_surface", "project", "periodic", "follow", "between", "at", "pitches" },
       entityText, Report);
     const MapEntry* kind = syntax::findKind(
-      keys, { "on_curve", "on_surface", "project", "periodic" }, entityText, Report);
+      keys, { "on_curve", "on_surface", "project", "periodic", "follow" }, entityText, Report);
     Edge edge;
     edge.name = entry.key;
     edge.where = where(entry.line);
@@ -3216,14 +3216,15 @@ private:
     {
       fail(pitches->line, entityText, "'pitches' belongs to periodic edges");
     }
-    if (kind->key == "periodic")
+    if (kind->key == "periodic" || kind->key == "follow")
     {
       if (at)
       {
-        fail(at->line, entityText, "a periodic edge takes its nodes from its source edge");
+        fail(at->line, entityText,
+          "a " + kind->key + " edge takes its shape from its source edge, not from 'at'");
       }
-      edge.kind = Edge::Kind::Periodic;
-      const std::string sourceName = name(kind->value, kind->line, entityText, "periodic");
+      edge.kind = kind->key == "periodic" ? Edge::Kind::Periodic : Edge::Kind::Follow;
+      const std::string sourceName = name(kind->value, kind->line, entityText, kind->key);
       for (std::size_t e = 0; e < Model.edges.size(); ++e)
       {
         if (Model.edges[e].name == sourceName)
@@ -3240,10 +3241,13 @@ private:
         }
         const std::string suggestion = syntax::closestName(sourceName, names);
         fail(kind->line, entityText,
-          "periodic: unknown edge '" + sourceName + "'" +
+          kind->key + ": unknown edge '" + sourceName + "'" +
             (suggestion.empty() ? std::string() : " (did you mean '" + suggestion + "'?)") +
             "; the source edge must be defined above this one");
       }
+    }
+    if (kind->key == "periodic")
+    {
       edge.pitches = 1;
       if (pitches)
       {
@@ -3260,7 +3264,7 @@ private:
           "a periodic edge needs the blade count: " + Evaluator.Unavailable["pitch"]);
       }
     }
-    else
+    else if (kind->key != "follow") // a follow edge is its source's shape at its own ends
     {
       const Want want = kind->key == "on_curve" ? Want::Curve : Want::Surface;
       edge.carrier = carrierRef(kind->value, kind->line, entityText, kind->key, want);
