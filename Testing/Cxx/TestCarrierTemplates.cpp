@@ -1842,3 +1842,45 @@ TEST(CarrierTemplates, OffsetAndAlignedCarriersSurviveTheDocument)
     }
   }
 }
+
+// A follow edge is its source edge's shape between its own ends: here the box edge b -> f
+// follows a spline a -> e bulging outwards, b and f being a and e moved by (1, 0, 0), so
+// its nodes are the spline's nodes moved by (1, 0, 0).
+TEST(CarrierTemplates, FollowEdgeIsItsSourceMoved)
+{
+  const std::string edges = "edges:\n"
+                            "  bulge: {spline: [a, e], points: [[9.7, 0, 0.5]]}\n"
+                            "  along: {follow: bulge, between: [b, f]}\n";
+  const std::string text = featureText("", "", edges);
+  const BlockModel model = parseFeature(text);
+  const Grid grid = meshAll(model);
+  const auto& n = grid.nodes[0];
+  double worst = 0.0, bulge = 0.0;
+  for (int k = 0; k < n[2]; ++k)
+  {
+    const Vec3 source = grid.at(0, 0, 0, k), moved = grid.at(0, n[0] - 1, 0, k);
+    worst = std::max(worst, (moved - source - Vec3(1, 0, 0)).norm());
+    bulge = std::max(bulge, 10.0 - source.x());
+  }
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_GT(bulge, 0.2); // the source is curved, so the check means something
+  // the document keeps it
+  const BlockModel reread = documentRoundTrip(model);
+  const Grid again = meshAll(reread);
+  EXPECT_TRUE(sameBits(grid.xyz[0], again.xyz[0]));
+  // errors: a source below, an unknown source, 'at'
+  auto errorFor = [&](const std::string& edgeLines) {
+    return errorOf([&] { parseFeature(featureText("", "", "edges:\n" + edgeLines)); });
+  };
+  const std::string later = "  along: {follow: bulge, between: [b, f]}\n"
+                            "  bulge: {spline: [a, e], points: [[9.7, 0, 0.5]]}\n";
+  EXPECT_EQ(errorFor(later),
+    featureLine(featureText("", "", "edges:\n" + later), "  along:") +
+      "edge 'along': follow: unknown edge 'bulge'; the source edge must be defined above this "
+      "one");
+  const std::string withAt = "  bulge: {spline: [a, e], points: [[9.7, 0, 0.5]]}\n"
+                             "  along: {follow: bulge, between: [b, f], at: [0, 1]}\n";
+  EXPECT_EQ(errorFor(withAt),
+    featureLine(featureText("", "", "edges:\n" + withAt), "  along:") +
+      "edge 'along': a follow edge takes its shape from its source edge, not from 'at'");
+}

@@ -444,3 +444,13 @@ TEST(PassageTemplates, HandedOverCarriersGiveTheSameGrid)
       << "block " << model.blocks[b].name;
   }
 }
+
+// Wide O-grid corners on the distributor's round leading edge: the leading-edge O block
+// wraps 120 degrees of the nose, so the straight lines between its corners fold although
+// its curved edges do not; the model check must let it through (by the edges' tangents),
+// and the grid keeps every property.
+TEST(PassageTemplates, AxialPassageOHWideCornersDistributor)
+{
+  const Checked c = checkPassage("axial_passage_oh", dataSets()[1], { { "o_corner", "60deg" } });
+  EXPECT_GT(c.minJacobian, 0.0);
+}
