@@ -63,8 +63,8 @@ public:
   /**
    * Global interpolation at given parameters: the curve passes through points[k] at
    * parameters[k] (strictly increasing from 0 to 1, one per point). Used to give curves a
-   * common parametrisation (blade sections with the leading edge at 0 and the trailing
-   * edge at 0.5). Throws GeometryError as interpolate() does, and for parameters that are
+   * common parametrisation (blade sections with the leading edge at 0.25 and the
+   * trailing edge at 0.75). Throws GeometryError as interpolate() does, and for parameters that are
    * not one per point, not strictly increasing or not from 0 to 1.
    */
   static BSplineCurve interpolateAt(const std::vector<Vec3>& points,

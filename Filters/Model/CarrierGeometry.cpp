@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 
 namespace blockforge
 {
@@ -25,6 +26,13 @@ double clampUnit(double x)
   return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
 }
 } // namespace
+
+ParameterMethod parameterMethodOf(int method)
+{
+  return method == 0 ? ParameterMethod::Uniform
+    : method == 2    ? ParameterMethod::Centripetal
+                     : ParameterMethod::ChordLength;
+}
 
 double wrapUnit(double x)
 {
@@ -263,10 +271,7 @@ void CarrierGeometry::buildEntry(const BlockModel& model, int index, int depth)
         {
           fail("the degree must be from 1 to " + std::to_string(bspline::MaxDegree));
         }
-        const ParameterMethod method = carrier.parameterMethod == 0
-          ? ParameterMethod::Uniform
-          : carrier.parameterMethod == 2 ? ParameterMethod::Centripetal
-                                         : ParameterMethod::ChordLength;
+        const ParameterMethod method = parameterMethodOf(carrier.parameterMethod);
         // Explicit parameters (nodes) give sections a common parametrisation (align).
         built.curve = std::make_shared<BSplineCurve>(carrier.nodes.empty()
             ? BSplineCurve::interpolate(carrier.points, carrier.degree, method)
@@ -528,11 +533,17 @@ void CarrierGeometry::project(
   }
   if (entry.surface)
   {
-    if (!entry.surfaceProjector)
+    std::shared_ptr<const SurfaceProjector> projector;
     {
-      entry.surfaceProjector = std::make_shared<SurfaceProjector>(entry.surface, 64, 64);
+      // made on first use (a sample of the surface), once, whichever thread asks first
+      std::lock_guard<std::mutex> lock(*ProjectorMutex);
+      if (!entry.surfaceProjector)
+      {
+        entry.surfaceProjector = std::make_shared<SurfaceProjector>(entry.surface, 64, 64);
+      }
+      projector = entry.surfaceProjector;
     }
-    const SurfaceProjection found = entry.surfaceProjector->project(p);
+    const SurfaceProjection found = projector->project(p);
     s = found.s;
     t = found.t;
     distance = found.distance;
@@ -542,11 +553,16 @@ void CarrierGeometry::project(
     }
     return;
   }
-  if (!entry.curveProjector)
+  std::shared_ptr<const CurveProjector> projector;
   {
-    entry.curveProjector = std::make_shared<CurveProjector>(entry.curve, 256);
+    std::lock_guard<std::mutex> lock(*ProjectorMutex);
+    if (!entry.curveProjector)
+    {
+      entry.curveProjector = std::make_shared<CurveProjector>(entry.curve, 256);
+    }
+    projector = entry.curveProjector;
   }
-  const CurveProjection found = entry.curveProjector->project(p);
+  const CurveProjection found = projector->project(p);
   s = found.t;
   t = 0.0;
   distance = found.distance;

@@ -17,6 +17,7 @@
 #include "../Core/Projection.h"
 
 #include <memory>
+#include <mutex>
 
 namespace blockforge
 {
@@ -24,6 +25,9 @@ namespace model
 {
 /// x for x in [0, 1], else x - floor(x): the parameter on a closed carrier.
 double wrapUnit(double x);
+
+/// Carrier::parameterMethod (0 uniform, 1 chord length, 2 centripetal) as the core's enum.
+ParameterMethod parameterMethodOf(int method);
 
 /// The piece u0 -> u1 of a curve, reparametrised on [0, 1] (u0 > u1 runs backwards).
 /// With `closed`, parameters outside [0, 1] wrap.
@@ -142,6 +146,8 @@ private:
   void buildEntry(const BlockModel& model, int index, int depth);
   void refineExtended(const Entry& entry, const Vec3& p, double& s, double& t, double& distance) const;
   std::vector<Entry> Entries;
+  /// Guards the projectors made on first use (copies share it, and the projectors).
+  std::shared_ptr<std::mutex> ProjectorMutex = std::make_shared<std::mutex>();
 };
 } // namespace model
 } // namespace blockforge

@@ -81,30 +81,34 @@ struct NamedCurve
   int projectOnto = -1; ///< Project: the nodes of the straight line are projected onto it
 };
 
-/// A curve moved parallel to itself: base(t) + (1 - t) startShift + t endShift (a `follow`
-/// edge: the source edge's shape between other ends).
+/// A curve moved parallel to itself: base(t) + (1 - t) startShift + t endShift, t the base
+/// curve's own parameter (a `follow` edge: the source edge's shape between other ends).
 class FollowCurve : public Curve
 {
 public:
-  FollowCurve(CurvePtr base, const Vec3& startShift, const Vec3& endShift)
+  /// `reversed`: the follow edge runs from the base's end to its start.
+  FollowCurve(CurvePtr base, const Vec3& startShift, const Vec3& endShift, bool reversed)
     : Base(std::move(base))
     , StartShift(startShift)
     , EndShift(endShift)
+    , Reversed(reversed)
   {
   }
   Vec3 point(double t) const override
   {
-    return Base->point(t) + (1.0 - t) * StartShift + t * EndShift;
+    return Base->point(Reversed ? 1.0 - t : t) + (1.0 - t) * StartShift + t * EndShift;
   }
   Vec3 derivative(double t, int order = 1) const override
   {
-    return order == 1 ? Vec3(Base->derivative(t, 1) + EndShift - StartShift)
-                      : Vec3(Base->derivative(t, order));
+    const double sign = Reversed && order % 2 == 1 ? -1.0 : 1.0;
+    const Vec3 base = sign * Base->derivative(Reversed ? 1.0 - t : t, order);
+    return order == 1 ? Vec3(base + EndShift - StartShift) : base;
   }
 
 private:
   CurvePtr Base;
   Vec3 StartShift, EndShift;
+  bool Reversed;
 };
 
 /// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.
@@ -259,8 +263,15 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
         throw GeometryError("edge '" + source.name +
           "' cannot be followed: follow a line, arc, spline, on_curve or on_surface edge");
       }
-      named.curve = std::make_shared<FollowCurve>(base.curve,
-        start - model.vertices[source.from].position, end - model.vertices[source.to].position);
+      // The follow edge may run either way along its source: its ends go with the
+      // source's nearer ends.
+      const Vec3& sourceStart = model.vertices[source.from].position;
+      const Vec3& sourceEnd = model.vertices[source.to].position;
+      const bool reversed = (start - sourceEnd).norm() + (end - sourceStart).norm() <
+        (start - sourceStart).norm() + (end - sourceEnd).norm();
+      named.curve = reversed
+        ? std::make_shared<FollowCurve>(base.curve, start - sourceEnd, end - sourceStart, true)
+        : std::make_shared<FollowCurve>(base.curve, start - sourceStart, end - sourceEnd, false);
       named.lengthTable = std::make_shared<ArcLengthTable>(named.curve);
       named.length = named.lengthTable->totalLength();
       break;
@@ -1104,6 +1115,48 @@ LocalEdge localEdge(
   return local;
 }
 
+/**
+ * The first cells at every block corner must not be inverted: the first nodes of the three
+ * edges leaving a corner (in +i, +j, +k: towards the corner from the far side) form a
+ * right-handed frame. This is the real shape of the corner cells, whatever the curvature
+ * of the edges; corners where an edge is collapsed (wedges) are skipped.
+ */
+void checkCornerCells(const BlockModel& model, const Topology& topology, double size)
+{
+  for (int b = 0; b < static_cast<int>(model.blocks.size()); ++b)
+  {
+    std::array<std::array<Vec3, 3>, 8> frame{};
+    for (int e = 0; e < 12; ++e)
+    {
+      const LocalEdge edge = localEdge(model, topology, b, e);
+      const double* xyz = edge.xyz();
+      const int n = edge.count;
+      const std::array<int, 2> ends = edgeVertices(e);
+      auto node = [&](int i) { return Vec3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]); };
+      frame[ends[0]][edgeDirection(e)] = node(1) - node(0);
+      frame[ends[1]][edgeDirection(e)] = node(n - 1) - node(n - 2);
+    }
+    for (int v = 0; v < 8; ++v)
+    {
+      const Vec3 &ds = frame[v][0], &dt = frame[v][1], &du = frame[v][2];
+      const double scale = ds.norm() * dt.norm() * du.norm();
+      if (ds.norm() <= 1e-12 * size || dt.norm() <= 1e-12 * size || du.norm() <= 1e-12 * size)
+      {
+        continue;
+      }
+      if (ds.dot(dt.cross(du)) < -1e-10 * scale)
+      {
+        const Block& block = model.blocks[b];
+        fail(block.where, blockEntity(model, b),
+          "the block folds at V" + std::to_string(v) + " (vertex '" +
+            model.vertices[block.vertices[v]].name +
+            "'): the edges leaving it form a left-handed frame, so its corner cells are "
+            "inverted; move the vertices or change the edges' shapes");
+      }
+    }
+  }
+}
+
 /// Face grid of `face` of `block` in the block's own orientation, from its four edges.
 void faceFromEdges(const BlockModel& model, const Topology& topology, int block, int face,
   std::vector<double>& out)
@@ -1773,6 +1826,7 @@ void MultiBlockMesher::computeBoundaries()
   computePeriodicEdges(model, topology);
   const std::vector<PeriodicImage> images = periodicImages(model, topology, modelSize(model));
   computePeriodicPatchEdges(model, topology, images);
+  checkCornerCells(model, topology, modelSize(model));
   std::map<int, const PeriodicImage*> imageOf;
   for (const PeriodicImage& entry : images)
   {

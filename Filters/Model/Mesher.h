@@ -24,8 +24,11 @@ namespace model
  * - every block vertex index valid; every block has positive cells;
  * - node counts agree on every shared edge (message names both blocks and the edge by
  *   its vertex names), and so do the distribution laws (node parameters within 1e-12);
- * - no block is inside-out (negative Jacobian at a non-degenerate corner or negative
- *   volume); degenerate blocks (collapsed edges/faces) are allowed;
+ * - no block is inside-out: negative volume of the straight-edged block, or a
+ *   non-degenerate corner left-handed both along the straight lines to its neighbours and
+ *   along its edges' tangents (curved blocks wrapping a blade's nose pass); degenerate
+ *   blocks (collapsed edges/faces) are allowed. The mesher checks the real corner cells
+ *   too (computeBoundaries: the first nodes of the edges leaving every corner);
  * - a face is shared by at most two blocks, with matching node counts;
  * - patch faces are on the domain boundary, no face is in two patches;
  * - periodic partners exist, have as many faces, and each face maps onto a partner face
@@ -58,7 +61,9 @@ public:
   /// Must be called before computeBoundaries().
   void setCellCap(int cap);
 
-  /// Computes all edge and face node grids (cheap: surface only).
+  /// Computes all edge and face node grids (cheap: surface only). Throws TemplateError
+  /// naming the block and corner when the first nodes of the edges leaving a corner form
+  /// a left-handed frame (inverted corner cells).
   void computeBoundaries();
 
   int blockCount() const;

@@ -232,6 +232,12 @@ public:
       }
       parser->SetExpr(expanded);
       parser->Eval(); // reports unknown names and syntax errors here, once
+      if (parser->GetNumResults() != 1)
+      {
+        throw ExpressionError{ "'" + expression + "' gives " +
+          std::to_string(parser->GetNumResults()) +
+          " comma-separated values where one number is expected" };
+      }
     }
     catch (const mu::ParserError& error)
     {
@@ -2382,10 +2388,8 @@ private:
    */
   void alignSection(Carrier& section)
   {
-    const ParameterMethod method = section.parameterMethod == 0 ? ParameterMethod::Uniform
-      : section.parameterMethod == 2                          ? ParameterMethod::Centripetal
-                                                              : ParameterMethod::ChordLength;
-    const BSplineCurve curve = BSplineCurve::interpolate(section.points, section.degree, method);
+    const BSplineCurve curve = BSplineCurve::interpolate(
+      section.points, section.degree, parameterMethodOf(section.parameterMethod));
     auto point = [&](double u) { return curve.point(u); };
     auto axialOf = [&](const Vec3& p) {
       double axial = 0.0, radius = 0.0, theta = 0.0;
@@ -2958,7 +2962,15 @@ private:
     }
     auto value = [&](const Vec3& p) {
       pointVariables(p, variables);
-      return objective();
+      const double result = objective();
+      if (!std::isfinite(result))
+      {
+        fail(extreme.line, entityText,
+          extreme.key + ": '" + text + "' is " + (std::isnan(result) ? "NaN" : "not finite") +
+            " at the curve point (" + shortNumber(p.x()) + ", " + shortNumber(p.y()) + ", " +
+            shortNumber(p.z()) + ")");
+      }
+      return result;
     };
     return extremum(curve, value, extreme.key == "min" ? 1.0 : -1.0, from, to);
   }

@@ -88,14 +88,22 @@ def write_grid(data_object, path):
             raise RuntimeError(f"could not write {path}{detail}")
         staged_pieces = os.path.join(staging, os.path.basename(pieces))
         # Pieces first, then the .vtm that references them; an older pieces directory is
-        # moved into the staging directory and removed with it.
-        if os.path.isdir(pieces) and not os.path.islink(pieces):
-            os.rename(pieces, os.path.join(staging, ".old-pieces"))
-        elif os.path.lexists(pieces):
-            os.remove(pieces)
-        if os.path.isdir(staged_pieces):
-            os.rename(staged_pieces, pieces)
-        os.replace(os.path.join(staging, name), path)
+        # moved into the staging directory (removed with it on success, moved back if
+        # putting the new grid in place fails).
+        old_pieces = None
+        if os.path.lexists(pieces):
+            old_pieces = os.path.join(staging, ".old-pieces")
+            os.rename(pieces, old_pieces)
+        try:
+            if os.path.isdir(staged_pieces):
+                os.rename(staged_pieces, pieces)
+            os.replace(os.path.join(staging, name), path)
+        except OSError:
+            if old_pieces:
+                if os.path.isdir(pieces) and not os.path.islink(pieces):
+                    shutil.rmtree(pieces, ignore_errors=True)
+                os.rename(old_pieces, pieces)
+            raise
     finally:
         shutil.rmtree(staging, ignore_errors=True)
 
@@ -113,6 +121,8 @@ def main(argv=None):
     parser.add_argument("-d", "--density", type=float, default=1.0,
                         help="grid density multiplier (scales every cell count)")
     args = parser.parse_args(argv)
+    if args.output and not args.output.endswith(".vtm"):
+        parser.error(f"the output must be a .vtm file (a multiblock grid), got '{args.output}'")
 
     timings = {}
     try:

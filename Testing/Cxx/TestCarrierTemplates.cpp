@@ -1868,6 +1868,14 @@ TEST(CarrierTemplates, FollowEdgeIsItsSourceMoved)
   const BlockModel reread = documentRoundTrip(model);
   const Grid again = meshAll(reread);
   EXPECT_TRUE(sameBits(grid.xyz[0], again.xyz[0]));
+  // running the other way along its source gives the same edge
+  const Grid reversed = meshAll(parseFeature(replaced(text, "between: [b, f]", "between: [f, b]")));
+  double apart = 0.0;
+  for (std::size_t i = 0; i < grid.xyz[0].size(); ++i)
+  {
+    apart = std::max(apart, std::abs(grid.xyz[0][i] - reversed.xyz[0][i]));
+  }
+  EXPECT_LT(apart, 1e-12);
   // errors: a source below, an unknown source, 'at'
   auto errorFor = [&](const std::string& edgeLines) {
     return errorOf([&] { parseFeature(featureText("", "", "edges:\n" + edgeLines)); });
@@ -1883,4 +1891,40 @@ TEST(CarrierTemplates, FollowEdgeIsItsSourceMoved)
   EXPECT_EQ(errorFor(withAt),
     featureLine(featureText("", "", "edges:\n" + withAt), "  along:") +
       "edge 'along': a follow edge takes its shape from its source edge, not from 'at'");
+}
+
+// A min/max objective that is NaN somewhere, or that gives several values, is an error
+// naming the vertex (a NaN never compares smaller, so it would silently pick the window's
+// start).
+TEST(CarrierTemplates, CurveExtremumOfNaNOrSeveralValues)
+{
+  const std::string head = "carriers:\n" + circleCarrier();
+  auto check = [&](const std::string& vertex, const std::string& expected) {
+    const std::string text = featureText(head, "  v: " + vertex + "\n");
+    const std::string message = errorOf([&] { parseFeature(text); });
+    EXPECT_EQ(message.rfind(featureLine(text, "  v: ") + "vertex 'v': " + expected, 0), 0u)
+      << message;
+  };
+  check("{on_curve: circle, at: {min: \"sqrt(-1) + axial\"}}",
+    "min: 'sqrt(-1) + axial' is NaN at the curve point (");
+  check("{on_curve: circle, at: {max: \"radius, axial\"}}",
+    "max: 'radius, axial' gives 2 comma-separated values where one number is expected");
+}
+
+// The mesher checks the real corner cells: a spline edge that leaves its corner backwards
+// (first node behind the corner) folds the corner cells although the straight block is
+// right-handed; the error names the block, the corner and its vertex.
+TEST(CarrierTemplates, FoldedCornerCellsAreAnError)
+{
+  const std::string text = featureText("", "",
+    "edges:\n  back: {spline: [a, b], points: [[9.6, 0, 0], [10.4, 0, 0]]}\n");
+  const BlockModel model = parseFeature(text); // the vertices are in a right-handed order
+  MultiBlockMesher mesher(model, 1.0);
+  const std::string message = errorOf([&] { mesher.computeBoundaries(); });
+  EXPECT_EQ(message.rfind(featureLine(text, "  box:") + "block 'box': the block folds at V0 "
+                                                        "(vertex 'a'): the edges leaving it "
+                                                        "form a left-handed frame",
+              0),
+    0u)
+    << message;
 }

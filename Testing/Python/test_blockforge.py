@@ -349,6 +349,29 @@ class CommandLineTest(unittest.TestCase):
         self.assertNotIn("grid written", out)
         self.assertEqual(os.listdir(self.directory), [])
 
+    def test_output_must_be_vtm(self):
+        path = os.path.join(self.directory, "grid")
+        with self.assertRaises(SystemExit) as raised:
+            self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-o", path)
+        self.assertEqual(raised.exception.code, 2)
+        self.assertEqual(os.listdir(self.directory), [])
+
+    def test_failed_move_keeps_the_older_grid(self):
+        """The new grid cannot be put in place (the .vtm path is a directory): the older
+        pieces go back where they were and the error is reported."""
+        path = os.path.join(self.directory, "kept.vtm")
+        status, _, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-o", path)
+        self.assertEqual(status, 0, err)
+        pieces = sorted(os.listdir(os.path.join(self.directory, "kept")))
+        os.remove(path)
+        os.makedirs(os.path.join(path, "occupied"))
+        status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-o", path)
+        self.assertEqual(status, 1)
+        self.assertIn("error:", err)
+        self.assertNotIn("grid written", out)
+        self.assertEqual(sorted(os.listdir(os.path.join(self.directory, "kept"))), pieces)
+        self.assertEqual(sorted(os.listdir(self.directory)), ["kept", "kept.vtm"])
+
     def test_bad_input_path(self):
         path = os.path.join(self.directory, "bad_input.vtm")
         missing = os.path.join(self.directory, "no_such.inf")
