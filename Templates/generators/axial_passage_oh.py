@@ -1,0 +1,243 @@
+#!/usr/bin/python3
+"""Writes Templates/axial_passage_oh.yaml.
+
+The hub and shroud layers of the O-grid template are the same text but for their names
+(_h on `hub`, _s on `shroud`), so they are written from one description here; edit this
+file, then run it (or edit the template and keep both layers alike; CTest's
+Templates.axial_passage_oh_generated checks that this script and the template agree).
+
+Usage: /usr/bin/python3 Templates/generators/axial_passage_oh.py [--check]
+  --check: exit 1 (and say so) when the template differs from what this script writes.
+"""
+import os
+import sys
+
+TEMPLATE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "axial_passage_oh.yaml")
+
+HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, then run it.
+# axial_passage_oh: O-grid around the blade inside H-type blocks, one periodic blade passage
+# of an axial turbomachine between hub and shroud (format 2), with inlet and outlet
+# extensions; after Kolsek et al. 2003 (template 2, Fig. 10). Input: hub, shroud and blade
+# sections (TurboPointSetsReader output). The same parameters mesh Data/rotor37/turbogrid
+# (36 blades, chords leaning +theta) and Data/distributor (16 vanes, leaning -theta).
+#
+#   Unrolled at the hub (axial up, theta to the right); the same at the shroud (_s):
+#
+#      lo_out ------ a_out --------- b_out ------ hi_out      outlet (axial plane)
+#        |    D_L      |      D_M      |    D_R     |
+#      lo_r -------- oa_r ---------- ob_r ------- hi_r
+#        |             | \\   O_te    / |            |
+#        |    M_L      |O_a (blade) O_b|    M_R     |         O_*: O-grid, width o_width
+#        |             | /   O_le    \\ |            |
+#      lo_f -------- oa_f ---------- ob_f ------- hi_f
+#        |    U_L      |      U_M      |    U_R     |
+#      lo_in ------- a_in ---------- b_in ------- hi_in       inlet (axial plane)
+#
+#   periodic_low (lo_*)                     periodic_high (hi_* = lo_* rotated by one pitch)
+#
+# How the decomposition follows the blade, on hub and shroud alike:
+# - blade_*: the blade (Gordon surface through the sections, extended to the hub and shroud
+#   surfaces of revolution) cut by hub/shroud; le/te its extreme axial points; side a is
+#   the side facing periodic_low (found by theta, so the order of the export does not
+#   matter), side b faces periodic_high.
+# - o_*: the blade curve offset within the hub/shroud by o_width chords. Offset curves
+#   keep the normals of the blade, so the O-grid's radial lines are straight and
+#   orthogonal to the blade.
+# - O corners: on the offset curve, where its normal leans o_corner from the camber
+#   direction at the leading (trailing) edge towards each side; a_f/b_f/a_r/b_r are their
+#   feet on the blade. The leading-edge O block O_le thus wraps the nose symmetrically
+#   about the camber line, however staggered the blade.
+# - H blocks: the periodic_low line runs mid-passage (between side a and the side b of the
+#   blade one pitch below) through the front, middle and rear O corners. Upstream and
+#   downstream the H lines leave the O-grid along the camber direction at the edges
+#   (follow_le, follow_te: 1 = the blade angle, 0 = axial) to the inlet and outlet planes;
+#   on staggered blades much below 0.5 folds cells where they meet the O-grid.
+# - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
+#   so a thin O-grid keeps its width along a bowed or leaning blade edge.
+# - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
+#   from hub to shroud; H blocks run i with theta, j with the axis.
+# The passage must lie away from theta = +-pi.
+blockforge: 2
+name: axial_passage_oh
+description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.
+
+inputs: {hub: Hub, shroud: Shroud, sections: Profiles}
+
+parameters:
+  o_width: 0.03           # O-grid width [chords of the hub/shroud section]
+  o_corner: 50deg         # the O-grid corners' normals lean this far from the edge camber direction
+  o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
+  probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
+  follow_le: 0.7          # upstream H lines follow this fraction of the blade's leading-edge angle (0: axial)
+  follow_te: 0.7          # downstream H lines follow this fraction of the trailing-edge angle
+  upstream: 0.5           # inlet distance upstream of the first leading edge [blade axial lengths]
+  downstream: 0.5         # outlet distance downstream of the last trailing edge [blade axial lengths]
+  n_up: 8                 # cells from inlet to the O-grid
+  n_down: 8               # cells from the O-grid to the outlet
+  n_pitch: 6              # cells across each H column beside the O-grid
+  n_le: 8                 # cells around the leading edge
+  n_te: 8                 # cells around the trailing edge
+  n_side: 16              # cells along each blade side
+  n_o: 6                  # cells across the O-grid
+  n_span: 12              # cells from hub to shroud
+  k_o: 1.15               # expansion ratio away from the blade in the O-grid
+  k_span: 1.05            # expansion ratio away from hub and shroud (two-sided)
+"""
+
+FOOTER = """blocks:
+  O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}}}
+  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}}}
+  O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}}}
+  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}}}
+  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {k: {two_sided: k_span}}}
+  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], grading: {k: {two_sided: k_span}}}
+  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {k: {two_sided: k_span}}}
+  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {k: {two_sided: k_span}}}
+  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {k: {two_sided: k_span}}}
+  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], grading: {k: {two_sided: k_span}}}
+  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], grading: {k: {two_sided: k_span}}}
+  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], grading: {k: {two_sided: k_span}}}
+
+faces:
+  hub_faces: {on_surface: hub, faces: [O_le.k0, O_a.k0, O_te.k0, O_b.k0, U_L.k0, U_M.k0, U_R.k0, M_L.k0, M_R.k0, D_L.k0, D_M.k0, D_R.k0]}
+  shroud_faces: {on_surface: shroud, faces: [O_le.k1, O_a.k1, O_te.k1, O_b.k1, U_L.k1, U_M.k1, U_R.k1, M_L.k1, M_R.k1, D_L.k1, D_M.k1, D_R.k1]}
+  blade_faces: {on_surface: blade, faces: [O_le.j0, O_a.j0, O_te.j0, O_b.j0]}
+
+patches:
+  hub: {type: wall, faces: [O_le.k0, O_a.k0, O_te.k0, O_b.k0, U_L.k0, U_M.k0, U_R.k0, M_L.k0, M_R.k0, D_L.k0, D_M.k0, D_R.k0]}
+  shroud: {type: wall, faces: [O_le.k1, O_a.k1, O_te.k1, O_b.k1, U_L.k1, U_M.k1, U_R.k1, M_L.k1, M_R.k1, D_L.k1, D_M.k1, D_R.k1]}
+  blade: {type: wall, faces: [O_le.j0, O_a.j0, O_te.j0, O_b.j0]}
+  inlet: {type: inlet, faces: [U_L.j0, U_M.j0, U_R.j0]}
+  outlet: {type: outlet, faces: [D_L.j1, D_M.j1, D_R.j1]}
+  periodic_low: {type: periodic, faces: [U_L.i0, M_L.i0, D_L.i0], partner: periodic_high, pitches: 1}
+  periodic_high: {type: periodic, faces: [U_R.i1, M_R.i1, D_R.i1]}
+"""
+
+
+def template_text():
+    out = [HEADER]
+    w = out.append
+    L = {'h': 'hub', 's': 'shroud'}
+    w('definitions:')
+    w('  # axial extent of the blade (both layers) and the inlet and outlet planes')
+    w('  blade_axial: "max(te_h.axial, te_s.axial) - min(le_h.axial, le_s.axial)"')
+    w('  inlet_axial: "min(le_h.axial, le_s.axial) - upstream*blade_axial"')
+    w('  outlet_axial: "max(te_h.axial, te_s.axial) + downstream*blade_axial"')
+    for l, S in L.items():
+        w(f'  # --- {S} (_{l}): lengths in the unrolled (axial, r*theta) plane at r = rm_{l}')
+        w(f'  rm_{l}: le_{l}.radius')
+        w(f'  fwd_{l}: "te_{l}.s < le_{l}.s ? te_{l}.s - le_{l}.s + 1 : te_{l}.s - le_{l}.s"        # u from le to te, increasing u')
+        w(f'  dir_{l}: "sin(fm_{l}.theta - bm_{l}.theta) < 0 ? 1 : -1"   # +1: side a (towards periodic_low) lies in increasing u from le')
+        w(f'  side_a_{l}: "dir_{l} > 0 ? fwd_{l} : 1 - fwd_{l}"')
+        w(f'  chord_{l}: "sqrt((te_{l}.axial - le_{l}.axial)^2 + (rm_{l}*(te_{l}.theta - le_{l}.theta))^2)"')
+        for e in ('le', 'te'):
+            # camber direction at the edge: from the mid-point of the two probes to the edge tip
+            w(f'  {e}_ux0_{l}: "{e}_{l}.axial - (pa_{e}_{l}.axial + pb_{e}_{l}.axial)/2"')
+            w(f'  {e}_uy0_{l}: "rm_{l}*({e}_{l}.theta - (pa_{e}_{l}.theta + pb_{e}_{l}.theta)/2)"')
+            w(f'  {e}_ux_{l}: "{e}_ux0_{l}/sqrt({e}_ux0_{l}^2 + {e}_uy0_{l}^2)"      # unit camber direction out of the {"leading" if e=="le" else "trailing"} edge')
+            w(f'  {e}_uy_{l}: "{e}_uy0_{l}/sqrt({e}_ux0_{l}^2 + {e}_uy0_{l}^2)"')
+            w(f'  {e}_vx0_{l}: "pa_{e}_{l}.axial - pb_{e}_{l}.axial - ((pa_{e}_{l}.axial - pb_{e}_{l}.axial)*{e}_ux_{l} + rm_{l}*(pa_{e}_{l}.theta - pb_{e}_{l}.theta)*{e}_uy_{l})*{e}_ux_{l}"')
+            w(f'  {e}_vy0_{l}: "rm_{l}*(pa_{e}_{l}.theta - pb_{e}_{l}.theta) - ((pa_{e}_{l}.axial - pb_{e}_{l}.axial)*{e}_ux_{l} + rm_{l}*(pa_{e}_{l}.theta - pb_{e}_{l}.theta)*{e}_uy_{l})*{e}_uy_{l}"')
+            w(f'  {e}_vx_{l}: "{e}_vx0_{l}/sqrt({e}_vx0_{l}^2 + {e}_vy0_{l}^2)"      # unit normal of the camber towards side a')
+            w(f'  {e}_vy_{l}: "{e}_vy0_{l}/sqrt({e}_vx0_{l}^2 + {e}_vy0_{l}^2)"')
+        # H lines upstream / downstream: slope d(r theta)/d(axial distance from the O-grid)
+        w(f'  slope_in_{l}: "tan(follow_le*atan2(le_uy_{l}, -le_ux_{l}))"')
+        w(f'  slope_out_{l}: "tan(follow_te*atan2(te_uy_{l}, te_ux_{l}))"')
+        # parameter gaps (in the dir sense) between consecutive O corners on the blade and the O curve
+        def gap(name, a, b):
+            x = f'dir_{l}*({b}_{l}.s - {a}_{l}.s)'
+            w(f'  {name}_{l}: "{x} - rint({x} - 0.5)"')
+        gap('gap_le', 'b_f', 'a_f'); gap('gap_a', 'a_f', 'a_r'); gap('gap_te', 'a_r', 'b_r'); gap('gap_b', 'b_r', 'b_f')
+        gap('ogap_le', 'ob_f', 'oa_f'); gap('ogap_a', 'oa_f', 'oa_r'); gap('ogap_te', 'oa_r', 'ob_r'); gap('ogap_b', 'ob_r', 'ob_f')
+    w('')
+    w('carriers:')
+    w('  hub: {revolve: hub, axis: machine}')
+    w('  shroud: {revolve: shroud, axis: machine}')
+    w('  blade: {gordon: sections, blending: spline, closed: true, align: axial}   # every section: leading edge at s = 0.25, trailing edge at 0.75')
+    for l, S in L.items():
+        w(f'  blade_{l}: {{intersect: [blade, {S}]}}')
+        w(f'  o_{l}: {{offset: blade_{l}, on: {S}, distance: "o_width*chord_{l}"}}      # outer boundary of the O-grid')
+        w(f'  lo_{l}: {{surface_curve: {S}, through: [lo_f_{l}, lo_m_{l}, lo_r_{l}]}}      # periodic_low line, mid-passage')
+    w('')
+    w('vertices:')
+    for l, S in L.items():
+        w(f'  # --- {S}: blade edges, camber probes, O-grid corners (offset curve points whose normal')
+        w(f'  # leans o_corner from the camber direction towards each side), their feet on the blade')
+        w(f'  le_{l}: {{on_curve: blade_{l}, at: {{min: axial}}}}')
+        w(f'  te_{l}: {{on_curve: blade_{l}, at: {{max: axial}}}}')
+        w(f'  fm_{l}: {{on_curve: blade_{l}, at: "le_{l}.s + fwd_{l}/2"}}')
+        w(f'  bm_{l}: {{on_curve: blade_{l}, at: "le_{l}.s + fwd_{l}/2 + 0.5"}}')
+        w(f'  pa_le_{l}: {{on_curve: blade_{l}, at: "le_{l}.s + dir_{l}*probe"}}')
+        w(f'  pb_le_{l}: {{on_curve: blade_{l}, at: "le_{l}.s - dir_{l}*probe"}}')
+        w(f'  pa_te_{l}: {{on_curve: blade_{l}, at: "te_{l}.s - dir_{l}*probe"}}')
+        w(f'  pb_te_{l}: {{on_curve: blade_{l}, at: "te_{l}.s + dir_{l}*probe"}}')
+        w(f'  ole_{l}: {{project: le_{l}, onto: o_{l}}}')
+        w(f'  ote_{l}: {{project: te_{l}, onto: o_{l}}}')
+        # each corner is searched on its own side only: from the edge towards side a (b)
+        for v, e, side, towards in (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+')):
+            c = 'o_corner'
+            dx = f'(cos({c})*{e}_ux_{l} {side} sin({c})*{e}_vx_{l})'
+            dy = f'(cos({c})*{e}_uy_{l} {side} sin({c})*{e}_vy_{l})'
+            far = f'o{e}_{l}.s {towards} dir_{l}*o_window'
+            w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}}}')
+        for v in ('a_f', 'b_f', 'a_r', 'b_r'):
+            w(f'  {v}_{l}: {{project: o{v}_{l}, onto: blade_{l}}}')
+        w(f'  a_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s + dir_{l}*side_a_{l}/2"}}')
+        w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
+        w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')
+        w(f'  ob_m_{l}: {{project: b_m_{l}, onto: o_{l}}}')
+        w(f'  # mid-passage points between side a and the side b of the blade one pitch below')
+        for f in ('f', 'm', 'r'):
+            w(f'  lo_{f}_{l}: {{on_surface: {S}, axial: "(oa_{f}_{l}.axial + ob_{f}_{l}.axial)/2", theta: "(oa_{f}_{l}.theta + ob_{f}_{l}.theta - pitch)/2"}}')
+        w(f'  hi_f_{l}: {{periodic: lo_f_{l}}}')
+        w(f'  hi_r_{l}: {{periodic: lo_r_{l}}}')
+        w(f'  # inlet and outlet: on the axial planes, H lines leaving the O-grid along slope_in/out')
+        for v, src in (('lo_in', 'lo_f'), ('a_in', 'oa_f'), ('b_in', 'ob_f')):
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "{src}_{l}.theta + ({src}_{l}.axial - inlet_axial)*slope_in_{l}/rm_{l}"}}')
+        w(f'  hi_in_{l}: {{periodic: lo_in_{l}}}')
+        for v, src in (('lo_out', 'lo_r'), ('a_out', 'oa_r'), ('b_out', 'ob_r')):
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*slope_out_{l}/rm_{l}"}}')
+        w(f'  hi_out_{l}: {{periodic: lo_out_{l}}}')
+    w('')
+    w('edges:')
+    for l, S in L.items():
+        w(f'  # --- {S}: blade arcs and O-grid arcs (clockwise in the sketch), periodic_low line, H lines straight in (s, t)')
+        for name, a, b, g in (('bl_le', 'b_f', 'a_f', 'gap_le'), ('bl_a', 'a_f', 'a_r', 'gap_a'), ('bl_te', 'a_r', 'b_r', 'gap_te'), ('bl_b', 'b_r', 'b_f', 'gap_b')):
+            w(f'  {name}_{l}: {{on_curve: blade_{l}, between: [{a}_{l}, {b}_{l}], at: [{a}_{l}.s, "{a}_{l}.s + dir_{l}*{g}_{l}"]}}')
+        for name, a, b, g in (('ol_le', 'ob_f', 'oa_f', 'ogap_le'), ('ol_a', 'oa_f', 'oa_r', 'ogap_a'), ('ol_te', 'oa_r', 'ob_r', 'ogap_te'), ('ol_b', 'ob_r', 'ob_f', 'ogap_b')):
+            w(f'  {name}_{l}: {{on_curve: o_{l}, between: [{a}_{l}, {b}_{l}], at: [{a}_{l}.s, "{a}_{l}.s + dir_{l}*{g}_{l}"]}}')
+        w(f'  lo_f_lo_r_{l}: {{on_curve: lo_{l}, between: [lo_f_{l}, lo_r_{l}]}}')
+        for a, b in (('a_f', 'oa_f'), ('a_r', 'oa_r'), ('b_f', 'ob_f'), ('b_r', 'ob_r'),
+                     ('lo_in', 'a_in'), ('a_in', 'b_in'), ('b_in', 'hi_in'), ('lo_f', 'oa_f'), ('ob_f', 'hi_f'),
+                     ('lo_r', 'oa_r'), ('ob_r', 'hi_r'), ('lo_out', 'a_out'), ('a_out', 'b_out'), ('b_out', 'hi_out'),
+                     ('lo_in', 'lo_f'), ('lo_r', 'lo_out'), ('a_in', 'oa_f'), ('b_in', 'ob_f'), ('oa_r', 'a_out'), ('ob_r', 'b_out')):
+            w(f'  {a}_{b}_{l}: {{on_surface: {S}, between: [{a}_{l}, {b}_{l}]}}')
+    w('  # --- spanwise on the blade, and the O-grid\'s outer corners following them (a straight line')
+    w('  # between the hub and shroud corners could cut a thin O-grid at a bowed blade edge)')
+    for v in ('a_f', 'a_r', 'b_f', 'b_r'):
+        w(f'  {v}_span: {{on_surface: blade, between: [{v}_h, {v}_s]}}')
+    for v in ('a_f', 'a_r', 'b_f', 'b_r'):
+        w(f'  o{v}_span: {{follow: {v}_span, between: [o{v}_h, o{v}_s]}}')
+    w('')
+    w(FOOTER)
+
+
+    return "\n".join(out)
+
+
+def main(argv):
+    text = template_text()
+    if "--check" in argv:
+        with open(TEMPLATE, encoding="utf-8") as stream:
+            if stream.read() != text:
+                print(f"{TEMPLATE} differs from what {__file__} writes; run it to update")
+                return 1
+        print("up to date")
+        return 0
+    with open(TEMPLATE, "w", encoding="utf-8") as stream:
+        stream.write(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
