@@ -1369,11 +1369,17 @@ private:
 
   /// Unit vector perpendicular to the machine axis from which theta is measured: the
   /// x axis projected (the y axis when the machine axis is close to x).
-  Vec3 referenceDirection() const
+  /// The direction of theta = 0 about `axis`: x (y when the axis is x), made normal to it.
+  static Vec3 defaultReference(const Vec3& axis)
   {
-    const Vec3& axis = Model.machine.axis;
     const Vec3 guess = std::abs(axis.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
     return (guess - guess.dot(axis) * axis).normalized();
+  }
+
+  /// theta = 0 about the machine axis: `machine: {theta_zero: ...}`, else the default.
+  Vec3 referenceDirection() const
+  {
+    return ThetaZero.allFinite() ? ThetaZero : defaultReference(Model.machine.axis);
   }
 
   void cylindrical(const Vec3& p, double& axial, double& radius, double& theta) const
@@ -1406,12 +1412,17 @@ private:
     Machine& machine = Model.machine;
     machine.defined = true;
     double bladeCount = 0.0;
+    std::vector<MapEntry> thetaZero; // a copy: the machine section's entries are local
     if (const MapEntry* section = this->section("machine"))
     {
       const std::string entityText = "machine";
       const auto keys =
         syntax::mapEntries(section->value, section->line, entityText, "the machine section", Report);
-      syntax::checkKeys(keys, { "axis", "origin", "blade_count" }, entityText, Report);
+      syntax::checkKeys(keys, { "axis", "origin", "blade_count", "theta_zero" }, entityText, Report);
+      if (const MapEntry* found = syntax::findEntry(keys, "theta_zero"))
+      {
+        thetaZero.push_back(*found);
+      }
       if (const MapEntry* axis = syntax::findEntry(keys, "axis"))
       {
         machine.axis = unitAxis(*axis, entityText, "machine axis");
@@ -1457,13 +1468,20 @@ private:
       Evaluator.Unavailable["pitch"] = why;
     }
 
-    const MapEntry* inputs = section("inputs");
-    if (!inputs)
+    if (const MapEntry* inputs = section("inputs"))
     {
-      return;
+      bindInputs(*inputs);
     }
+    if (!thetaZero.empty())
+    {
+      readThetaZero(thetaZero.front());
+    }
+  }
+
+  void bindInputs(const MapEntry& inputs)
+  {
     for (const MapEntry& entry :
-      syntax::mapEntries(inputs->value, inputs->line, "", "the inputs section", Report, "input"))
+      syntax::mapEntries(inputs.value, inputs.line, "", "the inputs section", Report, "input"))
     {
       const std::string entityText = entity("input", entry.key);
       if (!syntax::isEntityName(entry.key))
@@ -1514,6 +1532,52 @@ private:
       }
       BoundInputs[entry.key] = BoundInput{ found, entry.line };
     }
+  }
+
+  /// `theta_zero: [x, y, z]` (a direction) or `theta_zero: <input>` (the centroid of that
+  /// input's points): where theta = 0 lies about the machine axis. Templates that compute
+  /// in theta put their passage there, away from the seam theta = +-pi.
+  void readThetaZero(const MapEntry& entry)
+  {
+    const std::string entityText = "machine";
+    const Machine& machine = Model.machine;
+    Vec3 direction = Vec3::Zero();
+    if (entry.value.IsSequence())
+    {
+      direction = vector3(entry.value, entry.line, entityText, "theta_zero");
+    }
+    else
+    {
+      const std::string setName = name(entry.value, entry.line, entityText, "theta_zero");
+      const auto bound = BoundInputs.find(setName);
+      if (bound == BoundInputs.end())
+      {
+        if (InfoOnly && !Inputs)
+        {
+          return;
+        }
+        fail(entry.line, entityText,
+          "theta_zero: '" + setName + "' is neither a direction [x, y, z] nor an input of "
+          "this template");
+      }
+      std::size_t count = 0;
+      for (const InputCurve& curve : bound->second.set->curves)
+      {
+        for (const Vec3& point : curve.points)
+        {
+          direction += point - machine.axisPoint;
+          ++count;
+        }
+      }
+      direction /= static_cast<double>(std::max<std::size_t>(count, 1));
+    }
+    direction -= direction.dot(machine.axis) * machine.axis;
+    if (!direction.allFinite() || direction.norm() <= 1e-12 * std::max(1.0, vertexSpan()))
+    {
+      fail(entry.line, entityText,
+        "theta_zero: the direction is along the machine axis (or zero), so it gives no angle");
+    }
+    ThetaZero = direction.normalized();
   }
 
   std::vector<std::string> inputNames() const
@@ -1931,8 +1995,10 @@ private:
     const Vec3 q = p - axisPoint;
     const double axial = q.dot(axis);
     const double radius = (q - axial * axis).norm();
-    const Vec3 guess = std::abs(axis.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-    const Vec3 e1 = (guess - guess.dot(axis) * axis).normalized();
+    // the machine's theta = 0 when revolving about the machine axis, so that t measures
+    // the same theta as vertex queries (and the seam t = 0, 1 lies at theta = +-pi)
+    const Vec3 e1 = (axis - Model.machine.axis).norm() <= 1e-12 ? referenceDirection()
+                                                                 : defaultReference(axis);
     return axisPoint + axial * axis + radius * e1;
   }
 
@@ -3414,6 +3480,8 @@ private:
   std::map<std::string, BoundInput> BoundInputs;
   CarrierGeometry Geometry;
   std::vector<MapEntry> CarrierEntries, VertexEntries;
+  /// theta = 0 direction (machine: theta_zero); NaN: the default.
+  Vec3 ThetaZero = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
   std::vector<MapEntry> DefinitionEntries;
   std::map<std::string, int> DefinitionIndex;
   std::vector<int> CarrierState, VertexState, DefinitionState; // 0 pending, 1 in progress, 2 done

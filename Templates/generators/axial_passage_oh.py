@@ -56,12 +56,13 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
 #   from hub to shroud; H blocks run i with theta, j with the axis.
-# The passage must lie away from theta = +-pi.
+# - theta is measured from the blade (machine: theta_zero), wherever the export puts it.
 blockforge: 2
 name: axial_passage_oh
 description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.
 
 inputs: {hub: Hub, shroud: Shroud, sections: Profiles}
+machine: {theta_zero: sections}   # theta = 0 through the blade, so the passage is away from the seam theta = +-pi
 
 parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]

@@ -1928,3 +1928,28 @@ TEST(CarrierTemplates, FoldedCornerCellsAreAnError)
     0u)
     << message;
 }
+
+// machine: theta_zero sets where theta = 0 lies about the axis: a direction or the centroid
+// of an input's points; along the axis it gives no angle.
+TEST(CarrierTemplates, ThetaZero)
+{
+  {
+    const std::string text = featureText("machine: {theta_zero: [0, 3, 0]}\n",
+      "  p: {cylindrical: [0.5, 2, 0]}\n  q: {cylindrical: [0.5, 2, 90deg]}\n"
+      "  r: [\"p.theta\", \"q.theta\", 0]\n");
+    const BlockModel model = parseFeature(text);
+    EXPECT_LT((vertexNamed(model, "p").position - Vec3(0, 2, 0.5)).norm(), 1e-15);
+    EXPECT_LT((vertexNamed(model, "q").position - Vec3(-2, 0, 0.5)).norm(), 1e-15);
+    EXPECT_NEAR(vertexNamed(model, "r").position.x(), 0.0, 1e-15);
+    EXPECT_NEAR(vertexNamed(model, "r").position.y(), Pi / 2, 1e-15);
+  }
+  auto check = [&](const std::string& machine, const std::string& expected) {
+    const std::string text = featureText("machine: {theta_zero: " + machine + "}\n", "");
+    EXPECT_EQ(errorOf([&] { parseFeature(text); }),
+      featureLine(text, "machine:") + "machine: " + expected);
+  };
+  check("[0, 0, 2]",
+    "theta_zero: the direction is along the machine axis (or zero), so it gives no angle");
+  check("nosuch",
+    "theta_zero: 'nosuch' is neither a direction [x, y, z] nor an input of this template");
+}

@@ -454,3 +454,55 @@ TEST(PassageTemplates, AxialPassageOHWideCornersDistributor)
   const Checked c = checkPassage("axial_passage_oh", dataSets()[1], { { "o_corner", "60deg" } });
   EXPECT_GT(c.minJacobian, 0.0);
 }
+
+namespace
+{
+/// MinAngle classes and the smallest scaled Jacobian of a template applied to `inputs`.
+std::pair<std::array<long long, 5>, double> qualityOf(
+  const std::string& templateName, const TemplateInputs& inputs)
+{
+  const BlockModel model = loadTemplate(templatePath(templateName), {}, &inputs);
+  const Grid grid = meshAll(model);
+  std::vector<StructuredBlock> blocks;
+  for (std::size_t b = 0; b < grid.nodes.size(); ++b)
+  {
+    blocks.push_back({ grid.xyz[b].data(), grid.nodes[b][0], grid.nodes[b][1], grid.nodes[b][2] });
+  }
+  const auto quality = computeGridQuality(blocks);
+  double smallest = 1e300;
+  for (const auto& q : quality)
+    for (double v : q.scaledJacobian)
+      smallest = std::min(smallest, v);
+  return { minAngleClasses(quality), smallest };
+}
+} // namespace
+
+// Wherever the export puts the blade around the axis (here the distributor turned so that
+// its vane sits at theta = 180, -100 and 170 degrees, across the seam of the hub and shroud
+// surfaces), both templates measure theta from the blade (machine: theta_zero) and give
+// the same grid, turned.
+TEST(PassageTemplates, AnyPlaceAroundTheAxis)
+{
+  const TemplateInputs original = readTemplateInputs(dataSets()[1].inf);
+  for (const std::string name : { "axial_passage_h", "axial_passage_oh" })
+  {
+    const auto reference = qualityOf(name, original);
+    for (const double degrees : { 180.0, -100.0, 170.0 })
+    {
+      SCOPED_TRACE(name + " turned by " + std::to_string(degrees));
+      TemplateInputs turned = original;
+      const double angle = degrees * Pi / 180.0;
+      for (InputPointSet& set : turned.pointSets)
+        for (InputCurve& curve : set.curves)
+          for (Vec3& p : curve.points)
+            p = Vec3(std::cos(angle) * p.x() - std::sin(angle) * p.y(),
+              std::sin(angle) * p.x() + std::cos(angle) * p.y(), p.z());
+      const auto quality = qualityOf(name, turned);
+      EXPECT_NEAR(quality.second, reference.second, 1e-6);
+      for (int c = 0; c < 5; ++c)
+      {
+        EXPECT_NEAR(quality.first[c], reference.first[c], 2) << "class " << c;
+      }
+    }
+  }
+}
