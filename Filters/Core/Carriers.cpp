@@ -897,6 +897,30 @@ public:
     NearPreferred  ///< nearest `preferred`
   };
 
+  /// A root within `reach` of `preferred`, when f changes sign across that small bracket
+  /// (the refinement's guesses are that close): two evaluations and Brent instead of the
+  /// whole scan. False when the bracket shows no sign change (then scan).
+  bool findNear(double s, double preferred, double reach, double& root) const
+  {
+    const double a = std::max(TMin, preferred - reach), b = std::min(TMax, preferred + reach);
+    const double fa = f(s, a), fb = f(s, b);
+    if (!(b > a) || fa == 0.0 || fb == 0.0 || (fa < 0.0) == (fb < 0.0))
+    {
+      return false;
+    }
+    auto fAt = [&](double t) { return f(s, t); };
+    const double t = brentRoot(fAt, a, b, fa, fb, 5e-14);
+    // as in find(): a true root (|f| ~ 0 against the size of the scanned range), not the
+    // jump of f across a contour end's normal
+    const double size = (Surface.point(s, TMin) - Surface.point(s, TMax)).norm();
+    if (std::abs(fAt(t)) > 1e-7 * (size > 0.0 ? size : 1.0))
+    {
+      return false;
+    }
+    root = t;
+    return true;
+  }
+
   /// False when no root exists in the range (as far as the scan can see).
   bool find(double s, double preferred, Preference preference, double& root) const
   {
@@ -1100,7 +1124,9 @@ std::shared_ptr<SurfaceCurve> intersectWithRevolution(std::shared_ptr<const Gord
         continue; // the interval cannot be split further in double precision
       }
       double t;
-      if (!finder.find(s, mid.y(), RootFinder::Preference::NearPreferred, t))
+      const double reach = 1e-3 * (tMax - tMin);
+      if (!finder.findNear(s, mid.y(), reach, t) &&
+        !finder.find(s, mid.y(), RootFinder::Preference::NearPreferred, t))
       {
         throw noIntersection(s);
       }
