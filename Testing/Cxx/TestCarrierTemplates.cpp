@@ -26,55 +26,18 @@ using namespace blockforge::model;
 
 namespace
 {
+using test::expectError;
+using test::Grid;
+using test::lineContaining;
+using test::meshAll;
 using test::Pi;
+using test::readText;
+using test::replaced;
+using test::sameBits;
 
 std::string dataPath(const std::string& name)
 {
-  return std::string(BLOCKFORGE_SOURCE_DIR) + "/Testing/Data/" + name;
-}
-
-std::string readText(const std::string& path)
-{
-  std::ifstream stream(path);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
-}
-
-std::string replaced(std::string text, const std::string& from, const std::string& to)
-{
-  const std::size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos)
-  {
-    text.replace(at, from.size(), to);
-  }
-  return text;
-}
-
-using test::lineContaining;
-
-void expectError(const std::function<void()>& action, const std::vector<std::string>& pieces)
-{
-  try
-  {
-    action();
-    ADD_FAILURE() << "no TemplateError thrown; expected one containing " << pieces.front();
-  }
-  catch (const TemplateError& error)
-  {
-    const std::string message = error.what();
-    for (const std::string& piece : pieces)
-    {
-      EXPECT_NE(message.find(piece), std::string::npos)
-        << "message \"" << message << "\" lacks \"" << piece << "\"";
-    }
-  }
-}
-
-bool sameBits(const std::vector<double>& a, const std::vector<double>& b)
-{
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+  return test::sourcePath("Testing/Data/" + name);
 }
 
 double radius(const Vec3& p)
@@ -114,34 +77,6 @@ TemplateInputs passageInputs(int bladeCount = 12)
   inputs.axis = Vec3::UnitZ();
   inputs.bladeCount = bladeCount;
   return inputs;
-}
-
-struct Grid
-{
-  std::vector<std::array<int, 3>> nodes;
-  std::vector<std::vector<double>> xyz;
-  Vec3 at(int block, int i, int j, int k) const
-  {
-    const auto& n = nodes[block];
-    const double* p = &xyz[block][3 * ((static_cast<std::size_t>(k) * n[1] + j) * n[0] + i)];
-    return Vec3(p[0], p[1], p[2]);
-  }
-};
-
-Grid meshAll(const BlockModel& model, double multiplier = 1.0, int cap = 0)
-{
-  MultiBlockMesher mesher(model, multiplier);
-  mesher.setCellCap(cap);
-  mesher.computeBoundaries();
-  Grid grid;
-  for (int b = 0; b < mesher.blockCount(); ++b)
-  {
-    grid.nodes.push_back(mesher.nodeCounts(b));
-    const auto& n = grid.nodes.back();
-    grid.xyz.emplace_back(3 * static_cast<std::size_t>(n[0]) * n[1] * n[2]);
-    mesher.meshBlock(b, grid.xyz.back().data());
-  }
-  return grid;
 }
 
 BlockModel loadPassage(const TemplateInputs& inputs = passageInputs(),

@@ -22,12 +22,13 @@ using namespace blockforge::model;
 
 namespace
 {
+using test::parameter;
 using test::Pi;
-
 using test::templatePath;
 
 const std::vector<std::string>& ExampleTemplates = test::exampleTemplates();
 
+/// One block of a grid, with the accessors these tests use (same layout as test::Grid).
 struct BlockGrid
 {
   int ni = 0, nj = 0, nk = 0;
@@ -53,22 +54,19 @@ struct BlockGrid
   }
 };
 
-std::vector<BlockGrid> meshAll(const BlockModel& model, double multiplier = 1.0, int cap = 0)
+/// test::meshAll(model, multiplier, cap), one BlockGrid per block.
+std::vector<BlockGrid> meshBlocks(const BlockModel& model, double multiplier = 1.0, int cap = 0)
 {
-  MultiBlockMesher mesher(model, multiplier);
-  mesher.setCellCap(cap);
-  mesher.computeBoundaries();
-  std::vector<BlockGrid> grids(mesher.blockCount());
-  for (int b = 0; b < mesher.blockCount(); ++b)
+  test::Grid grid = test::meshAll(model, multiplier, cap);
+  std::vector<BlockGrid> blocks(grid.nodes.size());
+  for (std::size_t b = 0; b < blocks.size(); ++b)
   {
-    const std::array<int, 3> n = mesher.nodeCounts(b);
-    grids[b].ni = n[0];
-    grids[b].nj = n[1];
-    grids[b].nk = n[2];
-    grids[b].xyz.resize(3 * static_cast<std::size_t>(n[0]) * n[1] * n[2]);
-    mesher.meshBlock(b, grids[b].xyz.data());
+    blocks[b].ni = grid.nodes[b][0];
+    blocks[b].nj = grid.nodes[b][1];
+    blocks[b].nk = grid.nodes[b][2];
+    blocks[b].xyz = std::move(grid.xyz[b]);
   }
-  return grids;
+  return blocks;
 }
 
 /// Pointers to the nodes of one block face, in the face's (a, b) order.
@@ -125,19 +123,6 @@ std::vector<Vec3> patchNodes(
   }
   ADD_FAILURE() << "no patch " << name;
   return nodes;
-}
-
-double parameter(const BlockModel& model, const std::string& name)
-{
-  for (const auto& p : model.parameters)
-  {
-    if (p.first == name)
-    {
-      return p.second;
-    }
-  }
-  ADD_FAILURE() << "no parameter " << name;
-  return NAN;
 }
 
 /// Hexahedron volume by 6 tetrahedra about the diagonal V0-V6.
@@ -205,8 +190,7 @@ bool identical(const std::vector<BlockGrid>& a, const std::vector<BlockGrid>& b)
   }
   for (std::size_t i = 0; i < a.size(); ++i)
   {
-    if (a[i].xyz.size() != b[i].xyz.size() ||
-      std::memcmp(a[i].xyz.data(), b[i].xyz.data(), a[i].xyz.size() * sizeof(double)) != 0)
+    if (!test::sameBits(a[i].xyz, b[i].xyz))
     {
       return false;
     }
@@ -218,7 +202,7 @@ bool identical(const std::vector<BlockGrid>& a, const std::vector<BlockGrid>& b)
 TEST(Mesher, CylinderWallNodesAtRadius)
 {
   const BlockModel model = loadTemplate(templatePath("cylinder_in_box.yaml"));
-  const auto grids = meshAll(model);
+  const auto grids = meshBlocks(model);
   const double R = parameter(model, "R");
   const std::vector<Vec3> wall = patchNodes(model, grids, "cylinder");
   ASSERT_EQ(wall.size(), 4u * 17 * 9);
@@ -231,7 +215,7 @@ TEST(Mesher, CylinderWallNodesAtRadius)
 TEST(Mesher, CylinderBoxNodesOnTheBox)
 {
   const BlockModel model = loadTemplate(templatePath("cylinder_in_box.yaml"));
-  const auto grids = meshAll(model);
+  const auto grids = meshBlocks(model);
   const double B = parameter(model, "B"), D = parameter(model, "D");
   for (const auto& side : std::vector<std::pair<std::string, int>>{
          { "inlet", 0 }, { "outlet", 0 }, { "top", 1 }, { "bottom", 1 } })
@@ -257,7 +241,7 @@ TEST(Mesher, CylinderBoxNodesOnTheBox)
 TEST(Mesher, EdgeNodesFollowTheLaws)
 {
   const BlockModel model = loadTemplate(templatePath("cylinder_in_box.yaml"));
-  const auto grids = meshAll(model);
+  const auto grids = meshBlocks(model);
   const BlockGrid& north = grids[model.findBlock("north")];
   const double kWall = parameter(model, "k_wall");
   // The radial edge w_ne0 -> b_ne0 (north's E2): geometric, each cell k_wall times the last.
@@ -282,7 +266,7 @@ TEST(Mesher, CornerNodesAreTheVertices)
   for (const std::string& name : ExampleTemplates)
   {
     const BlockModel model = loadTemplate(templatePath(name));
-    const auto grids = meshAll(model);
+    const auto grids = meshBlocks(model);
     for (std::size_t b = 0; b < grids.size(); ++b)
     {
       const BlockGrid& g = grids[b];
@@ -306,7 +290,7 @@ TEST(Mesher, SharedFacesAreBitIdentical)
     const BlockModel model = loadTemplate(templatePath(name));
     for (double multiplier : { 1.0, 2.0 })
     {
-      const auto grids = meshAll(model, multiplier);
+      const auto grids = meshBlocks(model, multiplier);
       const auto pairs = sharedFaces(model);
       EXPECT_FALSE(pairs.empty()) << name;
       for (const auto& pair : pairs)
@@ -359,8 +343,8 @@ TEST(Mesher, DensityMultiplierAndCap)
   }
   // A preview cap where the first-cell law cannot fit any more falls back, not fails.
   const BlockModel annulus = loadTemplate(templatePath("annular_sector.yaml"));
-  EXPECT_NO_THROW(meshAll(annulus, 1.0, 3));
-  EXPECT_NO_THROW(meshAll(annulus, 0.2));
+  EXPECT_NO_THROW(meshBlocks(annulus, 1.0, 3));
+  EXPECT_NO_THROW(meshBlocks(annulus, 0.2));
 }
 
 TEST(Mesher, Deterministic)
@@ -368,8 +352,8 @@ TEST(Mesher, Deterministic)
   for (const std::string& name : ExampleTemplates)
   {
     const BlockModel model = loadTemplate(templatePath(name));
-    const auto first = meshAll(model);
-    const auto second = meshAll(model);
+    const auto first = meshBlocks(model);
+    const auto second = meshBlocks(model);
     EXPECT_TRUE(identical(first, second)) << name;
 
     // Blocks meshed concurrently, in reverse order, from one mesher: the same doubles.
@@ -398,7 +382,7 @@ TEST(Mesher, Deterministic)
 TEST(Mesher, AnnularSectorIsPeriodic)
 {
   const BlockModel model = loadTemplate(templatePath("annular_sector.yaml"));
-  const auto grids = meshAll(model);
+  const auto grids = meshBlocks(model);
   const double theta = parameter(model, "theta");
   const double size = parameter(model, "r_out");
   const std::vector<Vec3> low = patchNodes(model, grids, "periodic_low");
@@ -439,7 +423,7 @@ TEST(Mesher, WedgeMeshesWithoutInvertedCells)
   const BlockModel model = loadTemplate(templatePath("wedge_sector.yaml"));
   for (double multiplier : { 1.0, 2.0 })
   {
-    const auto grids = meshAll(model, multiplier);
+    const auto grids = meshBlocks(model, multiplier);
     std::size_t cells = 0;
     for (const BlockGrid& g : grids)
     {
@@ -474,7 +458,7 @@ TEST(Mesher, WedgeMeshesWithoutInvertedCells)
 TEST(Mesher, CylinderInBoxVolume)
 {
   const BlockModel model = loadTemplate(templatePath("cylinder_in_box.yaml"));
-  const auto grids = meshAll(model);
+  const auto grids = meshBlocks(model);
   const double R = parameter(model, "R"), B = parameter(model, "B"), D = parameter(model, "D");
   const double exact = (4 * B * B - Pi * R * R) * D;
   const double volume = gridVolume(grids);
@@ -523,7 +507,7 @@ blocks:
   box: {vertices: [a0, a1, a2, a3, a4, a5, a6, a7], cells: [4, 3, 2]}
 )yaml";
   const BlockModel model = parseTemplate(text, "edges.yaml");
-  const auto grids = meshAll(model);
+  const auto grids = meshBlocks(model);
   const BlockGrid& g = grids[0];
   // Spline, defined from a1 to a0 (against the block's i direction).
   EXPECT_LT((g.node(2, 0, 0) - Vec3(0.5, -0.1, 0)).norm(), 1e-9);

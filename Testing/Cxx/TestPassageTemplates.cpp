@@ -54,34 +54,9 @@ std::string templatePath(const std::string& name)
   return test::templatePath(name + ".yaml");
 }
 
+using test::Grid;
+using test::meshAll;
 using test::readTemplateInputs;
-
-struct Grid
-{
-  std::vector<std::array<int, 3>> nodes;
-  std::vector<std::vector<double>> xyz;
-  Vec3 at(int block, int i, int j, int k) const
-  {
-    const auto& n = nodes[block];
-    const double* p = &xyz[block][3 * ((static_cast<std::size_t>(k) * n[1] + j) * n[0] + i)];
-    return Vec3(p[0], p[1], p[2]);
-  }
-};
-
-Grid meshAll(const BlockModel& model)
-{
-  MultiBlockMesher mesher(model, 1.0);
-  mesher.computeBoundaries();
-  Grid grid;
-  for (int b = 0; b < mesher.blockCount(); ++b)
-  {
-    grid.nodes.push_back(mesher.nodeCounts(b));
-    const auto& n = grid.nodes.back();
-    grid.xyz.emplace_back(3 * static_cast<std::size_t>(n[0]) * n[1] * n[2]);
-    mesher.meshBlock(b, grid.xyz.back().data());
-  }
-  return grid;
-}
 
 /// The nodes of one block face (0..5 = i0 i1 j0 j1 k0 k1).
 std::vector<Vec3> faceNodes(const Grid& grid, const BlockFace& face)

@@ -6,38 +6,23 @@ Run by CTest with pvpython; BLOCKFORGE_PLUGIN is the plugin library of the build
 """
 import math
 import os
-import sys
 import unittest
 
 from paraview import servermanager
-from paraview.simple import Delete, LoadPlugin, OpenDataFile
+from paraview.simple import Delete, OpenDataFile
 from paraview.vtk.numpy_interface import dataset_adapter as dsa
 from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIntArray, vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkMultiBlockDataSet, vtkPolyData
 from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataWriter
 import numpy as np
 
-PLUGIN = os.environ["BLOCKFORGE_PLUGIN"]
-SOURCE = os.environ.get("BLOCKFORGE_SOURCE_DIR",
-                        os.path.join(os.path.dirname(__file__), "..", ".."))
-OUTPUT = os.environ.get("BLOCKFORGE_TEST_OUTPUT", "/tmp/blockforge-test-output")
-DATA = os.path.join(SOURCE, "Testing", "Data")
+import bftest
+from bftest import DATA, DISTRIBUTOR_INF, ROTOR37_INF, SOURCE, leaves, node_array, rotate_z
+
 PASSAGE = os.path.join(DATA, "annular_passage.yaml")
-INF = os.path.join(SOURCE, "Data", "rotor37", "turbogrid", "BladeGen.inf")
-DISTRIBUTOR_INF = os.path.join(SOURCE, "Data", "distributor", "BladeGen.inf")
 
 # Defines TurboPointSetsReader, BlockTemplate, BlockMesher, ... in this module.
-LoadPlugin(PLUGIN, remote=False, ns=globals())
-
-
-def leaves(multiblock):
-    result = []
-    iterator = multiblock.NewIterator()
-    iterator.InitTraversal()
-    while not iterator.IsDoneWithTraversal():
-        result.append(iterator.GetCurrentDataObject())
-        iterator.GoToNextItem()
-    return result
+bftest.load_plugin(globals())
 
 
 def polyline(points):
@@ -82,8 +67,7 @@ def point_sets(blade_count=12):
 
 
 def save_point_sets(name, blade_count=12):
-    os.makedirs(OUTPUT, exist_ok=True)
-    path = os.path.join(OUTPUT, name)
+    path = bftest.output_path(name)
     writer = vtkXMLMultiBlockDataWriter()
     writer.SetFileName(path)
     writer.SetInputData(point_sets(blade_count))
@@ -91,23 +75,12 @@ def save_point_sets(name, blade_count=12):
     return path
 
 
-def rotate_z(points, angle):
-    c, s = math.cos(angle), math.sin(angle)
-    return np.column_stack((c * points[:, 0] - s * points[:, 1],
-                            s * points[:, 0] + c * points[:, 1], points[:, 2]))
-
-
-def block_array(block):
-    nx, ny, nz = block.GetDimensions()
-    return np.array(dsa.WrapDataObject(block).Points).reshape(nz, ny, nx, 3)
-
-
 class BlockTemplateTest(unittest.TestCase):
     def check_passage(self, grid, pitch, hub_radius_of, shroud_radius, tolerance):
         blocks = leaves(grid)
         self.assertEqual(len(blocks), 2)
         for block in blocks:
-            nodes = block_array(block)
+            nodes = node_array(block)
             hub, shroud = nodes[0].reshape(-1, 3), nodes[-1].reshape(-1, 3)
             np.testing.assert_allclose(np.hypot(hub[:, 0], hub[:, 1]), hub_radius_of(hub[:, 2]),
                                        rtol=0, atol=tolerance)
@@ -163,7 +136,7 @@ class BlockTemplateTest(unittest.TestCase):
 
     def test_rotor37_passage(self):
         """The real Rotor 37 hub and shroud (cm, read in metres, 36 blades)."""
-        reader = TurboPointSetsReader(FileName=INF)
+        reader = TurboPointSetsReader(FileName=ROTOR37_INF)
         template = BlockTemplate(Input=reader, TemplateFile=PASSAGE)
         template.Parameters = ["z_in", "0.0", "z_out", "0.04", "r_probe", "0.18", "r_outer", "0.25"]
         mesher = BlockMesher(Input=template)
@@ -189,7 +162,7 @@ class BlockTemplateTest(unittest.TestCase):
 
     def test_rotor37_h_grid(self):
         """Templates/axial_passage_h.yaml on the Rotor 37 export: 8 blocks, periodic, sound."""
-        reader = TurboPointSetsReader(FileName=INF)
+        reader = TurboPointSetsReader(FileName=ROTOR37_INF)
         template = BlockTemplate(Input=reader,
                                  TemplateFile=os.path.join(SOURCE, "Templates", "axial_passage_h.yaml"))
         mesher = BlockMesher(Input=template)
@@ -202,7 +175,7 @@ class BlockTemplateTest(unittest.TestCase):
         jacobian = grid.GetFieldData().GetArray("ScaledJacobianSummary").GetTuple(0)
         self.assertGreater(jacobian[0], 0.0)
         for low, high in (("UL", "UR"), ("BL", "BR"), ("AL", "AR"), ("DL", "DR")):
-            a, b = block_array(blocks[low]), block_array(blocks[high])
+            a, b = node_array(blocks[low]), node_array(blocks[high])
             np.testing.assert_allclose(rotate_z(a[:, :, 0, :].reshape(-1, 3), 2 * math.pi / 36),
                                        b[:, :, -1, :].reshape(-1, 3), rtol=0, atol=1e-12)
         for proxy in (quality, mesher, template, reader):
@@ -237,7 +210,7 @@ class BlockTemplateTest(unittest.TestCase):
     def test_errors_leave_empty_output(self):
         path = save_point_sets("passage_point_sets_err.vtm")
         points = OpenDataFile(path)
-        broken = os.path.join(OUTPUT, "passage_bad_input.yaml")
+        broken = bftest.output_path("passage_bad_input.yaml")
         with open(PASSAGE) as source, open(broken, "w") as target:
             target.write(source.read().replace("hub: Hub ", "hub: Hbu "))
         template = BlockTemplate(Input=points, TemplateFile=broken)
@@ -250,5 +223,4 @@ class BlockTemplateTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    result = unittest.main(verbosity=2, argv=[sys.argv[0]], exit=False).result
-    sys.exit(0 if result.wasSuccessful() else 1)
+    bftest.run_tests()

@@ -7,71 +7,20 @@ import io
 import math
 import os
 import shutil
-import sys
 import unittest
 
 import blockforge
 from blockforge.__main__ import main as blockforge_main
 from vtkmodules.numpy_interface import dataset_adapter as dsa
-from vtkmodules.vtkCommonCore import vtkCommand
 from vtkmodules.vtkFiltersVerdict import vtkMeshQuality
 from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataReader, vtkXMLMultiBlockDataWriter
-from vtkmodules.util.misc import calldata_type
-from vtkmodules.util.vtkConstants import VTK_STRING
 import numpy as np
 
-SOURCE = os.environ.get("BLOCKFORGE_SOURCE_DIR",
-                        os.path.join(os.path.dirname(__file__), "..", ".."))
-OUTPUT = os.environ.get("BLOCKFORGE_TEST_OUTPUT", "/tmp/blockforge-test-output")
-CYLINDER = os.path.join(SOURCE, "Templates", "cylinder_in_box.yaml")
+import bftest
+from bftest import (CYLINDER, DATA, DISTRIBUTOR_INF, OUTPUT, ROTOR37_INF, SOURCE,
+                    ErrorCollector, named_leaves, node_array, points, rotate_z)
+
 AXIAL_OH = os.path.join(SOURCE, "Templates", "axial_passage_oh.yaml")
-DATA = os.path.join(SOURCE, "Testing", "Data")
-DISTRIBUTOR = os.path.join(SOURCE, "Data", "distributor", "BladeGen.inf")
-ROTOR37 = os.path.join(SOURCE, "Data", "rotor37", "turbogrid", "BladeGen.inf")
-
-
-def leaves(multiblock):
-    """(name, dataset) of every non-empty leaf, in order."""
-    result = []
-    iterator = multiblock.NewIterator()
-    iterator.InitTraversal()
-    while not iterator.IsDoneWithTraversal():
-        name = iterator.GetCurrentMetaData().Get(multiblock.NAME())
-        result.append((name, iterator.GetCurrentDataObject()))
-        iterator.GoToNextItem()
-    return result
-
-
-def points(dataset):
-    return np.array(dsa.WrapDataObject(dataset).Points)
-
-
-def node_array(block):
-    """The nodes of a structured block as an array [k, j, i, xyz]."""
-    dimensions = [0, 0, 0]
-    block.GetDimensions(dimensions)
-    nx, ny, nz = dimensions
-    return points(block).reshape(nz, ny, nx, 3)
-
-
-def rotate_z(xyz, angle):
-    c, s = math.cos(angle), math.sin(angle)
-    return np.column_stack((c * xyz[:, 0] - s * xyz[:, 1], s * xyz[:, 0] + c * xyz[:, 1],
-                            xyz[:, 2]))
-
-
-class ErrorCollector:
-    """Collects vtkErrorMacro messages of the observed algorithms."""
-
-    def __init__(self, *algorithms):
-        self.messages = []
-
-        @calldata_type(VTK_STRING)
-        def collect(_caller, _event, message):
-            self.messages.append(message)
-
-        for algorithm in algorithms:
-            algorithm.AddObserver(vtkCommand.ErrorEvent, collect)
 
 
 def pipeline(template, parameters=None, density=1.0):
@@ -106,7 +55,7 @@ class CylinderInBoxTest(unittest.TestCase):
 
     def test_block_names_and_cell_count(self):
         _, _, grid = self.mesh()
-        blocks = leaves(grid)
+        blocks = named_leaves(grid)
         self.assertEqual(len(blocks), 4)
         self.assertTrue(all(name for name, _ in blocks))
         cells = sum(block.GetNumberOfCells() for _, block in blocks)
@@ -114,7 +63,7 @@ class CylinderInBoxTest(unittest.TestCase):
 
     def test_wall_nodes_on_exact_radius(self):
         _, _, grid = self.mesh()
-        xyz = np.concatenate([points(block) for _, block in leaves(grid)])
+        xyz = np.concatenate([points(block) for _, block in named_leaves(grid)])
         radius = np.hypot(xyz[:, 0], xyz[:, 1])
         wall = radius < self.R * (1 + 1e-6)
         # 4 blocks, each with (AROUND+1) x (DEPTH+1) wall nodes
@@ -127,21 +76,20 @@ class CylinderInBoxTest(unittest.TestCase):
 
     def test_parameter_override_and_density(self):
         _, _, grid = self.mesh({"R": 0.6, "n_around": "2*8"}, density=2.0)
-        xyz = np.concatenate([points(block) for _, block in leaves(grid)])
+        xyz = np.concatenate([points(block) for _, block in named_leaves(grid)])
         self.assertAlmostEqual(np.hypot(xyz[:, 0], xyz[:, 1]).min(), 0.6, places=12)
-        cells = sum(block.GetNumberOfCells() for _, block in leaves(grid))
+        cells = sum(block.GetNumberOfCells() for _, block in named_leaves(grid))
         self.assertEqual(cells, 4 * 32 * 32 * 16)
 
     def test_deterministic_bit_for_bit(self):
         _, _, first = self.mesh()
         _, _, second = self.mesh()
-        for (_, a), (_, b) in zip(leaves(first), leaves(second)):
+        for (_, a), (_, b) in zip(named_leaves(first), named_leaves(second)):
             self.assertEqual(points(a).tobytes(), points(b).tobytes())
 
     def test_model_survives_vtm_round_trip(self):
         source, mesher, direct = self.mesh()
-        os.makedirs(OUTPUT, exist_ok=True)
-        path = os.path.join(OUTPUT, "cylinder_preview.vtm")
+        path = bftest.output_path("cylinder_preview.vtm")
         writer = vtkXMLMultiBlockDataWriter()
         writer.SetInputConnection(source.GetOutputPort())
         writer.SetFileName(path)
@@ -154,8 +102,8 @@ class CylinderInBoxTest(unittest.TestCase):
         remesher.Update()
         self.assertEqual(errors.messages, [])
         reloaded = remesher.GetOutput()
-        self.assertEqual(len(leaves(reloaded)), len(leaves(direct)))
-        for (name_a, a), (name_b, b) in zip(leaves(direct), leaves(reloaded)):
+        self.assertEqual(len(named_leaves(reloaded)), len(named_leaves(direct)))
+        for (name_a, a), (name_b, b) in zip(named_leaves(direct), named_leaves(reloaded)):
             self.assertEqual(name_a, name_b)
             self.assertEqual(points(a).tobytes(), points(b).tobytes())
 
@@ -163,7 +111,7 @@ class CylinderInBoxTest(unittest.TestCase):
         source, _, _ = self.mesh()
         source.SetPreviewCells(4)
         source.Update()
-        for _, block in leaves(source.GetOutput()):
+        for _, block in named_leaves(source.GetOutput()):
             self.assertTrue(all(d - 1 <= 4 for d in block.GetDimensions()))
 
 
@@ -172,7 +120,7 @@ class GridQualityTest(unittest.TestCase):
         quality = blockforge.mesh_template(CYLINDER)
         grid = quality.GetOutputDataObject(0)
         total = 0
-        for name, block in leaves(grid):
+        for name, block in named_leaves(grid):
             cell_data = block.GetCellData()
             for array in ("MinAngle", "MaxAngle", "NonOrthogonality", "Skewness",
                           "AspectRatio", "ScaledJacobian", "BlockId"):
@@ -212,7 +160,7 @@ class GridQualityTest(unittest.TestCase):
     def test_unit_cubes_are_perfect(self):
         quality = blockforge.mesh_template(os.path.join(DATA, "two_blocks.yaml"))
         grid = quality.GetOutputDataObject(0)
-        for _, block in leaves(grid):
+        for _, block in named_leaves(grid):
             data = dsa.WrapDataObject(block).CellData
             np.testing.assert_allclose(data["MinAngle"], 90.0, atol=1e-9)
             np.testing.assert_allclose(data["MaxAngle"], 90.0, atol=1e-9)
@@ -234,7 +182,7 @@ class AxialPassageOHTest(unittest.TestCase):
     def check_grid(self, input_file, blade_count):
         quality = blockforge.mesh_template(AXIAL_OH, input_file=input_file)
         grid = quality.GetOutputDataObject(0)
-        blocks = dict(leaves(grid))
+        blocks = dict(named_leaves(grid))
         self.assertEqual(sorted(blocks), self.BLOCKS)
         cells = sum(block.GetNumberOfCells() for block in blocks.values())
         self.assertEqual(cells, self.CELLS)
@@ -270,10 +218,10 @@ class AxialPassageOHTest(unittest.TestCase):
                                        rtol=0, atol=1e-12)
 
     def test_distributor(self):
-        self.check_grid(DISTRIBUTOR, 16)
+        self.check_grid(DISTRIBUTOR_INF, 16)
 
     def test_rotor37(self):
-        self.check_grid(ROTOR37, 36)
+        self.check_grid(ROTOR37_INF, 36)
 
     def test_bad_input_path_raises(self):
         missing = os.path.join(OUTPUT, "no_such_dir", "BladeGen.inf")
@@ -309,7 +257,7 @@ class CommandLineTest(unittest.TestCase):
 
     def test_input_writes_vtm_atomically(self):
         path = os.path.join(self.directory, "oh.vtm")
-        status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-o", path)
+        status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-o", path)
         self.assertEqual(status, 0, err)
         self.assertIn("cells: 9600", out)
         self.assertIn("grid written to", out)
@@ -317,15 +265,16 @@ class CommandLineTest(unittest.TestCase):
         self.assertEqual(sorted(os.listdir(self.directory)), ["oh", "oh.vtm"])
         self.assertEqual(len(os.listdir(os.path.join(self.directory, "oh"))), 12)
         grid = self.read_grid(path)
-        self.assertEqual(len(leaves(grid)), 12)
-        self.assertEqual(sum(block.GetNumberOfCells() for _, block in leaves(grid)), 9600)
-        for _, block in leaves(grid):
+        self.assertEqual(len(named_leaves(grid)), 12)
+        self.assertEqual(sum(block.GetNumberOfCells() for _, block in named_leaves(grid)), 9600)
+        for _, block in named_leaves(grid):
             self.assertIsNotNone(block.GetCellData().GetArray("ScaledJacobian"))
 
         # a failing run over an existing grid leaves it untouched
         with open(path, "rb") as file:
             before = file.read()
-        status, _, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-p", "nosuch=1", "-o", path)
+        status, _, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "nosuch=1",
+                                       "-o", path)
         self.assertEqual(status, 1)
         self.assertIn("nosuch", err)
         with open(path, "rb") as file:
@@ -338,11 +287,11 @@ class CommandLineTest(unittest.TestCase):
         self.assertEqual(status, 0, err)
         self.assertEqual(sorted(os.listdir(self.directory)), ["oh", "oh.vtm"])
         self.assertEqual(len(os.listdir(os.path.join(self.directory, "oh"))), 4)
-        self.assertEqual(len(leaves(self.read_grid(path))), 4)
+        self.assertEqual(len(named_leaves(self.read_grid(path))), 4)
 
     def test_failing_run_writes_nothing(self):
         path = os.path.join(self.directory, "failed.vtm")
-        status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-p", "nosuch=1",
+        status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "nosuch=1",
                                          "-o", path)
         self.assertEqual(status, 1)
         self.assertIn("nosuch", err)
@@ -352,7 +301,7 @@ class CommandLineTest(unittest.TestCase):
     def test_output_must_be_vtm(self):
         path = os.path.join(self.directory, "grid")
         with self.assertRaises(SystemExit) as raised:
-            self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-o", path)
+            self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-o", path)
         self.assertEqual(raised.exception.code, 2)
         self.assertEqual(os.listdir(self.directory), [])
 
@@ -360,12 +309,12 @@ class CommandLineTest(unittest.TestCase):
         """The new grid cannot be put in place (the .vtm path is a directory): the older
         pieces go back where they were and the error is reported."""
         path = os.path.join(self.directory, "kept.vtm")
-        status, _, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-o", path)
+        status, _, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-o", path)
         self.assertEqual(status, 0, err)
         pieces = sorted(os.listdir(os.path.join(self.directory, "kept")))
         os.remove(path)
         os.makedirs(os.path.join(path, "occupied"))
-        status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR, "-o", path)
+        status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-o", path)
         self.assertEqual(status, 1)
         self.assertIn("error:", err)
         self.assertNotIn("grid written", out)
@@ -440,4 +389,4 @@ class BadInputTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main(verbosity=2, argv=[sys.argv[0]])
+    bftest.run_tests()

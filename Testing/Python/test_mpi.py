@@ -1,15 +1,13 @@
 """pvbatch under MPI (2 ranks): blocks are shared out between the ranks, and the grid
 and GridQuality's class counts and statistics are global and equal a serial run."""
-import os
-
 from paraview import servermanager
-from paraview.simple import LoadPlugin
 
 import blockforge
 
-LoadPlugin(os.environ["BLOCKFORGE_PLUGIN"], ns=globals())
-SOURCE = os.environ["BLOCKFORGE_SOURCE_DIR"]
-template = os.path.join(SOURCE, "Templates", "cylinder_in_box.yaml")
+import bftest
+
+bftest.load_plugin(globals())
+template = bftest.CYLINDER
 
 controller = servermanager.vtkProcessModule.GetProcessModule().GetGlobalController()
 ranks = controller.GetNumberOfProcesses()

@@ -3,37 +3,21 @@
 Run by CTest with pvpython; BLOCKFORGE_PLUGIN is the plugin library of the build tree.
 """
 import os
-import sys
 import unittest
 
 from paraview import servermanager
-from paraview.simple import Delete, LoadPlugin, OpenDataFile, SaveData
-from paraview.vtk.numpy_interface import dataset_adapter as dsa
+from paraview.simple import Delete, OpenDataFile, SaveData
 import numpy as np
 
-PLUGIN = os.environ["BLOCKFORGE_PLUGIN"]
-SOURCE = os.environ.get("BLOCKFORGE_SOURCE_DIR",
-                        os.path.join(os.path.dirname(__file__), "..", ".."))
-OUTPUT = os.environ.get("BLOCKFORGE_TEST_OUTPUT", "/tmp/blockforge-test-output")
-CYLINDER = os.path.join(SOURCE, "Templates", "cylinder_in_box.yaml")
-DATA = os.path.join(SOURCE, "Testing", "Data")
+import bftest
+from bftest import CYLINDER, DATA, leaves, points
 
 # Defines BlockTemplateSource, BlockMesher, GridQuality, ... in this module.
-LoadPlugin(PLUGIN, remote=False, ns=globals())
-
-
-def leaves(multiblock):
-    result = []
-    iterator = multiblock.NewIterator()
-    iterator.InitTraversal()
-    while not iterator.IsDoneWithTraversal():
-        result.append(iterator.GetCurrentDataObject())
-        iterator.GoToNextItem()
-    return result
+bftest.load_plugin(globals())
 
 
 def all_points(multiblock):
-    return np.concatenate([np.array(dsa.WrapDataObject(b).Points) for b in leaves(multiblock)])
+    return np.concatenate([points(b) for b in leaves(multiblock)])
 
 
 class ProxyTest(unittest.TestCase):
@@ -80,8 +64,7 @@ class ProxyTest(unittest.TestCase):
         Delete(source)
 
     def test_save_and_reload_vtm(self):
-        os.makedirs(OUTPUT, exist_ok=True)
-        path = os.path.join(OUTPUT, "proxy_model.vtm")
+        path = bftest.output_path("proxy_model.vtm")
         source = BlockTemplateSource(TemplateFile=os.path.join(DATA, "two_blocks.yaml"))
         SaveData(path, proxy=source)
         reloaded = OpenDataFile(path)
@@ -106,5 +89,4 @@ class ProxyTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    result = unittest.main(verbosity=2, argv=[sys.argv[0]], exit=False).result
-    sys.exit(0 if result.wasSuccessful() else 1)
+    bftest.run_tests()

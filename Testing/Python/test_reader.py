@@ -4,23 +4,19 @@ Data/rotor37 (TurboGrid/BladeGen .inf + .curve, and the multi-section .dat set).
 Run by CTest with pvpython; BLOCKFORGE_PLUGIN is the plugin library of the build tree.
 """
 import os
-import sys
 import unittest
 
 from paraview import servermanager
-from paraview.simple import Delete, LoadPlugin, OpenDataFile
-from paraview.vtk.numpy_interface import dataset_adapter as dsa
+from paraview.simple import Delete, OpenDataFile
 import numpy as np
 
-PLUGIN = os.environ["BLOCKFORGE_PLUGIN"]
-SOURCE = os.environ.get("BLOCKFORGE_SOURCE_DIR",
-                        os.path.join(os.path.dirname(__file__), "..", ".."))
-OUTPUT = os.environ.get("BLOCKFORGE_TEST_OUTPUT", "/tmp/blockforge-test-output")
+import bftest
+from bftest import ROTOR37_INF, SOURCE, points
+
 ROTOR37 = os.path.join(SOURCE, "Data", "rotor37")
-INF = os.path.join(ROTOR37, "turbogrid", "BladeGen.inf")
 DAT = os.path.join(ROTOR37, "dat")
 
-LoadPlugin(PLUGIN, remote=False, ns=globals())
+bftest.load_plugin(globals())
 
 
 def named_blocks(multiblock):
@@ -38,14 +34,10 @@ def field(data, name):
     return values[0] if len(values) == 1 else values
 
 
-def xyz(polydata):
-    return np.array(dsa.WrapDataObject(polydata).Points)
-
-
-def axial_radius(points, axis):
+def axial_radius(xyz, axis):
     axis = np.asarray(axis)
-    axial = points @ axis
-    radial = np.linalg.norm(points - np.outer(axial, axis), axis=1)
+    axial = xyz @ axis
+    radial = np.linalg.norm(xyz - np.outer(axial, axis), axis=1)
     return axial, radial
 
 
@@ -77,15 +69,15 @@ class ReaderTest(unittest.TestCase):
         return blocks
 
     def test_open_turbogrid_inf(self):
-        reader = OpenDataFile(INF)
+        reader = OpenDataFile(ROTOR37_INF)
         self.assertIsNotNone(reader)
         self.assertEqual(reader.GetXMLLabel(), "Turbo Point Sets Reader")
-        self.assertEqual(reader.FileName, INF)
+        self.assertEqual(reader.FileName, ROTOR37_INF)
         data = read(reader)
         blocks = self.check_rotor37(data, 211, 209, "Z")
         self.assertEqual(field(data, "Axis"), (0.0, 0.0, 1.0))
         # Metres: the export is in cm.
-        np.testing.assert_allclose(xyz(blocks["Hub"])[0], [0.174036479, -0.0206644903, -0.0419],
+        np.testing.assert_allclose(points(blocks["Hub"])[0], [0.174036479, -0.0206644903, -0.0419],
                                    rtol=0, atol=1e-15)
         self.assertTrue(field(blocks["Hub"], "SourceFile").endswith("hub.curve"))
         Delete(reader)
@@ -99,24 +91,24 @@ class ReaderTest(unittest.TestCase):
             data = read(reader)
             blocks = self.check_rotor37(data, 30, 30, "X")
             self.assertEqual(field(data, "Axis"), (1.0, 0.0, 0.0))
-            np.testing.assert_allclose(xyz(blocks["Hub"])[0], [-0.0419, 0, 0.1752590003],
+            np.testing.assert_allclose(points(blocks["Hub"])[0], [-0.0419, 0, 0.1752590003],
                                        rtol=0, atol=1e-15)
             Delete(reader)
 
     def test_both_layouts_are_the_same_rotor(self):
-        tg_reader = OpenDataFile(INF)
+        tg_reader = OpenDataFile(ROTOR37_INF)
         dat_reader = OpenDataFile(os.path.join(DAT, "profile_R37.dat"))
         tg, dat = read(tg_reader), read(dat_reader)
         tg_blocks, dat_blocks = named_blocks(tg), named_blocks(dat)
         for a, b in zip(named_blocks(dat_blocks["Profiles"]).values(),
                         named_blocks(tg_blocks["Profiles"]).values()):
-            za, ra = axial_radius(xyz(a), field(dat, "Axis"))
-            zb, rb = axial_radius(xyz(b), field(tg, "Axis"))
+            za, ra = axial_radius(points(a), field(dat, "Axis"))
+            zb, rb = axial_radius(points(b), field(tg, "Axis"))
             np.testing.assert_allclose(za, zb, rtol=0, atol=1e-8)
             np.testing.assert_allclose(ra, rb, rtol=0, atol=1e-8)
         for part in ("Hub", "Shroud"):
-            z_dat, r_dat = axial_radius(xyz(dat_blocks[part]), field(dat, "Axis"))
-            z_tg, r_tg = axial_radius(xyz(tg_blocks[part]), field(tg, "Axis"))
+            z_dat, r_dat = axial_radius(points(dat_blocks[part]), field(dat, "Axis"))
+            z_tg, r_tg = axial_radius(points(tg_blocks[part]), field(tg, "Axis"))
             self.assertAlmostEqual(z_dat[0], z_tg[0], places=12)
             self.assertAlmostEqual(z_dat[-1], z_tg[-1], places=12)
             deviation = np.abs(np.interp(z_dat, z_tg, r_tg) - r_dat).max()
@@ -125,8 +117,7 @@ class ReaderTest(unittest.TestCase):
         Delete(dat_reader)
 
     def test_properties_fallbacks_and_domains(self):
-        os.makedirs(OUTPUT, exist_ok=True)
-        path = os.path.join(OUTPUT, "reader_points.csv")
+        path = bftest.output_path("reader_points.csv")
         with open(path, "w") as stream:
             stream.write("x,y,z\n0,0,10\n1,0,10\n2,0,11\n3,0,12\n")
         reader = TurboPointSetsReader(FileName=path)  # noqa: F821 (from LoadPlugin)
@@ -146,15 +137,14 @@ class ReaderTest(unittest.TestCase):
         blocks = named_blocks(data)
         self.assertIsNone(blocks["Hub"])
         profile = named_blocks(blocks["Profiles"])["Profile 1 (0%)"]
-        np.testing.assert_allclose(xyz(profile)[-1], [0.003, 0, 0.012], rtol=0, atol=1e-15)
+        np.testing.assert_allclose(points(profile)[-1], [0.003, 0, 0.012], rtol=0, atol=1e-15)
         # Replacing the hub file.
         reader.HubFile = os.path.join(DAT, "hub_R37.dat")
         self.assertEqual(named_blocks(read(reader))["Hub"].GetNumberOfPoints(), 30)
         Delete(reader)
 
     def test_tecplot_dat_still_goes_to_tecplot(self):
-        os.makedirs(OUTPUT, exist_ok=True)
-        path = os.path.join(OUTPUT, "reader_tecplot.dat")
+        path = bftest.output_path("reader_tecplot.dat")
         with open(path, "w") as stream:
             stream.write('TITLE = "t"\nVARIABLES = "X", "Y", "Z"\n'
                          'ZONE I=2, F=POINT\n0 0 0\n1 0 0\n')
@@ -163,24 +153,15 @@ class ReaderTest(unittest.TestCase):
         Delete(reader)
 
     def test_error_names_file_and_line_and_leaves_output_empty(self):
-        from vtkmodules.util.misc import calldata_type
-        from vtkmodules.util.vtkConstants import VTK_STRING
-        from vtkmodules.vtkCommonCore import vtkCommand, vtkOutputWindow
+        from vtkmodules.vtkCommonCore import vtkOutputWindow
         import blockforge
 
-        os.makedirs(OUTPUT, exist_ok=True)
-        path = os.path.join(OUTPUT, "reader_bad_profile.curve")
+        path = bftest.output_path("reader_bad_profile.curve")
         with open(path, "w") as stream:
             stream.write("# Profile 1 at 0%\n0 0 1\n1 0 1\nnan 0 1\n3 0 1\n")
-        errors = []
-
-        @calldata_type(VTK_STRING)
-        def collect(_caller, _event, message):
-            errors.append(message)
-
         reader = blockforge.vtkTurboPointSetsReader()
         reader.SetFileName(path)
-        reader.AddObserver(vtkCommand.ErrorEvent, collect)
+        errors = bftest.ErrorCollector(reader).messages
         vtkOutputWindow.GetInstance().SetDisplayModeToNever()
         try:
             reader.Update()
@@ -189,7 +170,7 @@ class ReaderTest(unittest.TestCase):
         self.assertEqual(reader.GetOutput().GetNumberOfBlocks(), 0)
         self.assertEqual(len(errors), 1, errors)
         self.assertIn(path + ":4: 'nan' is not a finite number", errors[0])
-        self.assertEqual(reader.CanReadFile(INF), 1)
+        self.assertEqual(reader.CanReadFile(ROTOR37_INF), 1)
         self.assertEqual(reader.CanReadFile(os.path.join(DAT, "README.md")), 0)
 
         # Through the proxy: empty output, no crash.
@@ -199,5 +180,4 @@ class ReaderTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    result = unittest.main(verbosity=2, argv=[sys.argv[0]], exit=False).result
-    sys.exit(0 if result.wasSuccessful() else 1)
+    bftest.run_tests()

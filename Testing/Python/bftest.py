@@ -1,0 +1,108 @@
+"""What the Python tests of BlockForge share: paths of the source tree and of the test
+output, loading the plugin into a test module, walking multiblock data sets, collecting
+VTK error messages and running the unittest cases.
+
+Imported as `import bftest` by the test scripts of this directory, which is on sys.path
+because the scripts are run by path (`pvpython <dir>/test_x.py`, `pvbatch <dir>/test_mpi.py`
+under mpiexec, `python3 <dir>/test_blockforge.py`). It needs only VTK and numpy, never
+paraview, so /usr/bin/python3 can import it as well (see load_plugin).
+
+CTest sets BLOCKFORGE_SOURCE_DIR, BLOCKFORGE_TEST_OUTPUT and BLOCKFORGE_PLUGIN
+(Testing/Python/CMakeLists.txt).
+"""
+import math
+import os
+import sys
+import unittest
+
+import numpy as np
+from vtkmodules.numpy_interface import dataset_adapter as dsa
+from vtkmodules.util.misc import calldata_type
+from vtkmodules.util.vtkConstants import VTK_STRING
+from vtkmodules.vtkCommonCore import vtkCommand
+
+SOURCE = os.environ.get("BLOCKFORGE_SOURCE_DIR",
+                        os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+OUTPUT = os.environ.get("BLOCKFORGE_TEST_OUTPUT", "/tmp/blockforge-test-output")
+DATA = os.path.join(SOURCE, "Testing", "Data")
+CYLINDER = os.path.join(SOURCE, "Templates", "cylinder_in_box.yaml")
+ROTOR37_INF = os.path.join(SOURCE, "Data", "rotor37", "turbogrid", "BladeGen.inf")
+DISTRIBUTOR_INF = os.path.join(SOURCE, "Data", "distributor", "BladeGen.inf")
+
+
+def output_path(name):
+    """The path of a file `name` in the test output directory, which is created if needed."""
+    os.makedirs(OUTPUT, exist_ok=True)
+    return os.path.join(OUTPUT, name)
+
+
+def load_plugin(namespace):
+    """Loads the plugin library BLOCKFORGE_PLUGIN (pvpython or pvbatch only) and defines
+    the constructors of its proxies (BlockTemplateSource, BlockTemplate, BlockMesher,
+    GridQuality, TurboPointSetsReader) in `namespace`: pass the test module's globals().
+
+    The plugin is loaded on the client (remote=False), which for the builtin connection
+    of pvpython and pvbatch, also under MPI, is the process that runs the pipeline.
+    """
+    from paraview.simple import LoadPlugin  # not at the top: python3 has no paraview
+
+    LoadPlugin(os.environ["BLOCKFORGE_PLUGIN"], remote=False, ns=namespace)
+
+
+def _leaf_iterators(multiblock):
+    iterator = multiblock.NewIterator()
+    iterator.InitTraversal()
+    while not iterator.IsDoneWithTraversal():
+        yield iterator
+        iterator.GoToNextItem()
+
+
+def leaves(multiblock):
+    """Every non-empty leaf data set of a multiblock, in order."""
+    return [iterator.GetCurrentDataObject() for iterator in _leaf_iterators(multiblock)]
+
+
+def named_leaves(multiblock):
+    """(name, data set) of every non-empty leaf of a multiblock, in order."""
+    return [(iterator.GetCurrentMetaData().Get(multiblock.NAME()),
+             iterator.GetCurrentDataObject()) for iterator in _leaf_iterators(multiblock)]
+
+
+def points(dataset):
+    """The points of a data set as an array [n, xyz]."""
+    return np.array(dsa.WrapDataObject(dataset).Points)
+
+
+def node_array(block):
+    """The nodes of a structured block as an array [k, j, i, xyz]."""
+    nx, ny, nz = block.GetDimensions()
+    return points(block).reshape(nz, ny, nx, 3)
+
+
+def rotate_z(xyz, angle):
+    """Points [n, xyz] turned by `angle` (radians) about the z axis."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.column_stack((c * xyz[:, 0] - s * xyz[:, 1], s * xyz[:, 0] + c * xyz[:, 1],
+                            xyz[:, 2]))
+
+
+class ErrorCollector:
+    """Collects in `messages` the vtkErrorMacro messages of the observed algorithms."""
+
+    def __init__(self, *algorithms):
+        self.messages = []
+
+        @calldata_type(VTK_STRING)
+        def collect(_caller, _event, message):
+            self.messages.append(message)
+
+        for algorithm in algorithms:
+            algorithm.AddObserver(vtkCommand.ErrorEvent, collect)
+
+
+def run_tests():
+    """Runs the unittest cases of the main script verbosely, then exits with 0 if they all
+    passed, 1 otherwise."""
+    result = unittest.main(module="__main__", verbosity=2, argv=[sys.argv[0]],
+                           exit=False).result
+    sys.exit(0 if result.wasSuccessful() else 1)
