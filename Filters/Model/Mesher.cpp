@@ -117,6 +117,21 @@ double carrierTolerance(const CarrierGeometry& geometry, int carrier, double siz
   return 1e-9 * std::max(size, geometry.size(carrier));
 }
 
+/// Parameters of `vertex` on `carrier`; GeometryError (ending with `advice`) when the
+/// vertex is not on it.
+Eigen::Vector2d vertexOnCarrier(const BlockModel& model, const CarrierGeometry& geometry,
+  int vertex, int carrier, double size, const std::string& advice)
+{
+  double s = 0.0, t = 0.0, distance = 0.0;
+  geometry.vertexParameters(model, vertex, carrier, s, t, distance);
+  if (distance > carrierTolerance(geometry, carrier, size))
+  {
+    throw GeometryError("vertex '" + model.vertices[vertex].name + "' is not on carrier '" +
+      model.carriers[carrier].name + "' (" + shortNumber(distance) + " away); " + advice);
+  }
+  return Eigen::Vector2d(s, t);
+}
+
 /// Parameter(s) of an edge end on the edge's carrier: from `at`, else from the vertex.
 Eigen::Vector2d edgeEndParameters(const BlockModel& model, const CarrierGeometry& geometry,
   const Edge& edge, int end, double size)
@@ -137,15 +152,7 @@ Eigen::Vector2d edgeEndParameters(const BlockModel& model, const CarrierGeometry
     }
     return st;
   }
-  double s = 0.0, t = 0.0, distance = 0.0;
-  geometry.vertexParameters(model, vertex, edge.carrier, s, t, distance);
-  if (distance > carrierTolerance(geometry, edge.carrier, size))
-  {
-    throw GeometryError("vertex '" + model.vertices[vertex].name + "' is not on carrier '" +
-      model.carriers[edge.carrier].name + "' (" + shortNumber(distance) +
-      " away); attach it to the carrier");
-  }
-  return Eigen::Vector2d(s, t);
+  return vertexOnCarrier(model, geometry, vertex, edge.carrier, size, "attach it to the carrier");
 }
 
 NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geometry,
@@ -203,17 +210,10 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       named.curve = std::make_shared<LineCurve>(start, end);
       named.length = (end - start).norm();
       named.projectOnto = edge.carrier;
-      for (int k = 0; k < 2; ++k)
+      for (const int vertex : { edge.from, edge.to })
       {
-        const int vertex = k == 0 ? edge.from : edge.to;
-        double s = 0.0, t = 0.0, distance = 0.0;
-        geometry.vertexParameters(model, vertex, edge.carrier, s, t, distance);
-        if (distance > carrierTolerance(geometry, edge.carrier, size))
-        {
-          throw GeometryError("vertex '" + model.vertices[vertex].name + "' is not on carrier '" +
-            model.carriers[edge.carrier].name + "' (" + shortNumber(distance) +
-            " away); the ends of a projected edge must lie on it");
-        }
+        vertexOnCarrier(model, geometry, vertex, edge.carrier, size,
+          "the ends of a projected edge must lie on it");
       }
       break;
     }

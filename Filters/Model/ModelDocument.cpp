@@ -580,31 +580,12 @@ private:
     return index;
   }
 
-  std::vector<int> carrierRefs(const std::vector<MapEntry>& keys, const std::string& key,
-    const YAML::Node& node, const std::string& entityText) const
+  /// The items of list `key` (empty when absent), each read by `item(node, line)`.
+  template <typename Item, typename Read>
+  std::vector<Item> listOf(const std::vector<MapEntry>& keys, const std::string& key,
+    const std::string& entityText, const std::string& what, Read&& item) const
   {
-    std::vector<int> refs;
-    const MapEntry* found = syntax::findEntry(keys, key);
-    if (!found)
-    {
-      return refs;
-    }
-    if (!found->value.IsSequence())
-    {
-      fail(found->line, entityText, "'" + key + "' must be a list of carriers");
-    }
-    for (const YAML::Node& item : found->value)
-    {
-      refs.push_back(carrierRef(item, found->line, entityText));
-    }
-    (void)node;
-    return refs;
-  }
-
-  std::vector<double> numbers(const std::vector<MapEntry>& keys, const std::string& key,
-    const std::string& entityText) const
-  {
-    std::vector<double> values;
+    std::vector<Item> values;
     const MapEntry* found = syntax::findEntry(keys, key);
     if (!found)
     {
@@ -612,13 +593,27 @@ private:
     }
     if (!found->value.IsSequence())
     {
-      fail(found->line, entityText, "'" + key + "' must be a list of numbers");
+      fail(found->line, entityText, "'" + key + "' must be a list of " + what);
     }
-    for (const YAML::Node& item : found->value)
+    for (const YAML::Node& node : found->value)
     {
-      values.push_back(number(item, found->line, entityText, key));
+      values.push_back(item(node, found->line));
     }
     return values;
+  }
+
+  std::vector<int> carrierRefs(
+    const std::vector<MapEntry>& keys, const std::string& key, const std::string& entityText) const
+  {
+    return listOf<int>(keys, key, entityText, "carriers",
+      [&](const YAML::Node& node, int line) { return carrierRef(node, line, entityText); });
+  }
+
+  std::vector<double> numbers(const std::vector<MapEntry>& keys, const std::string& key,
+    const std::string& entityText) const
+  {
+    return listOf<double>(keys, key, entityText, "numbers",
+      [&](const YAML::Node& node, int line) { return number(node, line, entityText, key); });
   }
 
   void readCarrier(const YAML::Node& node, Carrier& carrier)
@@ -679,8 +674,8 @@ private:
         fail(method->line, entityText, "unknown parameters '" + value + "'");
       }
     }
-    carrier.refs = carrierRefs(keys, "refs", node, entityText);
-    carrier.crossRefs = carrierRefs(keys, "cross_refs", node, entityText);
+    carrier.refs = carrierRefs(keys, "refs", entityText);
+    carrier.crossRefs = carrierRefs(keys, "cross_refs", entityText);
     carrier.nodes = numbers(keys, "at", entityText);
     carrier.crossNodes = numbers(keys, "cross_at", entityText);
     if (const MapEntry* blending = syntax::findEntry(keys, "blending"))

@@ -121,21 +121,8 @@ public:
 
   double evaluate(const std::string& expression)
   {
-    const std::string expanded = expandDegrees(expression);
+    const std::string expanded = prepare(expression);
     const std::string readAs = expanded != expression ? " (read as '" + expanded + "')" : "";
-    if (!parenthesesBalance(expression))
-    {
-      throw ExpressionError{ "unbalanced parentheses in '" + expression +
-        "'; inside [x, y, z] lists put an expression containing commas in quotes, "
-        "e.g. \"min(a, b)\"" };
-    }
-    if (OnReference)
-    {
-      for (const auto& reference : referencedNames(expanded))
-      {
-        OnReference(reference.first, reference.second);
-      }
-    }
     double value = 0.0;
     try
     {
@@ -204,18 +191,7 @@ public:
    */
   std::function<double()> pointFunction(const std::string& expression, double* variables)
   {
-    const std::string expanded = expandDegrees(expression);
-    if (!parenthesesBalance(expression))
-    {
-      throw ExpressionError{ "unbalanced parentheses in '" + expression + "'" };
-    }
-    if (OnReference)
-    {
-      for (const auto& reference : referencedNames(expanded))
-      {
-        OnReference(reference.first, reference.second);
-      }
-    }
+    const std::string expanded = prepare(expression);
     auto parser = std::make_shared<mu::Parser>(Parser);
     static const char* const names[6] = { "x", "y", "z", "axial", "radius", "theta" };
     try
@@ -260,6 +236,27 @@ public:
         error.GetMsg() };
     }
     return [parser]() { return parser->Eval(); };
+  }
+
+  /// The expression with degrees expanded, after checking its parentheses and resolving
+  /// the vertices and definitions it refers to (OnReference).
+  std::string prepare(const std::string& expression)
+  {
+    if (!parenthesesBalance(expression))
+    {
+      throw ExpressionError{ "unbalanced parentheses in '" + expression +
+        "'; inside [x, y, z] lists put an expression containing commas in quotes, "
+        "e.g. \"min(a, b)\"" };
+    }
+    const std::string expanded = expandDegrees(expression);
+    if (OnReference)
+    {
+      for (const auto& reference : referencedNames(expanded))
+      {
+        OnReference(reference.first, reference.second);
+      }
+    }
+    return expanded;
   }
 
   /// `45deg` -> `(45*deg)`; identifiers that merely contain digits (x2deg) are untouched.

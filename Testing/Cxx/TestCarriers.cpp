@@ -52,6 +52,22 @@ double maxError(const Vec3& a, const Vec3& b)
   return (a - b).cwiseAbs().maxCoeff();
 }
 
+/// Largest maxError between `surface` and the analytic `f(s, t, 0, 0)` on a 21 x 21 grid.
+template <typename Function>
+double worstOnGrid(const Surface& surface, const Function& f)
+{
+  double worst = 0;
+  for (int i = 0; i <= 20; ++i)
+  {
+    for (int j = 0; j <= 20; ++j)
+    {
+      const double s = i / 20.0, t = j / 20.0;
+      worst = std::max(worst, maxError(surface.point(s, t), f(s, t, 0, 0)));
+    }
+  }
+  return worst;
+}
+
 /// A curve given by a function of (t, derivative order): exact analytic sections.
 class FunctionCurve : public Curve
 {
@@ -617,16 +633,7 @@ TEST(GordonNetwork, LagrangeReproducesBiquadraticAndPassesThroughAllCurves)
   }
   const GordonSurface gordon = GordonSurface::fromNetwork(
     sCurves, tNodes, tCurves, sNodes, GordonSurface::Blending::Lagrange);
-  double worst = 0;
-  for (int i = 0; i <= 20; ++i)
-  {
-    for (int j = 0; j <= 20; ++j)
-    {
-      const double s = i / 20.0, t = j / 20.0;
-      worst = std::max(worst, maxError(gordon.point(s, t), f(s, t, 0, 0)));
-    }
-  }
-  EXPECT_LT(worst, 1e-14);
+  EXPECT_LT(worstOnGrid(gordon, f), 1e-14);
   for (int k = 0; k <= 40; ++k)
   {
     const double u = k / 40.0;
@@ -705,16 +712,7 @@ TEST(GordonNetwork, SplineReproducesTransfiniteSurface)
   {
     const GordonSurface gordon =
       GordonSurface::fromNetwork(sCurves, tNodes, tCurves, sNodes, blending);
-    double worst = 0;
-    for (int i = 0; i <= 20; ++i)
-    {
-      for (int j = 0; j <= 20; ++j)
-      {
-        const double s = i / 20.0, t = j / 20.0;
-        worst = std::max(worst, maxError(gordon.point(s, t), f(s, t, 0, 0)));
-      }
-    }
-    EXPECT_LT(worst, 1e-14);
+    EXPECT_LT(worstOnGrid(gordon, f), 1e-14);
     for (double s : { 0.1, 0.5, 0.9 })
     {
       for (double t : { 0.1, 0.42, 0.9 })
