@@ -36,10 +36,10 @@ MIN_ANGLE_CLASSES = ("0-20", "20-40", "40-60", "60-80", "80-90")
 
 
 def _message(text):
-    """The text of a VTK error message without VTK's "ERROR: In file, line N" and
+    """The text of a VTK error or warning without VTK's "ERROR: In file, line N" and
     "Class (0x...): " header."""
     text = text.strip()
-    if text.startswith("ERROR: In "):
+    if text.startswith(("ERROR: In ", "Warning: In ")):
         text = text.partition("\n")[2]
     head, sep, rest = text.partition("): ")
     if sep and " (0x" in head and "\n" not in head:
@@ -48,9 +48,11 @@ def _message(text):
 
 
 def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_file=None,
-                  timings=None):
+                  timings=None, allow_inverted_cells=False, warnings=None):
     """:func:`mesh_template`; with a dict *timings*, also records the seconds of each
-    stage under "read" (only with an input file), "template" and "mesh + quality"."""
+    stage under "read" (only with an input file), "template" and "mesh + quality"; with a
+    list *warnings*, collects the stages' warnings (reader repairs, inverted cells let
+    through) without VTK's header."""
     import time
 
     from vtkmodules.util.misc import calldata_type
@@ -72,6 +74,7 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     stages.append(("template", template))
     mesher = vtkBlockMesher()
     mesher.SetDensityMultiplier(float(density_multiplier))
+    mesher.SetAllowInvertedCells(bool(allow_inverted_cells))
     mesher.SetInputConnection(template.GetOutputPort())
     quality = vtkGridQuality()
     quality.SetInputConnection(mesher.GetOutputPort())
@@ -88,8 +91,14 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     def collect_failure(_caller, _event, message):
         failures.append(message)
 
+    @calldata_type(VTK_STRING)
+    def collect_warning(_caller, _event, message):
+        if warnings is not None:
+            warnings.append(_message(message))
+
     for algorithm in [stage for _, stage in stages] + [mesher]:
         algorithm.AddObserver(vtkCommand.ErrorEvent, collect)
+        algorithm.AddObserver(vtkCommand.WarningEvent, collect_warning)
         algorithm.GetExecutive().AddObserver(vtkCommand.ErrorEvent, collect_failure)
     # Stage by stage, so that a failing stage stops the pipeline with its own message.
     for key, algorithm in stages:
@@ -102,7 +111,8 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     return quality
 
 
-def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None):
+def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None,
+                  allow_inverted_cells=False):
     """Applies a template, meshes it and measures the grid.
 
     Without *input_file* the pipeline is vtkBlockTemplateSource -> vtkBlockMesher ->
@@ -116,6 +126,9 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
     :param input_file: point data for a template with inputs: a file the
         vtkTurboPointSetsReader reads (a BladeGen .inf, an Info.txt or a point file);
         None for a template without inputs
+    :param allow_inverted_cells: False (default): a grid with an inverted cell is an error
+        naming the block and the cell range; True: the grid is returned anyway for
+        inspection (field data ``InvertedCellCount``, a VTK warning per folded block)
     :returns: the vtkGridQuality algorithm after its update (port 0: the grid with the
         quality arrays; port 1: MinAngle class table; port 2: statistics table)
     :raises RuntimeError: when a stage (reader, template, mesher or quality) reports an
@@ -123,4 +136,5 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
         "ERROR: In file, line" header (e.g. "<file>: no such file", or the template's
         "<template>:<line>: ..." message). No later stage runs after a failing one.
     """
-    return _run_pipeline(template_file, parameters, density_multiplier, input_file)
+    return _run_pipeline(template_file, parameters, density_multiplier, input_file,
+                         allow_inverted_cells=allow_inverted_cells)

@@ -1,5 +1,5 @@
 """Command line: ``python3 -m blockforge TEMPLATE [-i POINTS] [-o grid.vtm] [-p NAME=EXPR ...]
-[-d DENSITY]``.
+[-d DENSITY] [--allow-inverted-cells]``.
 
 Applies a template (to the point data of -i, read by the TurboPointSetsReader, for a
 template with inputs), meshes it, prints a quality summary (cell count, the paper's
@@ -120,17 +120,25 @@ def main(argv=None):
                         default=[], metavar="NAME=EXPR", help="override a template parameter")
     parser.add_argument("-d", "--density", type=float, default=1.0,
                         help="grid density multiplier (scales every cell count)")
+    parser.add_argument("--allow-inverted-cells", action="store_true",
+                        help="output a grid with inverted cells anyway, for inspection "
+                             "(default: an error naming the block and the cell range)")
     args = parser.parse_args(argv)
     if args.output and not args.output.endswith(".vtm"):
         parser.error(f"the output must be a .vtm file (a multiblock grid), got '{args.output}'")
 
     timings = {}
+    warnings = []
     try:
         quality = blockforge._run_pipeline(args.template, dict(args.parameter), args.density,
-                                           args.input, timings)
+                                           args.input, timings, args.allow_inverted_cells,
+                                           warnings)
     except RuntimeError as error:
         print(f"error: {error}", file=sys.stderr)
         return 1
+    finally:
+        for warning in warnings:
+            print(f"warning: {warning}", file=sys.stderr)
     print(f"template: {args.template}")
     if args.input:
         print(f"input: {args.input}")

@@ -300,6 +300,25 @@ class CommandLineTest(unittest.TestCase):
         self.assertEqual(len(os.listdir(os.path.join(self.directory, "oh"))), 4)
         self.assertEqual(len(named_leaves(self.read_grid(path))), 4)
 
+    def test_inverted_cells_refused_unless_allowed(self):
+        folded = os.path.join(DATA, "folded_spline.yaml")
+        path = os.path.join(self.directory, "folded.vtm")
+        status, out, err = self.run_main(folded, "-o", path)
+        self.assertEqual(status, 1)
+        self.assertIn("block 'bent'", err)
+        self.assertIn("inverted cells of 512", err)
+        self.assertIn("cell range i", err)
+        self.assertEqual(os.listdir(self.directory), [])
+        status, out, err = self.run_main(folded, "--allow-inverted-cells", "-o", path)
+        self.assertEqual(status, 0, err)
+        self.assertIn("warning: ", err)
+        self.assertIn("block 'bent'", err)
+        self.assertIn("grid written", out)
+        grid = self.read_grid(path)
+        jacobian = np.concatenate([dsa.WrapDataObject(block).CellData["ScaledJacobian"]
+                                   for _, block in named_leaves(grid)])
+        self.assertLess(float(jacobian.min()), 0.0)
+
     def test_failing_run_writes_nothing(self):
         path = os.path.join(self.directory, "failed.vtm")
         status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "nosuch=1",
@@ -392,6 +411,20 @@ class BadInputTest(unittest.TestCase):
         errors = ErrorCollector(mesher)
         mesher.Update()
         self.assertTrue(any("BlockForge model" in m for m in errors.messages))
+
+    def test_mesh_template_allow_inverted_cells(self):
+        folded = os.path.join(DATA, "folded_spline.yaml")
+        with self.assertRaises(RuntimeError) as context:
+            blockforge.mesh_template(folded)
+        self.assertIn("inverted cell", str(context.exception))
+        quality = blockforge.mesh_template(folded, allow_inverted_cells=True)
+        grid = quality.GetOutputDataObject(0)
+        count = grid.GetFieldData().GetArray("InvertedCellCount").GetValue(0)
+        jacobian = np.concatenate([dsa.WrapDataObject(block).CellData["ScaledJacobian"]
+                                   for _, block in named_leaves(grid)])
+        # the mesher's count is GridQuality's count of negative scaled Jacobians
+        self.assertGreater(count, 0)
+        self.assertEqual(count, int((jacobian < 0).sum()))
 
     def test_mesh_template_raises(self):
         with self.assertRaises(RuntimeError) as context:
