@@ -265,6 +265,8 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
     blockId->SetNumberOfTuples(grid->GetNumberOfCells());
     blockId->FillValue(b);
     grid->GetCellData()->AddArray(blockId);
+    // The active scalars are what ParaView colours by at first: the decomposition.
+    grid->GetCellData()->SetActiveScalars("BlockId");
 
     output->SetBlock(static_cast<unsigned int>(b), grid);
     if (progress)

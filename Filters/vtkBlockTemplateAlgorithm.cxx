@@ -1,10 +1,12 @@
 #include "vtkBlockTemplateAlgorithm.h"
 
+#include "BlockForgeFileStamps.h"
 #include "BlockForgeModelIO.h"
 
 #include "../Model/CarrierGeometry.h"
 #include "../Model/ModelDocument.h"
 #include "../Model/Template.h"
+#include "../Model/TemplateParameters.h"
 
 #include <vtkCellArray.h>
 #include <vtkCompositeDataSet.h>
@@ -16,11 +18,76 @@
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkStringArray.h>
 #include <vtkStructuredGrid.h>
 
+#include <iomanip>
 #include <iterator>
+#include <sstream>
 
-vtkBlockTemplateAlgorithm::vtkBlockTemplateAlgorithm() = default;
+struct vtkBlockTemplateAlgorithm::Internals
+{
+  blockforge::vtkglue::FileStamps TemplateStamp;
+  /// The parameter table and what it was read from.
+  vtkNew<vtkStringArray> ParameterTable;
+  std::string TableFile;
+  vtkMTimeType TableTime = 0;
+  vtkMTimeType TableRunTime = 0;
+  vtkTimeStamp RunTime;
+};
+
+vtkBlockTemplateAlgorithm::vtkBlockTemplateAlgorithm()
+  : Internal(new Internals)
+{
+}
+
+vtkMTimeType vtkBlockTemplateAlgorithm::GetMTime()
+{
+  return std::max(this->Superclass::GetMTime(), this->Internal->TemplateStamp.changeTime());
+}
+
+vtkStringArray* vtkBlockTemplateAlgorithm::GetTemplateParameters()
+{
+  Internals& internal = *this->Internal;
+  const std::string file = this->TemplateFile ? this->TemplateFile : "";
+  const vtkMTimeType fileTime = internal.TemplateStamp.changeTime();
+  if (file == internal.TableFile && fileTime == internal.TableTime &&
+    internal.RunTime.GetMTime() == internal.TableRunTime)
+  {
+    return internal.ParameterTable;
+  }
+  internal.TableFile = file;
+  internal.TableTime = fileTime;
+  internal.TableRunTime = internal.RunTime.GetMTime();
+  vtkStringArray* table = internal.ParameterTable;
+  table->Initialize();
+  if (file.empty())
+  {
+    return table;
+  }
+  try
+  {
+    for (const auto& parameter : blockforge::model::readTemplateParameters(file))
+    {
+      table->InsertNextValue(parameter.name);
+      table->InsertNextValue(parameter.defaultExpression);
+      const auto value = this->ParameterValues.find(parameter.name);
+      std::ostringstream text;
+      if (value != this->ParameterValues.end())
+      {
+        text << std::setprecision(10) << value->second;
+      }
+      table->InsertNextValue(text.str());
+      table->InsertNextValue(parameter.unit);
+      table->InsertNextValue(parameter.description);
+    }
+  }
+  catch (const std::exception&)
+  {
+    table->Initialize(); // the run reports the error, with file and line
+  }
+  return table;
+}
 
 vtkBlockTemplateAlgorithm::~vtkBlockTemplateAlgorithm()
 {
@@ -148,6 +215,11 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
     carriers->Initialize();
   }
   this->ModelDocument.clear();
+  this->ParameterValues.clear();
+  this->Internal->RunTime.Modified();
+  // Watched for edits from now on, also when it fails (fixing the file runs it again).
+  this->Internal->TemplateStamp.remember(
+    { this->TemplateFile ? std::string(this->TemplateFile) : std::string() });
   if (!this->TemplateFile || !*this->TemplateFile)
   {
     vtkErrorMacro("No TemplateFile set: choose a BlockForge template (.yaml).");
@@ -185,6 +257,10 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
       fillCarriers(blockModel, geometry, carriers);
     }
     this->ModelDocument = document;
+    for (const auto& parameter : blockModel.parameters)
+    {
+      this->ParameterValues[parameter.first] = parameter.second;
+    }
   }
   catch (const std::exception& error)
   {
