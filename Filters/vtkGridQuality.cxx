@@ -5,6 +5,7 @@
 #include "../Model/Topology.h"
 #include "BlockForgeModelIO.h"
 #include "BlockForgeParallel.h"
+#include "BlockForgeRanges.h"
 
 #include <vtkCellData.h>
 #include <vtkCompositeDataSet.h>
@@ -176,6 +177,7 @@ int vtkGridQuality::RequestData(
       blockId->SetNumberOfTuples(cells);
       blockId->FillValue(static_cast<int>(b));
       measured->GetCellData()->AddArray(blockId);
+      blockforge::vtkglue::cacheConstantRange(blockId, static_cast<double>(b));
     }
     // ParaView colours by the active scalars at first: the paper's criterion.
     measured->GetCellData()->SetActiveScalars("MinAngle");
@@ -228,6 +230,10 @@ int vtkGridQuality::RequestData(
         maximum[m] = std::max(maximum[m], values[c]);
         sum[m] += values[c];
       }
+    }
+    for (int m = 0; m < 6; ++m)
+    {
+      blockforge::vtkglue::cacheRanges(measureArrays[b][m]);
     }
     const auto blockClasses = blockforge::minAngleClasses(
       measureArrays[b][0]->GetPointer(0), static_cast<std::size_t>(cells));

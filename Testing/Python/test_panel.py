@@ -168,5 +168,36 @@ class FirstLook(unittest.TestCase):
             simple.Delete(proxy)
 
 
+class CachedRanges(unittest.TestCase):
+    def test_cached_ranges_equal_computed_ones(self):
+        """The ranges cached for ParaView's data information and colour maps (all,
+        finite, per component and of the norm) equal those VTK computes afresh."""
+        import numpy as np
+        source = BlockTemplateSource(TemplateFile=TEMPLATE)  # noqa: F821
+        quality = GridQuality(Input=BlockMesher(Input=source))  # noqa: F821
+        quality.UpdatePipeline()
+        grid = quality.GetClientSideObject().GetOutputDataObject(0)
+        for block in bftest.leaves(grid):
+            arrays = [block.GetPoints().GetData()] + [
+                block.GetCellData().GetArray(n) for n in range(block.GetCellData().GetNumberOfArrays())]
+            for array in arrays:
+                cached = [array.GetRange(c) for c in range(-1, array.GetNumberOfComponents())]
+                cached_finite = [array.GetFiniteRange(c)
+                                 for c in range(-1, array.GetNumberOfComponents())]
+                values = np.asarray(array).reshape(array.GetNumberOfTuples(), -1)
+                fresh = [(float(np.sqrt((values ** 2).sum(axis=1).min())),
+                          float(np.sqrt((values ** 2).sum(axis=1).max())))
+                         if values.shape[1] > 1 else (float(values.min()), float(values.max()))]
+                fresh += [(float(values[:, c].min()), float(values[:, c].max()))
+                          for c in range(values.shape[1])]
+                for a, b in zip(cached, fresh):
+                    self.assertAlmostEqual(a[0], b[0], delta=1e-12 * max(1.0, abs(b[0])))
+                    self.assertAlmostEqual(a[1], b[1], delta=1e-12 * max(1.0, abs(b[1])))
+                self.assertEqual(cached, cached_finite)
+                array.Modified()  # VTK drops the cache: computed afresh, the same
+                self.assertEqual([array.GetRange(c) for c in range(array.GetNumberOfComponents())],
+                                 cached[1:], array.GetName())
+
+
 if __name__ == "__main__":
     bftest.run_tests()
