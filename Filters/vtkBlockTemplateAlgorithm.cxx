@@ -6,7 +6,6 @@
 #include "../Model/CarrierGeometry.h"
 #include "../Model/ModelDocument.h"
 #include "../Model/Template.h"
-#include "../Model/TemplateParameters.h"
 
 #include <vtkCellArray.h>
 #include <vtkCompositeDataSet.h>
@@ -24,6 +23,16 @@
 #include <iomanip>
 #include <iterator>
 #include <sstream>
+
+namespace
+{
+std::string trimmed(const std::string& text)
+{
+  const std::size_t first = text.find_first_not_of(" \t");
+  const std::size_t last = text.find_last_not_of(" \t");
+  return first == std::string::npos ? std::string() : text.substr(first, last - first + 1);
+}
+} // namespace
 
 struct vtkBlockTemplateAlgorithm::Internals
 {
@@ -67,10 +76,10 @@ vtkStringArray* vtkBlockTemplateAlgorithm::GetTemplateParameters()
   }
   try
   {
-    for (const auto& parameter : blockforge::model::readTemplateParameters(file))
+    for (const auto& parameter : blockforge::model::templateParameters(file))
     {
       table->InsertNextValue(parameter.name);
-      table->InsertNextValue(parameter.defaultExpression);
+      table->InsertNextValue(parameter.expression);
       const auto value = this->ParameterValues.find(parameter.name);
       std::ostringstream text;
       if (value != this->ParameterValues.end())
@@ -78,8 +87,18 @@ vtkStringArray* vtkBlockTemplateAlgorithm::GetTemplateParameters()
         text << std::setprecision(10) << value->second;
       }
       table->InsertNextValue(text.str());
-      table->InsertNextValue(parameter.unit);
-      table->InsertNextValue(parameter.description);
+      // The comment is the description, with the unit in its last [...].
+      std::string description = parameter.comment;
+      std::string unit;
+      const std::size_t open = description.rfind('[');
+      const std::size_t close = description.rfind(']');
+      if (open != std::string::npos && close != std::string::npos && close > open)
+      {
+        unit = trimmed(description.substr(open + 1, close - open - 1));
+        description = trimmed(description.substr(0, open) + description.substr(close + 1));
+      }
+      table->InsertNextValue(unit);
+      table->InsertNextValue(description);
     }
   }
   catch (const std::exception&)
