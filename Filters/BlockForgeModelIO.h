@@ -62,12 +62,19 @@ void fillMultiBlock(const model::BlockModel& model, const model::MultiBlockMeshe
 
 /**
  * Meshes `model` (density multiplier, optional cell cap for previews) into `output`
- * through fillMultiBlock and attaches `document` to the output's field data. Throws
- * (TemplateError, GeometryError) on any problem; `output` is only touched on success.
+ * through fillMultiBlock and attaches `document` to the output's field data. Before any
+ * grid memory is allocated, the memory this piece's grid needs is checked against the
+ * available memory and `maximumMemoryGigabytes` (<= 0: no user limit). Throws
+ * (TemplateError, GeometryError, ResourceError) on any problem; `output` is only touched
+ * on success.
  */
 void meshModel(const model::BlockModel& model, const std::string& document,
   double densityMultiplier, int cellCap, int piece, int pieceCount,
   vtkMultiBlockDataSet* output, const std::function<void(double)>& progress,
-  const model::CarrierGeometry* carriers = nullptr);
+  const model::CarrierGeometry* carriers = nullptr, double maximumMemoryGigabytes = 0.0);
+
+/// `text` with bytes that are not UTF-8 escaped (\xNN), for vtkErrorMacro: Python's error
+/// observers and ParaView's Output Messages get a readable message whatever the input.
+std::string printable(const char* text);
 } // namespace vtkglue
 } // namespace blockforge

@@ -52,11 +52,12 @@ int vtkBlockMesher::RequestData(
     const blockforge::model::BlockModel blockModel =
       blockforge::model::readModelDocument(document);
     blockforge::vtkglue::meshModel(blockModel, document, this->DensityMultiplier, 0, piece,
-      pieceCount, output, [this](double fraction) { this->UpdateProgress(fraction); });
+      pieceCount, output, [this](double fraction) { this->UpdateProgress(fraction); }, nullptr,
+      this->MaximumMemory);
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro(<< error.what());
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
     output->Initialize();
     return 0;
   }
@@ -68,4 +69,5 @@ void vtkBlockMesher::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "DensityMultiplier: " << this->DensityMultiplier << "\n";
+  os << indent << "MaximumMemory: " << this->MaximumMemory << " GB\n";
 }
