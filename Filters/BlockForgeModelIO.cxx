@@ -190,6 +190,7 @@ std::string findModelDocument(vtkDataObject* object)
 
 #include "../Core/Quality.h"
 #include "../Model/MemoryBudget.h"
+#include "../Model/GridCheck.h"
 #include "../Model/Mesher.h"
 #include "../Model/PrintableText.h"
 
@@ -211,7 +212,8 @@ namespace vtkglue
 {
 void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlockMesher& mesher,
   vtkMultiBlockDataSet* output, int piece, int pieceCount,
-  const std::function<void(double)>& progress)
+  const std::function<void(double)>& progress, InvertedCellPolicy policy,
+  std::vector<model::InvertedCellReport>* reports)
 {
   const int blockCount = mesher.blockCount();
   output->SetNumberOfBlocks(static_cast<unsigned int>(blockCount));
@@ -237,6 +239,19 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
     // Fresh memory faulted in one go is much cheaper than page by page on some VMs.
     prepareOutputMemory(coordinates->GetPointer(0), sizeof(double) * 3 * nodeCount);
     mesher.meshBlock(b, coordinates->GetPointer(0));
+    if (policy == InvertedCellPolicy::Refuse)
+    {
+      model::checkBlockCells(blockModel, b, nodes, coordinates->GetPointer(0));
+    }
+    else if (policy == InvertedCellPolicy::Report)
+    {
+      model::InvertedCellReport report =
+        model::reportInvertedCells(blockModel, b, nodes, coordinates->GetPointer(0));
+      if (report.cells > 0 && reports)
+      {
+        reports->push_back(std::move(report));
+      }
+    }
 
     vtkNew<vtkPoints> points;
     points->SetData(coordinates);
@@ -313,7 +328,8 @@ private:
 void meshModel(const model::BlockModel& blockModel, const std::string& document,
   double densityMultiplier, int cellCap, int piece, int pieceCount,
   vtkMultiBlockDataSet* output, const std::function<void(double)>& progress,
-  const model::CarrierGeometry* carriers, double maximumMemoryGigabytes)
+  const model::CarrierGeometry* carriers, InvertedCellPolicy policy,
+  std::vector<model::InvertedCellReport>* reports, double maximumMemoryGigabytes)
 {
   model::CarrierGeometry known;
   bool haveCarriers = false;
@@ -351,12 +367,15 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
     progress(0.05);
   }
   vtkNew<vtkMultiBlockDataSet> grid;
-  fillMultiBlock(blockModel, mesher, grid, piece, pieceCount, [&progress](double fraction) {
-    if (progress)
-    {
-      progress(0.05 + 0.95 * fraction);
-    }
-  });
+  fillMultiBlock(
+    blockModel, mesher, grid, piece, pieceCount,
+    [&progress](double fraction) {
+      if (progress)
+      {
+        progress(0.05 + 0.95 * fraction);
+      }
+    },
+    policy, reports);
   attachModel(grid->GetFieldData(), document);
   output->ShallowCopy(grid);
 }

@@ -43,6 +43,17 @@ public:
   vtkGetMacro(MaximumMemory, double);
   ///@}
 
+  ///@{
+  /// Off (default): a grid with an inverted cell (negative Jacobian at one of a cell's
+  /// corners or its centre, the sign of GridQuality's ScaledJacobian) is an error naming
+  /// the block, its cell range and the worst cell, and the output stays empty. On: the
+  /// grid is output anyway so the folds can be inspected, with a warning per folded block
+  /// and the field data array InvertedCellCount (cells found on this piece).
+  vtkSetMacro(AllowInvertedCells, bool);
+  vtkGetMacro(AllowInvertedCells, bool);
+  vtkBooleanMacro(AllowInvertedCells, bool);
+  ///@}
+
 protected:
   vtkBlockMesher();
   ~vtkBlockMesher() override = default;
@@ -53,6 +64,7 @@ protected:
 
   double DensityMultiplier = 1.0;
   double MaximumMemory = 0.0;
+  bool AllowInvertedCells = false;
 
 private:
   vtkBlockMesher(const vtkBlockMesher&) = delete;

@@ -177,7 +177,9 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
     const std::string document = blockforge::model::writeModelDocument(blockModel);
     blockforge::vtkglue::meshModel(blockModel, document, 1.0, this->PreviewCells, piece,
       pieceCount, output, [this](double fraction) { this->UpdateProgress(0.4 + 0.55 * fraction); },
-      &geometry, this->MaximumMemory);
+      &geometry,
+      // The preview's capped cell counts are not the grid: BlockMesher checks the cells.
+      blockforge::vtkglue::InvertedCellPolicy::Skip, nullptr, this->MaximumMemory);
     if (carriers && piece == 0)
     {
       fillCarriers(blockModel, geometry, carriers);

@@ -11,7 +11,8 @@
  * projection, evaluations of the outer function) across the whole search and throws a
  * GeometryError naming the search when it is spent. Scope makes a budget the current one
  * of this thread, so inner routines (CurveProjector::project) charge it without a
- * parameter on every call path.
+ * parameter on every call path; scopes nest, and a charge counts for every enclosing
+ * budget (a caller can bound or measure a whole template).
  */
 #pragma once
 
@@ -44,12 +45,13 @@ public:
   std::size_t spent() const { return Spent; }
   std::size_t limit() const { return Limit; }
 
-  /// Charges the current budget of this thread (the innermost Scope), if there is one.
+  /// Charges the current budget of this thread (the innermost Scope) and every budget
+  /// whose Scope encloses it, so an outer search also bounds (and counts) nested ones.
   static void charge(std::size_t units = 1)
   {
-    if (Current)
+    for (WorkBudget* budget = Current; budget; budget = budget->Parent)
     {
-      Current->spend(units);
+      budget->spend(units);
     }
   }
 
@@ -62,15 +64,24 @@ public:
   public:
     explicit Scope(WorkBudget& budget)
       : Previous(Current)
+      , Budget(budget)
+      , PreviousParent(budget.Parent)
     {
+      budget.Parent = Current;
       Current = &budget;
     }
-    ~Scope() { Current = Previous; }
+    ~Scope()
+    {
+      Current = Previous;
+      Budget.Parent = PreviousParent;
+    }
     Scope(const Scope&) = delete;
     Scope& operator=(const Scope&) = delete;
 
   private:
     WorkBudget* Previous;
+    WorkBudget& Budget;
+    WorkBudget* PreviousParent;
   };
 
 private:
@@ -79,6 +90,7 @@ private:
   std::size_t Limit;
   std::size_t Spent = 0;
   std::string What;
+  WorkBudget* Parent = nullptr; ///< the enclosing scope's budget while in a Scope
   static thread_local WorkBudget* Current;
 };
 } // namespace blockforge

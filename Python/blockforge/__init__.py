@@ -52,13 +52,13 @@ def printable(text):
 
 
 def _message(text):
-    """The text of a VTK error message without VTK's "ERROR: In file, line N" and
+    """The text of a VTK error or warning without VTK's "ERROR: In file, line N" and
     "Class (0x...): " header. VTK hands Python None for a message that is not valid
     UTF-8 (BlockForge's own messages never are: they escape such bytes)."""
     if text is None:
-        return "an error whose message is not valid UTF-8 text"
+        return "a message that is not valid UTF-8 text"
     text = printable(text).strip()
-    if text.startswith("ERROR: In "):
+    if text.startswith(("ERROR: In ", "Warning: In ")):
         text = text.partition("\n")[2]
     head, sep, rest = text.partition("): ")
     if sep and " (0x" in head and "\n" not in head:
@@ -80,9 +80,12 @@ def _path_argument(path):
 
 
 def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_file=None,
-                  timings=None, maximum_memory=0.0):
+                  timings=None, allow_inverted_cells=False, warnings=None,
+                  maximum_memory=0.0):
     """:func:`mesh_template`; with a dict *timings*, also records the seconds of each
-    stage under "read" (only with an input file), "template" and "mesh + quality"."""
+    stage under "read" (only with an input file), "template" and "mesh + quality"; with a
+    list *warnings*, collects the stages' warnings (reader repairs, inverted cells let
+    through) without VTK's header."""
     import time
 
     from vtkmodules.util.misc import calldata_type
@@ -106,6 +109,7 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     mesher = vtkBlockMesher()
     mesher.SetDensityMultiplier(float(density_multiplier))
     mesher.SetMaximumMemory(float(maximum_memory))
+    mesher.SetAllowInvertedCells(bool(allow_inverted_cells))
     mesher.SetInputConnection(template.GetOutputPort())
     quality = vtkGridQuality()
     quality.SetInputConnection(mesher.GetOutputPort())
@@ -123,8 +127,14 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     def collect_failure(_caller, _event, message):
         failures.append(message)
 
+    @calldata_type(VTK_STRING)
+    def collect_warning(_caller, _event, message):
+        if warnings is not None:
+            warnings.append(_message(message))
+
     for algorithm in [stage for _, stage in stages] + [mesher]:
         algorithm.AddObserver(vtkCommand.ErrorEvent, collect)
+        algorithm.AddObserver(vtkCommand.WarningEvent, collect_warning)
         algorithm.GetExecutive().AddObserver(vtkCommand.ErrorEvent, collect_failure)
     # Stage by stage, so that a failing stage stops the pipeline with its own message.
     for key, algorithm in stages:
@@ -138,7 +148,7 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
 
 
 def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None,
-                  maximum_memory=0.0):
+                  allow_inverted_cells=False, maximum_memory=0.0):
     """Applies a template, meshes it and measures the grid.
 
     Without *input_file* the pipeline is vtkBlockTemplateSource -> vtkBlockMesher ->
@@ -152,6 +162,9 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
     :param input_file: point data for a template with inputs: a file the
         vtkTurboPointSetsReader reads (a BladeGen .inf, an Info.txt or a point file);
         None for a template without inputs
+    :param allow_inverted_cells: False (default): a grid with an inverted cell is an error
+        naming the block and the cell range; True: the grid is returned anyway for
+        inspection (field data ``InvertedCellCount``, a VTK warning per folded block)
     :param maximum_memory: largest memory in GB (2^30 bytes) a stage may allocate; 0:
         what the machine has available. A larger grid is refused before it is allocated
         ("the grid would need 48 GB for 2e+09 nodes; this machine has 23 GB available;
@@ -164,4 +177,5 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
         "<template>:<line>: ..." message). No later stage runs after a failing one.
     """
     return _run_pipeline(template_file, parameters, density_multiplier, input_file,
+                         allow_inverted_cells=allow_inverted_cells,
                          maximum_memory=maximum_memory)

@@ -1,5 +1,5 @@
 """Command line: ``python3 -m blockforge TEMPLATE [-i POINTS] [-o grid.vtm] [-p NAME=EXPR ...]
-[-d DENSITY] [-m GB]``.
+[-d DENSITY] [-m GB] [--allow-inverted-cells]``.
 
 Applies a template (to the point data of -i, read by the TurboPointSetsReader, for a
 template with inputs), meshes it, prints a quality summary (cell count, the paper's
@@ -81,6 +81,9 @@ def main(argv=None):
     parser.add_argument("-m", "--max-memory", type=float, default=0.0, metavar="GB",
                         help="refuse grids that would need more memory than this, in GB "
                              "(2^30 bytes); default 0: what the machine has available")
+    parser.add_argument("--allow-inverted-cells", action="store_true",
+                        help="output a grid with inverted cells anyway, for inspection "
+                             "(default: an error naming the block and the cell range)")
     args = parser.parse_args(argv)
     if args.output and not args.output.endswith(".vtm"):
         parser.error(f"the output must be a .vtm file (a multiblock grid), got '{printable(args.output)}'")
@@ -89,12 +92,17 @@ def main(argv=None):
                      f"{args.max_memory}")
 
     timings = {}
+    warnings = []
     try:
         quality = blockforge._run_pipeline(args.template, dict(args.parameter), args.density,
-                                           args.input, timings, args.max_memory)
+                                           args.input, timings, args.allow_inverted_cells,
+                                           warnings, args.max_memory)
     except (RuntimeError, MemoryError) as error:
         print(f"error: {printable(error) if str(error) else 'out of memory'}", file=sys.stderr)
         return 1
+    finally:
+        for warning in warnings:
+            print(f"warning: {printable(warning)}", file=sys.stderr)
     print(f"template: {printable(args.template)}")
     if args.input:
         print(f"input: {printable(args.input)}")

@@ -157,7 +157,7 @@ def make_case(rng, index, work):
     template_copy = os.path.join(folder, os.path.basename(template))
     shutil.copy(os.path.join(SOURCE, template), template_copy)
     candidates.append(template_copy)
-    description = [os.path.relpath(template, SOURCE)]
+    description = [template]
     if argv_input:
         description.append("-i " + os.path.relpath(argv_input[1], folder))
     argv = [template_copy] + argv_input + ["-o", output]

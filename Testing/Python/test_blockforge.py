@@ -173,6 +173,17 @@ class GridQualityTest(unittest.TestCase):
         self.assertEqual([counts.GetValue(i) for i in range(5)], [0, 0, 0, 0, 2 * 64])
 
 
+    def test_periodic_faces_are_measured_like_interior_faces(self):
+        # Testing/Data/sheared_periodic.yaml: across its periodic faces the cell centres
+        # (the partner's rotated back by the model's angle) lean atan(1/2) from the normal.
+        quality = blockforge.mesh_template(os.path.join(DATA, "sheared_periodic.yaml"))
+        blocks = dict(named_leaves(quality.GetOutputDataObject(0)))
+        low = np.array(dsa.WrapDataObject(blocks["low"]).CellData["NonOrthogonality"])
+        low = low.reshape(4, 4, 2)  # cells (k, j, i)
+        np.testing.assert_allclose(low[:, 0, :], math.degrees(math.atan(0.5)), atol=1e-9)
+        np.testing.assert_allclose(low[:, 1:, :], 0.0, atol=1e-6)
+
+
 class AxialPassageOHTest(unittest.TestCase):
     """mesh_template with input_file: TurboPointSetsReader -> BlockTemplate -> BlockMesher ->
     GridQuality on Templates/axial_passage_oh.yaml, for both bundled data sets."""
@@ -303,6 +314,25 @@ class CommandLineTest(unittest.TestCase):
         self.assertEqual(len(new_files), 4)
         self.assertEqual(len(named_leaves(self.read_grid(path))), 4)
 
+    def test_inverted_cells_refused_unless_allowed(self):
+        folded = os.path.join(DATA, "folded_spline.yaml")
+        path = os.path.join(self.directory, "folded.vtm")
+        status, out, err = self.run_main(folded, "-o", path)
+        self.assertEqual(status, 1)
+        self.assertIn("block 'bent'", err)
+        self.assertIn("inverted cells of 512", err)
+        self.assertIn("cell range i", err)
+        self.assertEqual(os.listdir(self.directory), [])
+        status, out, err = self.run_main(folded, "--allow-inverted-cells", "-o", path)
+        self.assertEqual(status, 0, err)
+        self.assertIn("warning: ", err)
+        self.assertIn("block 'bent'", err)
+        self.assertIn("grid written", out)
+        grid = self.read_grid(path)
+        jacobian = np.concatenate([dsa.WrapDataObject(block).CellData["ScaledJacobian"]
+                                   for _, block in named_leaves(grid)])
+        self.assertLess(float(jacobian.min()), 0.0)
+
     def test_failing_run_writes_nothing(self):
         path = os.path.join(self.directory, "failed.vtm")
         status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "nosuch=1",
@@ -395,6 +425,20 @@ class BadInputTest(unittest.TestCase):
         errors = ErrorCollector(mesher)
         mesher.Update()
         self.assertTrue(any("BlockForge model" in m for m in errors.messages))
+
+    def test_mesh_template_allow_inverted_cells(self):
+        folded = os.path.join(DATA, "folded_spline.yaml")
+        with self.assertRaises(RuntimeError) as context:
+            blockforge.mesh_template(folded)
+        self.assertIn("inverted cell", str(context.exception))
+        quality = blockforge.mesh_template(folded, allow_inverted_cells=True)
+        grid = quality.GetOutputDataObject(0)
+        count = grid.GetFieldData().GetArray("InvertedCellCount").GetValue(0)
+        jacobian = np.concatenate([dsa.WrapDataObject(block).CellData["ScaledJacobian"]
+                                   for _, block in named_leaves(grid)])
+        # the mesher's count is GridQuality's count of negative scaled Jacobians
+        self.assertGreater(count, 0)
+        self.assertEqual(count, int((jacobian < 0).sum()))
 
     def test_mesh_template_raises(self):
         with self.assertRaises(RuntimeError) as context:
