@@ -359,7 +359,8 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
     }
   }
   model::checkGridMemory(nodes, maximumMemoryGigabytes,
-    cellCap > 0 ? "lower PreviewCells or the cell counts"
+    cellCap > 0 || policy == InvertedCellPolicy::Skip // the template's preview
+      ? "lower PreviewCells or the cell counts"
                 : "lower the density multiplier or the cell counts");
   mesher.computeBoundaries();
   if (progress)

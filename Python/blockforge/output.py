@@ -32,8 +32,10 @@ PIECES_MARK = ".pieces-"
 
 
 def _process_alive(pid):
+    """Whether another process *pid* runs (this process's own leftovers are stale: one
+    process writes one target at a time)."""
     if pid == os.getpid():
-        return True
+        return False
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -199,6 +201,30 @@ class _Messages:
         return _message(self.texts[0])
 
 
+class _quiet_vtk:
+    """Catches what VTK prints during a write (the piece writers' executives report their
+    failures only to the output window, as pages of pipeline detail): the caller turns it
+    into one clear error."""
+
+    def __enter__(self):
+        from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
+
+        self.previous = vtkOutputWindow.GetInstance()
+        self.window = vtkStringOutputWindow()
+        vtkOutputWindow.SetInstance(self.window)
+        # VTK's logger prints errors to stderr itself, besides the output window
+        self.verbosity = vtkLogger.GetCurrentVerbosityCutoff()
+        vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
+        return self.window
+
+    def __exit__(self, *exc):
+        from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow
+
+        vtkLogger.SetStderrVerbosity(vtkLogger.ConvertToVerbosity(self.verbosity))
+        vtkOutputWindow.SetInstance(self.previous)
+        return False
+
+
 def _leaves(multiblock):
     from vtkmodules.vtkCommonDataModel import vtkDataObjectTreeIterator
 
@@ -231,10 +257,12 @@ def write_vtm(data_object, path):
         writer.SetFileName(staged_main)
         writer.SetDataModeToAppended()
         writer.EncodeAppendedDataOff()
-        written = writer.Write()
-        if not written or messages.texts or writer.GetErrorCode():
-            detail = f": {messages.first()}" if messages.texts else ""
-            raise RuntimeError(f"could not write {path}{detail}")
+        with _quiet_vtk() as noise:
+            written = writer.Write()
+        if not written or messages.texts or writer.GetErrorCode() or noise.GetOutput():
+            detail = messages.first() if messages.texts else "the VTK writer failed"
+            raise RuntimeError(f"could not write {path}: {detail} (check the free space, "
+                               "the file size limit and the permissions there)")
         # What was written: the .vtm must be complete XML naming one piece per non-empty
         # block, each piece complete and the size of its block.
         staged_pieces = output.staged(pieces)

@@ -350,8 +350,9 @@ class CommandLineTest(unittest.TestCase):
         self.assertEqual(os.listdir(self.directory), [])
 
     def test_failed_move_keeps_the_older_grid(self):
-        """The new grid cannot be put in place (the .vtm path is a directory): the older
-        pieces stay where they were, the new ones are removed and the error is reported."""
+        """The new grid cannot be put in place (the .vtm path is a directory): the new
+        pieces are removed and the error is reported; the pieces nothing references any
+        more (their .vtm was removed) are cleaned up as leftovers."""
         path = os.path.join(self.directory, "kept.vtm")
         status, _, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-o", path)
         self.assertEqual(status, 0, err)
@@ -362,8 +363,9 @@ class CommandLineTest(unittest.TestCase):
         self.assertEqual(status, 1)
         self.assertIn("error:", err)
         self.assertNotIn("grid written", out)
-        self.assertEqual(sorted(os.listdir(os.path.join(self.directory, folder))), files)
-        self.assertEqual(sorted(os.listdir(self.directory)), [folder, "kept.vtm"])
+        self.assertEqual(len(files), 12)
+        self.assertEqual(sorted(os.listdir(self.directory)), ["kept.vtm"])
+        self.assertEqual(os.listdir(path), ["occupied"])
 
     def test_bad_input_path(self):
         path = os.path.join(self.directory, "bad_input.vtm")
