@@ -244,6 +244,52 @@ void writeBoundary(const std::string& path, const PolyMesh& mesh)
   file.close();
 }
 
+/// A system/ dictionary, unless the case has one (a solver set-up is never touched).
+void writeSystemFileIfAbsent(const std::string& caseDir, const char* object, const char* body)
+{
+  const std::string system = caseDir + "/system";
+  const std::string path = system + "/" + object;
+  if (std::FILE* existing = std::fopen(path.c_str(), "rb"))
+  {
+    std::fclose(existing);
+    return;
+  }
+  makeDirectories(system);
+  StagedOutput staged(path, StagedOutput::Kind::File);
+  CheckedFile file(staged.path());
+  std::string text = header("dictionary", object, false);
+  text.replace(text.find("\"constant/polyMesh\""), 19, "\"system\"");
+  file.write(text + body);
+  file.write(Footer);
+  file.close();
+  staged.publish();
+}
+
+/// Minimal system/ files so that OpenFOAM's tools (checkMesh, simpleFoam) open the case.
+void writeSystemFilesIfAbsent(const std::string& caseDir)
+{
+  writeSystemFileIfAbsent(caseDir, "controlDict",
+    "application     simpleFoam;\nstartFrom       latestTime;\nstartTime       0;\n"
+    "stopAt          endTime;\nendTime         100;\ndeltaT          1;\n"
+    "writeControl    timeStep;\nwriteInterval   100;\nwriteFormat     binary;\n"
+    "writePrecision  17;\nwriteCompression off;\ntimeFormat      general;\n"
+    "runTimeModifiable false;\n");
+  writeSystemFileIfAbsent(caseDir, "fvSchemes",
+    "ddtSchemes { default steadyState; }\ngradSchemes { default Gauss linear; }\n"
+    "divSchemes { default none; div(phi,U) bounded Gauss linearUpwind grad(U); "
+    "div(phi,k) bounded Gauss upwind; div(phi,epsilon) bounded Gauss upwind; "
+    "div(phi,omega) bounded Gauss upwind; div((nuEff*dev2(T(grad(U))))) Gauss linear; }\n"
+    "laplacianSchemes { default Gauss linear corrected; }\n"
+    "interpolationSchemes { default linear; }\nsnGradSchemes { default corrected; }\n"
+    "wallDist { method meshWave; }\n");
+  writeSystemFileIfAbsent(caseDir, "fvSolution",
+    "solvers\n{\n    p { solver GAMG; smoother GaussSeidel; tolerance 1e-7; relTol 0.1; }\n"
+    "    \"(U|k|epsilon|omega)\" { solver smoothSolver; smoother symGaussSeidel; "
+    "tolerance 1e-8; relTol 0.1; }\n}\n"
+    "SIMPLE { nNonOrthogonalCorrectors 0; consistent yes; }\n"
+    "relaxationFactors { equations { U 0.9; \".*\" 0.9; } }\n");
+}
+
 std::string folderOf(const std::string& path)
 {
   const std::size_t slash = path.find_last_of('/');
@@ -265,6 +311,7 @@ void writeFoamCase(const PolyMesh& mesh, const std::string& foamFile, const Foam
   {
     CheckedFile failing(foamFile); // throws with the reason
   }
+  writeSystemFilesIfAbsent(caseDir);
   StagedOutput staged(constant + "/polyMesh", StagedOutput::Kind::Directory);
   const std::string dir = staged.path() + "/";
   const bool binary = options.binary;
