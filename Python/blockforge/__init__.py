@@ -12,6 +12,8 @@ and :func:`mesh_template` runs the whole pipeline in one call.
 from vtkmodules import vtkCommonCore, vtkCommonDataModel, vtkCommonExecutionModel  # noqa: F401
 
 from .BlockForgeFilters import (  # noqa: F401
+    vtkBlockFoamWriter,
+    vtkBlockGridWriter,
     vtkBlockMesher,
     vtkBlockTemplate,
     vtkBlockTemplateAlgorithm,
@@ -21,6 +23,8 @@ from .BlockForgeFilters import (  # noqa: F401
 )
 
 __all__ = [
+    "vtkBlockFoamWriter",
+    "vtkBlockGridWriter",
     "vtkBlockMesher",
     "vtkBlockTemplate",
     "vtkBlockTemplateAlgorithm",

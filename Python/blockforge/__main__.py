@@ -16,6 +16,7 @@ import tempfile
 import time
 
 import blockforge
+from blockforge import writers
 
 
 def _parse_parameter(text):
@@ -115,14 +116,18 @@ def main(argv=None):
     parser.add_argument("-i", "--input", metavar="FILE",
                         help="point data for a template with inputs (BladeGen .inf, Info.txt "
                              "or point file, read by the TurboPointSetsReader)")
-    parser.add_argument("-o", "--output", help="grid file to write (.vtm)")
+    parser.add_argument("-o", "--output", help="grid file to write: .vtm, or DIR/NAME.foam "
+                        "(OpenFOAM case)")
+    parser.add_argument("--ascii", action="store_true",
+                        help="ASCII instead of binary where the format has both")
     parser.add_argument("-p", "--parameter", action="append", type=_parse_parameter,
                         default=[], metavar="NAME=EXPR", help="override a template parameter")
     parser.add_argument("-d", "--density", type=float, default=1.0,
                         help="grid density multiplier (scales every cell count)")
     args = parser.parse_args(argv)
-    if args.output and not args.output.endswith(".vtm"):
-        parser.error(f"the output must be a .vtm file (a multiblock grid), got '{args.output}'")
+    if args.output and not (args.output.endswith(".vtm") or writers.is_solver_format(args.output)):
+        parser.error(f"the output must be .vtm or {', '.join(writers.SOLVER_WRITERS)}, "
+                     f"got '{args.output}'")
 
     timings = {}
     try:
@@ -141,7 +146,11 @@ def main(argv=None):
     if args.output:
         start = time.perf_counter()
         try:
-            write_grid(quality.GetOutputDataObject(0), args.output)
+            if writers.is_solver_format(args.output):
+                writers.write_solver_grid(quality.GetOutputDataObject(0), args.output,
+                                          binary=not args.ascii)
+            else:
+                write_grid(quality.GetOutputDataObject(0), args.output)
         except (RuntimeError, OSError) as error:
             print(f"error: {error}", file=sys.stderr)
             return 1
