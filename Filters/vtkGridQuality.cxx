@@ -1,6 +1,9 @@
 #include "vtkGridQuality.h"
 
 #include "../Core/Quality.h"
+#include "../Model/ModelDocument.h"
+#include "../Model/Topology.h"
+#include "BlockForgeModelIO.h"
 
 #include <vtkCellData.h>
 #include <vtkCompositeDataSet.h>
@@ -25,6 +28,8 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <map>
+#include <string>
 #include <vector>
 
 vtkStandardNewMacro(vtkGridQuality);
@@ -35,6 +40,55 @@ const char* const MeasureNames[6] = { "MinAngle", "MaxAngle", "NonOrthogonality"
   "AspectRatio", "ScaledJacobian" };
 const char* const ClassLabels[5] = { "0-20", "20-40", "40-60", "60-80", "80-90" };
 
+/**
+ * The periodic pairs of the block model carried by `input` (none without a model), as
+ * links between the measured grids: model blocks are found by name among `names` (the
+ * grids' block names). Pairs with a block that is not here (another MPI rank) are left
+ * out; pairs that do not fit the grid (it was changed after meshing) are left out and
+ * counted in `unfit`.
+ */
+std::vector<blockforge::PeriodicSideLink> periodicLinks(vtkDataObject* input,
+  const std::vector<std::string>& names, const std::vector<blockforge::StructuredBlock>& blocks,
+  int& unfit)
+{
+  unfit = 0;
+  std::vector<blockforge::PeriodicSideLink> links;
+  const std::string document = blockforge::vtkglue::findModelDocument(input);
+  if (document.empty())
+  {
+    return links;
+  }
+  const blockforge::model::BlockModel model = blockforge::model::readModelDocument(document);
+  std::map<std::string, int> gridOf;
+  for (std::size_t g = 0; g < names.size(); ++g)
+  {
+    if (!names[g].empty() && !gridOf.emplace(names[g], static_cast<int>(g)).second)
+    {
+      return links; // two grids of one name: no safe mapping
+    }
+  }
+  const blockforge::model::Topology topology = blockforge::model::buildTopology(model);
+  for (blockforge::PeriodicSideLink link : topology.periodicSideLinks())
+  {
+    const auto source = gridOf.find(model.blocks[link.sourceBlock].name);
+    const auto image = gridOf.find(model.blocks[link.imageBlock].name);
+    if (source == gridOf.end() || image == gridOf.end())
+    {
+      continue;
+    }
+    link.sourceBlock = source->second;
+    link.imageBlock = image->second;
+    if (blockforge::periodicSidesMatch(blocks, link))
+    {
+      links.push_back(link);
+    }
+    else
+    {
+      ++unfit;
+    }
+  }
+  return links;
+}
 } // namespace
 
 vtkGridQuality::vtkGridQuality()
@@ -72,6 +126,7 @@ int vtkGridQuality::RequestData(
   std::vector<vtkStructuredGrid*> grids;
   std::vector<std::vector<double>> convertedPoints;
   std::vector<blockforge::StructuredBlock> blocks;
+  std::vector<std::string> names;
   vtkSmartPointer<vtkDataObjectTreeIterator> iterator;
   iterator.TakeReference(input->NewTreeIterator());
   iterator->SkipEmptyNodesOn();
@@ -116,6 +171,11 @@ int vtkGridQuality::RequestData(
     }
     blocks.push_back(block);
     grids.push_back(grid);
+    vtkInformation* metaData =
+      iterator->HasCurrentMetaData() ? iterator->GetCurrentMetaData() : nullptr;
+    names.push_back(metaData && metaData->Has(vtkCompositeDataSet::NAME())
+        ? metaData->Get(vtkCompositeDataSet::NAME())
+        : "");
   }
 
   // The measures are written straight into the output arrays: no copy, and the fresh
@@ -153,8 +213,17 @@ int vtkGridQuality::RequestData(
   }
   try
   {
-    blockforge::computeGridQuality(
-      blocks, outputs, [this](double fraction) { this->UpdateProgress(0.9 * fraction); });
+    int unfit = 0;
+    const std::vector<blockforge::PeriodicSideLink> links =
+      periodicLinks(input, names, blocks, unfit);
+    if (unfit > 0)
+    {
+      vtkWarningMacro(<< unfit
+                      << " periodic face pair(s) of the input's block model do not fit its "
+                         "grid (changed after meshing?); they are measured as boundaries.");
+    }
+    blockforge::computeGridQuality(blocks, links, outputs,
+      [this](double fraction) { this->UpdateProgress(0.9 * fraction); });
   }
   catch (const std::exception& error)
   {

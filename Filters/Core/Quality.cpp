@@ -687,6 +687,132 @@ inline int usableLanes(const FaceGeometry<T>& face, const FaceMeasures<T>& m)
 }
 
 // ---------------------------------------------------------------------------------------
+// Cell centres
+
+/// The six faces of a hexahedron (outward area vectors for a right-handed cell).
+template <typename T>
+inline void hexFaceGeometry(const V3<T> (&c)[8], FaceGeometry<T> (&faces)[6])
+{
+  for (int f = 0; f < 6; ++f)
+  {
+    const V3<T> p[4] = { c[hexFaces[f][0]], c[hexFaces[f][1]], c[hexFaces[f][2]],
+      c[hexFaces[f][3]] };
+    faces[f] = quadFace(p);
+  }
+}
+
+/**
+ * OpenFOAM's cell centre (primitiveMesh::makeCellCentresAndVols): the volume-weighted
+ * centre of the pyramids from each face to the mean of the face centres, which is the
+ * cell's volume centroid (the mean of the corners is not, unless the cell is a
+ * parallelepiped). Branch-free; `usable` gets the lanes (bits) where the result holds:
+ * every face has a regular centre and no face is collapsed, and the volume is not zero.
+ * The others take cellCentroidSpecialCase.
+ */
+template <typename T>
+inline V3<T> cellCentroidKernel(const V3<T> (&c)[8], int& usable)
+{
+  FaceGeometry<T> faces[6];
+  hexFaceGeometry(c, faces);
+  const V3<T> estimate = (1.0 / 6.0) *
+    (((faces[0].centre + faces[1].centre) + (faces[2].centre + faces[3].centre)) +
+      (faces[4].centre + faces[5].centre));
+  V3<T> weighted = { splat<T>(0.0), splat<T>(0.0), splat<T>(0.0) };
+  T volume = splat<T>(0.0);
+  for (const FaceGeometry<T>& face : faces)
+  {
+    const T pyramid3 = dot(face.area, face.centre - estimate);
+    weighted = weighted + pyramid3 * (0.75 * face.centre + 0.25 * estimate);
+    volume = volume + pyramid3;
+  }
+  constexpr int lanes = laneCount<T>;
+  double volumes[lanes];
+  extractLanes(volume, volumes);
+  usable = 0;
+  for (int l = 0; l < lanes; ++l)
+  {
+    usable |= (std::abs(volumes[l]) > vSmall) << l;
+  }
+  for (const FaceGeometry<T>& face : faces)
+  {
+    double area2[lanes], diagonals2[lanes], weightSum[lanes];
+    extractLanes(face.area2, area2);
+    extractLanes(face.diagonals2, diagonals2);
+    extractLanes(face.weightSum, weightSum);
+    for (int l = 0; l < lanes; ++l)
+    {
+      const bool regular = !faceCollapsed(area2[l], diagonals2[l]) && weightSum[l] > 0.0 &&
+        weightSum[l] * weightSum[l] > 4.0 * vSmall * vSmall * area2[l];
+      usable &= ~(static_cast<int>(!regular) << l);
+    }
+  }
+  return (1.0 / volume) * weighted;
+}
+
+/// The centre of a cell with collapsed faces or edges, or no volume: as OpenFOAM's mesh
+/// of it would have it (blockMesh drops collapsed faces), the estimate alone when the
+/// volume is zero, the mean of the corners when no face is left.
+P3 cellCentroidSpecialCase(const P3 (&c)[8])
+{
+  FaceGeometry<double> faces[6];
+  bool kept[6];
+  P3 estimate = { 0.0, 0.0, 0.0 };
+  int count = 0;
+  for (int f = 0; f < 6; ++f)
+  {
+    const P3 p[4] = { c[hexFaces[f][0]], c[hexFaces[f][1]], c[hexFaces[f][2]], c[hexFaces[f][3]] };
+    faces[f] = scalarFace(p);
+    kept[f] = !faceCollapsed(faces[f].area2, faces[f].diagonals2);
+    if (kept[f])
+    {
+      estimate = estimate + faces[f].centre;
+      ++count;
+    }
+  }
+  if (count == 0)
+  {
+    return 0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7])));
+  }
+  estimate = (1.0 / count) * estimate;
+  P3 weighted = { 0.0, 0.0, 0.0 };
+  double volume = 0.0;
+  for (int f = 0; f < 6; ++f)
+  {
+    if (kept[f])
+    {
+      const double pyramid3 = dot(faces[f].area, faces[f].centre - estimate);
+      weighted = weighted + pyramid3 * (0.75 * faces[f].centre + 0.25 * estimate);
+      volume += pyramid3;
+    }
+  }
+  return std::abs(volume) > vSmall ? (1.0 / volume) * weighted : estimate;
+}
+
+/// OpenFOAM's cell centre of every lane.
+template <typename T>
+inline V3<T> cellCentroid(const V3<T> (&c)[8])
+{
+  int usable = 0;
+  V3<T> centre = cellCentroidKernel(c, usable);
+  for (int l = 0; usable != (1 << laneCount<T>)-1 && l < laneCount<T>; ++l)
+  {
+    if (!(usable & (1 << l)))
+    {
+      P3 corners[8];
+      for (int v = 0; v < 8; ++v)
+      {
+        corners[v] = laneOf(c[v], l);
+      }
+      const P3 special = cellCentroidSpecialCase(corners);
+      setLane(centre.x, l, special.x);
+      setLane(centre.y, l, special.y);
+      setLane(centre.z, l, special.z);
+    }
+  }
+  return centre;
+}
+
+// ---------------------------------------------------------------------------------------
 // Memory
 
 /**
@@ -778,7 +904,7 @@ struct BlockView
   {
     P3 c[8];
     cellCorners(i, j, k, c);
-    return 0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7])));
+    return cellCentroid(c);
   }
   /// Face grid size of a block side: 0/1 are i = 0 / i = ni-1 (indexed j, k),
   /// 2/3 are j = 0 / nj-1 (i, k), 4/5 are k = 0 / nk-1 (i, j).
@@ -898,6 +1024,25 @@ struct InterfaceTable
 
   std::vector<long> partner;
   std::vector<long> sideOffset; // first face of each (block, side), block-major
+  /// Periodic faces: 2 l + 0 when the partner cell is rotated by link l's rotation into
+  /// this face's frame, 2 l + 1 by its inverse; -1 for interfaces and boundaries. Empty
+  /// when there are no periodic links.
+  std::vector<int> periodic;
+  std::vector<PeriodicSideLink> links;
+
+  /// The neighbour centre as the face at `index` sees it.
+  P3 neighbourCentre(long index, const P3& centre) const
+  {
+    const int code = periodic.empty() ? -1 : periodic[index];
+    if (code < 0)
+    {
+      return centre;
+    }
+    const PeriodicSideLink& link = links[code / 2];
+    const Vec3 relative = toVec3(centre) - link.origin;
+    return toP3(link.origin +
+      (code % 2 == 0 ? Vec3(link.rotation * relative) : Vec3(link.rotation.transpose() * relative)));
+  }
 
   long index(int block, int side, int a, int b, const BlockView& view) const
   {
@@ -1019,6 +1164,105 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     first = last;
   }
   return table;
+}
+
+/// Cells along the a and b directions of a block side.
+void sideCells(const BlockView& view, int side, int& width, int& height)
+{
+  width = view.sideWidth(side);
+  height = view.sideHeight(side);
+}
+
+/**
+ * Whether the image side of `link` is its source side rotated, cell face for cell face:
+ * the side sizes agree under the transform and the four corner nodes land within 1e-9
+ * of the side's size.
+ */
+bool linkMatches(const std::vector<BlockView>& views, const PeriodicSideLink& link)
+{
+  const int blocks = static_cast<int>(views.size());
+  if (link.sourceBlock < 0 || link.sourceBlock >= blocks || link.imageBlock < 0 ||
+    link.imageBlock >= blocks || link.sourceSide < 0 || link.sourceSide > 5 ||
+    link.imageSide < 0 || link.imageSide > 5)
+  {
+    return false;
+  }
+  const BlockView& source = views[link.sourceBlock];
+  const BlockView& image = views[link.imageBlock];
+  if (source.cellCount == 0 || image.cellCount == 0)
+  {
+    return false;
+  }
+  int sw = 0, sh = 0, iw = 0, ih = 0;
+  sideCells(source, link.sourceSide, sw, sh);
+  sideCells(image, link.imageSide, iw, ih);
+  if ((link.transform.swap() ? ih : iw) != sw || (link.transform.swap() ? iw : ih) != sh)
+  {
+    return false;
+  }
+  // Corner nodes of the image side's cell faces at the four corners of the side.
+  const int cornerA[4] = { 0, iw - 1, iw - 1, 0 }, cornerB[4] = { 0, 0, ih - 1, ih - 1 };
+  double size = 0.0, miss = 0.0;
+  for (int n = 0; n < 4; ++n)
+  {
+    int a = 0, b = 0;
+    link.transform.map(cornerA[n], cornerB[n], sw, sh, a, b);
+    P3 q[4], r[4];
+    int ijk[3];
+    image.sideFace(link.imageSide, cornerA[n], cornerB[n], q, ijk);
+    source.sideFace(link.sourceSide, a, b, r, ijk);
+    // The face centroids (corner means) must coincide after the rotation.
+    const P3 imageMean = 0.25 * ((q[0] + q[1]) + (q[2] + q[3]));
+    const P3 sourceMean = 0.25 * ((r[0] + r[1]) + (r[2] + r[3]));
+    const Vec3 rotated = link.origin + link.rotation * (toVec3(sourceMean) - link.origin);
+    miss = std::max(miss, (rotated - toVec3(imageMean)).norm());
+    for (const P3& p : q)
+    {
+      size = std::max(size, (toVec3(p) - toVec3(imageMean)).norm());
+    }
+  }
+  return miss <= 1e-6 * size;
+}
+
+/// Pairs the faces of periodic sides (replacing what hashing found there).
+void addPeriodicLinks(InterfaceTable& table, const std::vector<BlockView>& views,
+  const std::vector<PeriodicSideLink>& links)
+{
+  if (links.empty())
+  {
+    return;
+  }
+  table.links = links;
+  table.periodic.assign(table.partner.size(), -1);
+  for (std::size_t l = 0; l < links.size(); ++l)
+  {
+    const PeriodicSideLink& link = links[l];
+    if (!linkMatches(views, link))
+    {
+      throw GeometryError("grid quality: side " + std::to_string(link.imageSide) + " of block " +
+        std::to_string(link.imageBlock) + " is not the periodic image of side " +
+        std::to_string(link.sourceSide) + " of block " + std::to_string(link.sourceBlock));
+    }
+    const BlockView& source = views[link.sourceBlock];
+    const BlockView& image = views[link.imageBlock];
+    int sw = 0, sh = 0, iw = 0, ih = 0;
+    sideCells(source, link.sourceSide, sw, sh);
+    sideCells(image, link.imageSide, iw, ih);
+    for (int b = 0; b < ih; ++b)
+    {
+      for (int a = 0; a < iw; ++a)
+      {
+        int sa = 0, sb = 0;
+        link.transform.map(a, b, sw, sh, sa, sb);
+        const long imageIndex = table.index(link.imageBlock, link.imageSide, a, b, image);
+        const long sourceIndex = table.index(link.sourceBlock, link.sourceSide, sa, sb, source);
+        table.partner[imageIndex] = sourceIndex;
+        table.partner[sourceIndex] = imageIndex;
+        table.periodic[imageIndex] = static_cast<int>(2 * l);
+        table.periodic[sourceIndex] = static_cast<int>(2 * l + 1);
+      }
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -1297,8 +1541,7 @@ private:
       quality_.aspectRatio[cell + l] = shape.aspectRatio;
     }
 
-    const V3<T> centre =
-      0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7])));
+    const V3<T> centre = cellCentroid(c);
     const long inLayer = i + static_cast<long>(view_.ci) * j_;
     const CoordinateArrays& centres = centres_[k_ % 2];
     storeLanes(centres.x + inLayer, centre.x);
@@ -1380,7 +1623,9 @@ void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
     {
       for (int a = 0; a < view.sideWidth(side); ++a)
       {
-        const long partner = interfaces.partner[interfaces.index(blockIndex, side, a, b, view)];
+        const long faceIndex = interfaces.index(blockIndex, side, a, b, view);
+        const long partner = interfaces.partner[faceIndex];
+        const bool periodic = !interfaces.periodic.empty() && interfaces.periodic[faceIndex] >= 0;
         P3 q[4];
         int ijk[3];
         view.sideFace(side, a, b, q, ijk);
@@ -1402,14 +1647,16 @@ void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
           const BoundaryFaceRef other = interfaces.face(partner, views);
           otherView = &views[other.block];
           otherView->sideFace(other.side, other.a, other.b, otherCorners, otherIjk);
-          if (!sameCorners(q, otherCorners))
+          if (!periodic && !sameCorners(q, otherCorners))
           {
             otherView = nullptr; // hashes collided: a true boundary face
           }
         }
         if (otherView)
         {
-          const P3 d = otherView->cellCentre(otherIjk[0], otherIjk[1], otherIjk[2]) - ownerCentre;
+          const P3 d = interfaces.neighbourCentre(faceIndex,
+                         otherView->cellCentre(otherIjk[0], otherIjk[1], otherIjk[2])) -
+            ownerCentre;
           minCosine2 = std::min(minCosine2, signedSquare(orthogonalityCosine(d, outward)));
           maxSkewness =
             std::max(maxSkewness, skewness(ownerCentre, d, 0.2, outward, face.centre, q));
@@ -1498,7 +1745,7 @@ Vec3 hexCentre(const std::array<Vec3, 8>& corners)
 {
   P3 c[8];
   loadCorners(corners, c);
-  return toVec3(0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7]))));
+  return toVec3(cellCentroid(c));
 }
 
 void quadAreaAndCentre(
@@ -1578,11 +1825,13 @@ std::vector<BlockView> blockViews(const std::vector<StructuredBlock>& blocks, do
 }
 
 void evaluateBlocks(const std::vector<BlockView>& views, double totalCells,
-  const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress)
+  const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
+  const std::function<void(double)>& progress)
 {
   ProgressReporter reporter(progress, totalCells);
   reporter.start();
-  const InterfaceTable interfaces = matchBlockInterfaces(views);
+  InterfaceTable interfaces = matchBlockInterfaces(views);
+  addPeriodicLinks(interfaces, views, periodic);
   std::vector<double> scratch;
   for (std::size_t n = 0; n < views.size(); ++n)
   {
@@ -1595,6 +1844,12 @@ void evaluateBlocks(const std::vector<BlockView>& views, double totalCells,
 std::vector<CellQualityArrays> computeGridQuality(
   const std::vector<StructuredBlock>& blocks, const std::function<void(double)>& progress)
 {
+  return computeGridQuality(blocks, std::vector<PeriodicSideLink>(), progress);
+}
+
+std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::function<void(double)>& progress)
+{
   double totalCells = 0.0;
   const std::vector<BlockView> views = blockViews(blocks, totalCells);
   std::vector<CellQualityArrays> quality(blocks.size());
@@ -1606,12 +1861,25 @@ std::vector<CellQualityArrays> computeGridQuality(
     outputs[n] = { q.minAngle.data(), q.maxAngle.data(), q.nonOrthogonality.data(),
       q.skewness.data(), q.aspectRatio.data(), q.scaledJacobian.data() };
   }
-  evaluateBlocks(views, totalCells, outputs, progress);
+  evaluateBlocks(views, totalCells, periodic, outputs, progress);
   return quality;
 }
 
 void computeGridQuality(const std::vector<StructuredBlock>& blocks,
   const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress)
+{
+  computeGridQuality(blocks, std::vector<PeriodicSideLink>(), outputs, progress);
+}
+
+bool periodicSidesMatch(const std::vector<StructuredBlock>& blocks, const PeriodicSideLink& link)
+{
+  double totalCells = 0.0;
+  return linkMatches(blockViews(blocks, totalCells), link);
+}
+
+void computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
+  const std::function<void(double)>& progress)
 {
   if (outputs.size() != blocks.size())
   {
@@ -1620,7 +1888,7 @@ void computeGridQuality(const std::vector<StructuredBlock>& blocks,
   }
   double totalCells = 0.0;
   const std::vector<BlockView> views = blockViews(blocks, totalCells);
-  evaluateBlocks(views, totalCells, outputs, progress);
+  evaluateBlocks(views, totalCells, periodic, outputs, progress);
 }
 
 void prepareOutputMemory(void* begin, std::size_t bytes)

@@ -1,7 +1,7 @@
 #include "CarrierGeometry.h"
 
 #include "ModelSyntax.h"
-#include "Template.h"
+#include "Errors.h"
 
 #include "../Core/BSpline.h"
 

@@ -10,7 +10,8 @@
 
 #include "BlockModel.h"
 #include "CarrierGeometry.h"
-#include "Template.h"
+#include "Errors.h"
+#include "Topology.h"
 
 #include <functional>
 #include <memory>
@@ -71,6 +72,9 @@ public:
   const CarrierGeometry& carriers() const;
   /// Node counts (ni, nj, nk) of block b.
   std::array<int, 3> nodeCounts(int block) const;
+  /// The model's topology at the mesher's node counts (shared edges and faces, interfaces,
+  /// periodic pairs, patches). computeBoundaries() must have been called.
+  const Topology& topology() const;
   /// Writes the nodes of block b (ni*nj*nk*3 doubles, i fastest) into `out`.
   /// computeBoundaries() must have been called. Thread-safe for different blocks.
   void meshBlock(int block, double* out) const;

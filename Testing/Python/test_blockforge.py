@@ -172,6 +172,17 @@ class GridQualityTest(unittest.TestCase):
         self.assertEqual([counts.GetValue(i) for i in range(5)], [0, 0, 0, 0, 2 * 64])
 
 
+    def test_periodic_faces_are_measured_like_interior_faces(self):
+        # Testing/Data/sheared_periodic.yaml: across its periodic faces the cell centres
+        # (the partner's rotated back by the model's angle) lean atan(1/2) from the normal.
+        quality = blockforge.mesh_template(os.path.join(DATA, "sheared_periodic.yaml"))
+        blocks = dict(named_leaves(quality.GetOutputDataObject(0)))
+        low = np.array(dsa.WrapDataObject(blocks["low"]).CellData["NonOrthogonality"])
+        low = low.reshape(4, 4, 2)  # cells (k, j, i)
+        np.testing.assert_allclose(low[:, 0, :], math.degrees(math.atan(0.5)), atol=1e-9)
+        np.testing.assert_allclose(low[:, 1:, :], 0.0, atol=1e-6)
+
+
 class AxialPassageOHTest(unittest.TestCase):
     """mesh_template with input_file: TurboPointSetsReader -> BlockTemplate -> BlockMesher ->
     GridQuality on Templates/axial_passage_oh.yaml, for both bundled data sets."""
