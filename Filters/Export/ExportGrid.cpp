@@ -21,23 +21,23 @@ long long faceNode(const GridBlock& block, int face, int a, int b)
   return index[0] + block.nodes[0] * (index[1] + static_cast<long long>(block.nodes[1]) * index[2]);
 }
 
-std::array<int, 2> mapFaceNode(int code, int a, int b, int toA, int toB)
+std::array<int, 2> mapFaceNode(FaceTransform transform, int a, int b, int toA, int toB)
 {
-  const bool swap = (code & 4) != 0;
-  const int x = swap ? b : a;
-  const int y = swap ? a : b;
-  return { (code & 1) != 0 ? toA - 1 - x : x, (code & 2) != 0 ? toB - 1 - y : y };
+  std::array<int, 2> out{};
+  transform.map(a, b, toA, toB, out[0], out[1]);
+  return out;
 }
 
-int inverseCode(int code)
+FaceTransform inverse(FaceTransform transform)
 {
   // Without a swap, reversing a and b undoes itself; with a swap, the reversal of the
   // target's a is the reversal of the source's b and the other way round.
+  const int code = transform.code;
   if ((code & 4) == 0)
   {
-    return code;
+    return transform;
   }
-  return 4 | ((code & 1) << 1) | ((code & 2) >> 1);
+  return FaceTransform{ 4 | ((code & 1) << 1) | ((code & 2) >> 1) };
 }
 
 long long ExportGrid::cellCount() const

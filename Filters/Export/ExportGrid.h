@@ -10,6 +10,7 @@
 #pragma once
 
 #include "BlockModel.h"
+#include "FaceTransform.h"
 
 #include <array>
 #include <string>
@@ -34,26 +35,25 @@ struct GridBlock
 };
 
 /**
- * Two block faces whose node grids coincide node for node: node (a, b) of `from` (a, b
- * along model::faceDirections(from.face)) is node map(a, b) of `to`. `code` is one of the
- * 8 symmetries of a square: bit 2 swaps a and b, then bits 0 and 1 reverse a and b.
+ * Two block faces whose node grids coincide node for node (or are rotated copies): node
+ * (a, b) of `from` (a, b along model::faceDirections(from.face)) is node
+ * transform.map(a, b) of `to`.
  */
 struct FaceMatch
 {
   model::BlockFace from;
   model::BlockFace to;
-  int code = 0;
+  FaceTransform transform;
 };
 
 /// Node counts (along a, b) of a block face.
 std::array<int, 2> faceNodeCounts(const GridBlock& block, int face);
 /// Index (into the block's nodes) of node (a, b) of a block face.
 long long faceNode(const GridBlock& block, int face, int a, int b);
-/// (a, b) on the `to` face of node (a, b) of the `from` face; (toA, toB) are the node
-/// counts of the `to` face.
-std::array<int, 2> mapFaceNode(int code, int a, int b, int toA, int toB);
-/// The code of the inverse map (from `to` back to `from`).
-int inverseCode(int code);
+/// (a, b) on the other face of node (a, b); (toA, toB) are the other face's node counts.
+std::array<int, 2> mapFaceNode(FaceTransform transform, int a, int b, int toA, int toB);
+/// The inverse map (from the other side back).
+FaceTransform inverse(FaceTransform transform);
 
 /// A named boundary patch as the template declares it.
 struct GridPatch

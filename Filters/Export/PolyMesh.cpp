@@ -124,7 +124,7 @@ struct Builder
       {
         for (int a = 0; a < n[0]; ++a)
         {
-          const std::array<int, 2> image = mapFaceNode(match.code, a, b, m[0], m[1]);
+          const std::array<int, 2> image = mapFaceNode(match.transform, a, b, m[0], m[1]);
           sets.unite(static_cast<int>(nodeBase[match.from.block] + faceNode(from, match.from.face, a, b)),
             static_cast<int>(nodeBase[match.to.block] + faceNode(to, match.to.face, image[0], image[1])));
         }
@@ -205,12 +205,12 @@ struct Builder
     across.assign(grid.blocks.size(), {});
     for (const FaceMatch& match : grid.interfaces)
     {
-      linkSide(match.from, match.to, match.code);
-      linkSide(match.to, match.from, inverseCode(match.code));
+      linkSide(match.from, match.to, match.transform);
+      linkSide(match.to, match.from, inverse(match.transform));
     }
   }
 
-  void linkSide(model::BlockFace from, model::BlockFace to, int code)
+  void linkSide(model::BlockFace from, model::BlockFace to, FaceTransform transform)
   {
     const GridBlock& fromBlock = grid.blocks[from.block];
     const GridBlock& toBlock = grid.blocks[to.block];
@@ -222,10 +222,10 @@ struct Builder
     {
       for (int ca = 0; ca + 1 < n[0]; ++ca)
       {
-        const std::array<int, 2> p = mapFaceNode(code, ca, cb, m[0], m[1]);
-        const std::array<int, 2> q = mapFaceNode(code, ca + 1, cb + 1, m[0], m[1]);
-        cells[ca + static_cast<std::size_t>(n[0] - 1) * cb] = static_cast<int>(cellBase[to.block] +
-          faceCell(toBlock, to.face, std::min(p[0], q[0]), std::min(p[1], q[1])));
+        // The transform maps cell indices as it maps node indices (with cell counts).
+        const std::array<int, 2> image = mapFaceNode(transform, ca, cb, m[0] - 1, m[1] - 1);
+        cells[ca + static_cast<std::size_t>(n[0] - 1) * cb] = static_cast<int>(
+          cellBase[to.block] + faceCell(toBlock, to.face, image[0], image[1]));
       }
     }
   }
@@ -385,7 +385,7 @@ struct Builder
         std::array<int, 2> low{ std::numeric_limits<int>::max(), std::numeric_limits<int>::max() };
         for (int c = 0; c < 4; ++c)
         {
-          const std::array<int, 2> at = mapFaceNode(match.code, loop[(4 - c) % 4][0],
+          const std::array<int, 2> at = mapFaceNode(match.transform, loop[(4 - c) % 4][0],
             loop[(4 - c) % 4][1], m[0], m[1]);
           corners[c] = point(match.to.block, faceNode(image, match.to.face, at[0], at[1]));
           low = { std::min(low[0], at[0]), std::min(low[1], at[1]) };
@@ -445,9 +445,10 @@ struct Builder
       entry.rotationAngle = patch.angle * 180.0 / Pi;
       if (p < patch.partner)
       {
-        for (const model::BlockFace& face : patch.faces)
+        // In the order of the pairs, which the later patch follows.
+        for (const FaceMatch& match : patch.images)
         {
-          patchFaces(face);
+          patchFaces(match.from);
         }
       }
       else

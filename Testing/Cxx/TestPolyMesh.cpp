@@ -189,7 +189,7 @@ TEST(PolyMesh, InterfaceThroughTurnedFaceMergesNodes)
   }));
   ExportGrid grid = gridOf(blocks);
   // A.i1 (a = j, b = k) -> B.j0 (a = i, b = k): i_B = nj - 1 - j_A, k_B = k_A: reverse a.
-  grid.interfaces.push_back(FaceMatch{ { 0, 1 }, { 1, 2 }, 1 });
+  grid.interfaces.push_back(FaceMatch{ { 0, 1 }, { 1, 2 }, FaceTransform{ 1 } });
   const PolyMesh mesh = buildPolyMesh(grid);
   EXPECT_EQ(mesh.pointCount(), ni * nj * nk + nj * 3 * nk - nj * nk);
   const int cellsA = 3 * 4 * 5, cellsB = 4 * 2 * 5;
@@ -199,7 +199,7 @@ TEST(PolyMesh, InterfaceThroughTurnedFaceMergesNodes)
   EXPECT_EQ(mesh.internalFaceCount(), insideA + insideB + 4 * 5);
   EXPECT_NEAR(totalVolume(mesh), 2.0, 1e-12);
   // The same with the interface given from B's side.
-  grid.interfaces = { FaceMatch{ { 1, 2 }, { 0, 1 }, inverseCode(1) } };
+  grid.interfaces = { FaceMatch{ { 1, 2 }, { 0, 1 }, inverse(FaceTransform{ 1 }) } };
   const PolyMesh again = buildPolyMesh(grid);
   EXPECT_EQ(again.faceNodes, mesh.faceNodes);
   EXPECT_EQ(again.neighbour, mesh.neighbour);
@@ -213,8 +213,8 @@ TEST(PolyMesh, SquareSymmetriesInvert)
       for (int b = 0; b < 5; ++b)
       {
         const bool swap = (code & 4) != 0;
-        const std::array<int, 2> m = mapFaceNode(code, a, b, swap ? 5 : 3, swap ? 3 : 5);
-        const std::array<int, 2> back = mapFaceNode(inverseCode(code), m[0], m[1], 3, 5);
+        const std::array<int, 2> m = mapFaceNode(FaceTransform{ code }, a, b, swap ? 5 : 3, swap ? 3 : 5);
+        const std::array<int, 2> back = mapFaceNode(inverse(FaceTransform{ code }), m[0], m[1], 3, 5);
         EXPECT_EQ(back[0], a);
         EXPECT_EQ(back[1], b);
       }
@@ -270,13 +270,13 @@ TEST(PolyMesh, PeriodicPairIsCyclicInMatchingOrder)
   low.faces = { { 0, 2 } };
   low.partner = 1;
   low.angle = 0.5 * Pi;
-  low.images = { FaceMatch{ { 0, 2 }, { 0, 3 }, 0 } };
+  low.images = { FaceMatch{ { 0, 2 }, { 0, 3 }, FaceTransform{ 0 } } };
   high.name = "periodic_high";
   high.type = "periodic";
   high.faces = { { 0, 3 } };
   high.partner = 0;
   high.angle = -0.5 * Pi;
-  high.images = { FaceMatch{ { 0, 3 }, { 0, 2 }, 0 } };
+  high.images = { FaceMatch{ { 0, 3 }, { 0, 2 }, FaceTransform{ 0 } } };
   grid.patches = { low, high };
   const PolyMesh mesh = buildPolyMesh(grid);
   const FoamPatch& a = patchNamed(mesh, "periodic_low");
