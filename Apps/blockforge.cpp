@@ -11,6 +11,7 @@
  */
 #include "ExportModel.h"
 #include "Mesher.h"
+#include "Plot3D.h"
 #include "PolyMesh.h"
 #include "Template.h"
 #include "TurboPointSets.h"
@@ -35,6 +36,7 @@ const char* const Usage =
   "Applies a BlockForge template (to the point data of -i: a BladeGen .inf, an Info.txt or a\n"
   "point file), meshes it and writes the grid. The extension of OUTPUT picks the format:\n"
   "  DIR/NAME.foam  OpenFOAM case (DIR/constant/polyMesh, binary unless --ascii)\n"
+  "  NAME.xyz       Plot3D multi-grid (binary unless --ascii), NAME.nmf beside it\n"
   "Options:\n"
   "  -i, --input FILE        point data for a template with inputs\n"
   "  -p, --parameter N=EXPR  override a template parameter (repeatable)\n"
@@ -118,10 +120,11 @@ Arguments parse(int argc, char** argv)
   {
     throw std::invalid_argument("no output given (-o DIR/NAME.foam)");
   }
-  if (!endsWith(args.output, ".foam"))
+  if (!endsWith(args.output, ".foam") && !endsWith(args.output, ".xyz"))
   {
-    throw std::invalid_argument("the output must end in .foam (OpenFOAM case); for .vtm use "
-                                "python3 -m blockforge, got '" + args.output + "'");
+    throw std::invalid_argument("the output must end in .foam (OpenFOAM case) or .xyz "
+                                "(Plot3D); for .vtm use python3 -m blockforge, got '" +
+      args.output + "'");
   }
   return args;
 }
@@ -164,6 +167,34 @@ model::TemplateInputs readInputs(const std::string& file)
   inputs.bladeCount = sets.bladeCount;
   inputs.origin = file;
   return inputs;
+}
+
+/// Writes the grid in the format of the output's extension; prints what was written.
+void writeGrid(const exporting::ExportGrid& grid, const Arguments& args)
+{
+  if (endsWith(args.output, ".xyz"))
+  {
+    exporting::Plot3DOptions options;
+    options.binary = !args.ascii;
+    exporting::writePlot3D(grid, args.output, options);
+    const std::string map = args.output.substr(0, args.output.size() - 4) + ".nmf";
+    exporting::writePlot3DNeutralMap(grid, map);
+    std::printf("blocks: %zu   cells: %lld   nodes: %lld (Plot3D, patches and interfaces in %s)\n",
+      grid.blocks.size(), grid.cellCount(), grid.nodeCount(), map.c_str());
+    return;
+  }
+  const exporting::PolyMesh mesh = exporting::buildPolyMesh(grid);
+  exporting::FoamWriteOptions options;
+  options.binary = !args.ascii;
+  exporting::writeFoamCase(mesh, args.output, options);
+  std::printf("blocks: %zu   cells: %lld   points: %d   faces: %d (%d internal, %d triangles)\n",
+    grid.blocks.size(), grid.cellCount(), mesh.pointCount(), mesh.faceCount(),
+    mesh.internalFaceCount(), mesh.triangleFaces);
+  for (const exporting::FoamPatch& patch : mesh.patches)
+  {
+    std::printf("  patch %-16s %-9s %8d faces\n", patch.name.c_str(), patch.type.c_str(),
+      patch.faceCount);
+  }
 }
 
 double seconds(std::chrono::steady_clock::time_point since)
@@ -215,26 +246,14 @@ int main(int argc, char** argv)
     const exporting::ExportGrid grid = exporting::exportGrid(model, std::move(blocks));
     const double meshTime = seconds(meshStart);
 
-    const auto writeStart = std::chrono::steady_clock::now();
-    const exporting::PolyMesh mesh = exporting::buildPolyMesh(grid);
-    exporting::FoamWriteOptions options;
-    options.binary = !args.ascii;
-    exporting::writeFoamCase(mesh, args.output, options);
-    const double writeTime = seconds(writeStart);
-
     std::printf("template: %s\n", args.templateFile.c_str());
     if (!args.input.empty())
     {
       std::printf("input: %s\n", args.input.c_str());
     }
-    std::printf("blocks: %zu   cells: %lld   points: %d   faces: %d (%d internal, %d triangles)\n",
-      grid.blocks.size(), grid.cellCount(), mesh.pointCount(), mesh.faceCount(),
-      mesh.internalFaceCount(), mesh.triangleFaces);
-    for (const exporting::FoamPatch& patch : mesh.patches)
-    {
-      std::printf("  patch %-16s %-9s %8d faces\n", patch.name.c_str(), patch.type.c_str(),
-        patch.faceCount);
-    }
+    const auto writeStart = std::chrono::steady_clock::now();
+    writeGrid(grid, args);
+    const double writeTime = seconds(writeStart);
     std::printf("time [s]: template %.3f, mesh %.3f, write %.3f, total %.3f\n", templateTime,
       meshTime, writeTime, seconds(start));
     std::printf("grid written to %s (%s)\n", args.output.c_str(), args.ascii ? "ASCII" : "binary");

@@ -91,6 +91,7 @@ StagedOutput::StagedOutput(const std::string& target, Kind kind)
   : Target(target)
   , What(kind)
 {
+  makeDirectories(folderOf(target));
   std::string pattern = folderOf(target) + "/." + nameOf(target) + ".XXXXXX";
   std::vector<char> buffer(pattern.begin(), pattern.end());
   buffer.push_back('\0');

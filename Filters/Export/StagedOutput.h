@@ -55,7 +55,7 @@ public:
     File,
     Directory
   };
-  /// Creates the staging entry; the folder of `target` must exist (see makeDirectories).
+  /// Creates the folder of `target` if needed and the staging entry in it.
   StagedOutput(const std::string& target, Kind kind);
   ~StagedOutput();
   StagedOutput(const StagedOutput&) = delete;

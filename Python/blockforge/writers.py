@@ -1,6 +1,7 @@
 """Solver-format writers of the command line: the output's extension picks the writer.
 
-``.foam`` (OpenFOAM case: ``DIR/constant/polyMesh`` and an empty ``DIR/NAME.foam``);
+``.foam`` (OpenFOAM case: ``DIR/constant/polyMesh`` and an empty ``DIR/NAME.foam``),
+``.xyz`` (Plot3D multi-grid, with patches and interfaces in ``NAME.nmf``);
 ``.vtm`` stays with :func:`blockforge.__main__.write_grid`. The C++ writers put their
 files in place by a rename only when everything was written, so a failure leaves no
 partial grid and keeps an older one.
@@ -8,7 +9,7 @@ partial grid and keeps an older one.
 import os
 
 #: extension -> name of the wrapped writer class
-SOLVER_WRITERS = {".foam": "vtkBlockFoamWriter"}
+SOLVER_WRITERS = {".foam": "vtkBlockFoamWriter", ".xyz": "vtkBlockPlot3DWriter"}
 
 
 def is_solver_format(path):
