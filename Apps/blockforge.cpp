@@ -9,6 +9,7 @@
  * and an empty NAME.foam), NAME.xyz (Plot3D multiblock), NAME.cgns (CGNS). `python3 -m
  * blockforge` takes the same arguments and also writes .vtm with the quality arrays.
  */
+#include "Cgns.h"
 #include "ExportModel.h"
 #include "Mesher.h"
 #include "Plot3D.h"
@@ -37,6 +38,7 @@ const char* const Usage =
   "point file), meshes it and writes the grid. The extension of OUTPUT picks the format:\n"
   "  DIR/NAME.foam  OpenFOAM case (DIR/constant/polyMesh, binary unless --ascii)\n"
   "  NAME.xyz       Plot3D multi-grid (binary unless --ascii), NAME.nmf beside it\n"
+  "  NAME.cgns      CGNS (HDF5): zones, 1-to-1 and periodic connectivity, BCs by family\n"
   "Options:\n"
   "  -i, --input FILE        point data for a template with inputs\n"
   "  -p, --parameter N=EXPR  override a template parameter (repeatable)\n"
@@ -120,10 +122,11 @@ Arguments parse(int argc, char** argv)
   {
     throw std::invalid_argument("no output given (-o DIR/NAME.foam)");
   }
-  if (!endsWith(args.output, ".foam") && !endsWith(args.output, ".xyz"))
+  if (!endsWith(args.output, ".foam") && !endsWith(args.output, ".xyz") &&
+    !endsWith(args.output, ".cgns"))
   {
-    throw std::invalid_argument("the output must end in .foam (OpenFOAM case) or .xyz "
-                                "(Plot3D); for .vtm use python3 -m blockforge, got '" +
+    throw std::invalid_argument("the output must end in .foam (OpenFOAM case), .xyz (Plot3D) "
+                                "or .cgns; for .vtm use python3 -m blockforge, got '" +
       args.output + "'");
   }
   return args;
@@ -172,6 +175,13 @@ model::TemplateInputs readInputs(const std::string& file)
 /// Writes the grid in the format of the output's extension; prints what was written.
 void writeGrid(const exporting::ExportGrid& grid, const Arguments& args)
 {
+  if (endsWith(args.output, ".cgns"))
+  {
+    exporting::writeCgns(grid, args.output);
+    std::printf("blocks: %zu   cells: %lld   nodes: %lld (CGNS zones), interfaces: %zu\n",
+      grid.blocks.size(), grid.cellCount(), grid.nodeCount(), grid.interfaces.size());
+    return;
+  }
   if (endsWith(args.output, ".xyz"))
   {
     exporting::Plot3DOptions options;
@@ -256,7 +266,8 @@ int main(int argc, char** argv)
     const double writeTime = seconds(writeStart);
     std::printf("time [s]: template %.3f, mesh %.3f, write %.3f, total %.3f\n", templateTime,
       meshTime, writeTime, seconds(start));
-    std::printf("grid written to %s (%s)\n", args.output.c_str(), args.ascii ? "ASCII" : "binary");
+    std::printf("grid written to %s%s\n", args.output.c_str(),
+      endsWith(args.output, ".cgns") ? "" : args.ascii ? " (ASCII)" : " (binary)");
   }
   catch (const std::exception& error)
   {

@@ -12,6 +12,7 @@ and :func:`mesh_template` runs the whole pipeline in one call.
 from vtkmodules import vtkCommonCore, vtkCommonDataModel, vtkCommonExecutionModel  # noqa: F401
 
 from .BlockForgeFilters import (  # noqa: F401
+    vtkBlockCGNSWriter,
     vtkBlockFoamWriter,
     vtkBlockGridWriter,
     vtkBlockMesher,
@@ -24,6 +25,7 @@ from .BlockForgeFilters import (  # noqa: F401
 )
 
 __all__ = [
+    "vtkBlockCGNSWriter",
     "vtkBlockFoamWriter",
     "vtkBlockGridWriter",
     "vtkBlockMesher",

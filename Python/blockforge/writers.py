@@ -1,7 +1,8 @@
 """Solver-format writers of the command line: the output's extension picks the writer.
 
 ``.foam`` (OpenFOAM case: ``DIR/constant/polyMesh`` and an empty ``DIR/NAME.foam``),
-``.xyz`` (Plot3D multi-grid, with patches and interfaces in ``NAME.nmf``);
+``.xyz`` (Plot3D multi-grid, with patches and interfaces in ``NAME.nmf``), ``.cgns``
+(CGNS with 1-to-1 and periodic connectivity, BCs by family);
 ``.vtm`` stays with :func:`blockforge.__main__.write_grid`. The C++ writers put their
 files in place by a rename only when everything was written, so a failure leaves no
 partial grid and keeps an older one.
@@ -9,7 +10,8 @@ partial grid and keeps an older one.
 import os
 
 #: extension -> name of the wrapped writer class
-SOLVER_WRITERS = {".foam": "vtkBlockFoamWriter", ".xyz": "vtkBlockPlot3DWriter"}
+SOLVER_WRITERS = {".foam": "vtkBlockFoamWriter", ".xyz": "vtkBlockPlot3DWriter",
+                  ".cgns": "vtkBlockCGNSWriter"}
 
 
 def is_solver_format(path):

@@ -92,6 +92,36 @@ class Plot3DTest(unittest.TestCase):
             self.assertEqual(text.count("'ONE_TO_ONE'"), interfaces + pairs)
 
 
+class CgnsTest(unittest.TestCase):
+    def test_cgnscheck_and_paraview_reader(self):
+        from vtkmodules.vtkIOCGNSReader import vtkCGNSReader
+
+        for name, template, inf in (("cylinder", CYLINDER, None),
+                                    ("wedge", os.path.join(SOURCE, "Templates", "wedge_sector.yaml"), None),
+                                    ("distributor_oh", AXIAL_OH, DISTRIBUTOR_INF)):
+            with self.subTest(grid=name):
+                grid = mesh(template, inf)
+                path = bftest.output_path(f"cgns/{name}.cgns")
+                writers.write_solver_grid(grid, path)
+                check = subprocess.run(["cgnscheck", path], capture_output=True, text=True)
+                self.assertEqual(check.returncode, 0, check.stdout + check.stderr)
+                self.assertNotIn("ERROR", check.stdout + check.stderr)
+                self.assertNotIn("WARNING", check.stdout + check.stderr)
+                reader = vtkCGNSReader()
+                reader.SetFileName(path)
+                reader.UpdateInformation()
+                reader.EnableAllBases()
+                reader.Update()
+                base = reader.GetOutput().GetBlock(0)
+                zones = {base.GetMetaData(z).Get(base.NAME()): base.GetBlock(z)
+                         for z in range(base.GetNumberOfBlocks())}
+                ours = dict(bftest.named_leaves(grid))
+                self.assertEqual(sorted(zones), sorted(ours))
+                for zone, block in ours.items():
+                    self.assertTrue(np.array_equal(bftest.points(block), bftest.points(zones[zone])),
+                                    zone)
+
+
 class FoamFormatsTest(unittest.TestCase):
     def test_ascii_and_binary_are_the_same_mesh(self):
         grid = mesh(AXIAL_OH, DISTRIBUTOR_INF, 0.5)
