@@ -66,7 +66,7 @@ machine: {theta_zero: sections}   # theta = 0 through the blade, so the passage 
 
 parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
-  o_corner: 50deg         # the O-grid corners' normals lean this far from the edge camber direction
+  o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
   probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
   follow_le: 0.7          # upstream H lines follow this fraction of the blade's leading-edge angle (0: axial)
