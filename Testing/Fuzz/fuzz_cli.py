@@ -20,7 +20,8 @@ hang costs only the worker, which is restarted (the case is recorded). The worke
 under an address-space limit (``--memory-limit``), so huge grids must be refused by the
 memory estimate rather than crash. Deterministic for a given ``--seed``.
 
-Usage:  python3 fuzz_cli.py [--cases N | --seconds S] [--seed K] [--json out.json]
+Usage:  python3 fuzz_cli.py [--cases N] [--seconds S] [--seed K] [--json out.json]
+(CTest: Fuzz.cli runs 300 cases with seed 12, at most 120 s.)
 Exit status 1 when a case crashed, hung or gave invalid output (``--allow`` lists the
 classes that do not fail the run).
 """
@@ -301,8 +302,10 @@ def classify(answer):
 def main():
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--cases", type=int, default=0, help="number of cases (0: by time)")
-    parser.add_argument("--seconds", type=float, default=60.0, help="time budget")
+    parser.add_argument("--cases", type=int, default=0,
+                        help="number of cases (0: as many as --seconds allow)")
+    parser.add_argument("--seconds", type=float, default=60.0,
+                        help="time budget (no new case starts after it)")
     parser.add_argument("--seed", type=int, default=12)
     parser.add_argument("--case-timeout", type=float, default=20.0)
     parser.add_argument("--memory-limit", type=float, default=6.0, help="GB for the worker")
@@ -322,8 +325,8 @@ def main():
     start = time.monotonic()
     index = 0
     try:
-        while (index < args.cases if args.cases else
-               time.monotonic() - start < args.seconds):
+        while ((not args.cases or index < args.cases)
+               and time.monotonic() - start < args.seconds):
             argv, output, description = make_case(rng, index, work)
             began = time.monotonic()
             answer = runner.run(argv, output, args.case_timeout)
