@@ -44,7 +44,7 @@ def fresh_directory(name):
 
 def read_grid(path):
     reader = vtkXMLMultiBlockDataReader()
-    reader.SetFileName(path)
+    reader.SetFileName(os.fsencode(path))
     reader.Update()
     return named_leaves(reader.GetOutput())
 
@@ -85,6 +85,18 @@ class MessagesTest(unittest.TestCase):
         status, _, err = run_main(AXIAL_OH, "-i", os.path.join(self.data, "BladeGen.inf"))
         self.assertEqual(status, 1)
         self.assertRegex(err, r"^error: .*hub\.curve:5: .*\\xff")
+
+    def test_output_path(self):
+        """A stray byte in the output name: the grid is written and readable (its pieces
+        folder is named without the byte, so the .vtm stays valid UTF-8 XML)."""
+        path = os.fsdecode(os.path.join(os.fsencode(self.directory), b"grid\xff.vtm"))
+        status, out, err = run_main(CYLINDER, "-o", path)
+        self.assertEqual(status, 0, err)
+        self.assertIn("grid written to", out)
+        self.assertIn("grid\\xff.vtm", out)
+        self.assertEqual(len(read_grid(path)), 4)
+        folder = blockforge.output.referenced_folders(path).pop()
+        self.assertTrue(os.path.basename(folder).startswith("grid_.pieces-"), folder)
 
     def test_output_window_gets_the_escaped_text(self):
         """ParaView's Output Messages show what VTK's output window receives."""
