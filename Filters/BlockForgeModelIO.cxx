@@ -1,6 +1,9 @@
 #include "BlockForgeModelIO.h"
 
+#include "BlockForgeParallel.h"
+
 #include "../Model/ModelDocument.h"
+#include "../Model/Partition.h"
 #include "../Model/Template.h"
 
 #include <vtkCellArray.h>
@@ -217,11 +220,17 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
 {
   const int blockCount = mesher.blockCount();
   output->SetNumberOfBlocks(static_cast<unsigned int>(blockCount));
+  std::vector<std::array<int, 3>> nodeCounts;
+  for (int b = 0; b < blockCount; ++b)
+  {
+    nodeCounts.push_back(mesher.nodeCounts(b));
+  }
+  const std::vector<int> pieceOf = model::balancedPieces(nodeCounts, pieceCount);
   for (int b = 0; b < blockCount; ++b)
   {
     output->GetMetaData(static_cast<unsigned int>(b))
       ->Set(vtkCompositeDataSet::NAME(), blockModel.blocks[b].name.c_str());
-    if (pieceCount > 1 && b % pieceCount != piece)
+    if (pieceCount > 1 && pieceOf[b] != piece)
     {
       continue;
     }
@@ -331,6 +340,7 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
   const model::CarrierGeometry* carriers, InvertedCellPolicy policy,
   std::vector<model::InvertedCellReport>* reports, double maximumMemoryGigabytes)
 {
+  useSMPTools();
   model::CarrierGeometry known;
   bool haveCarriers = false;
   if (carriers)

@@ -64,7 +64,7 @@ enum class InvertedCellPolicy
 /**
  * Fills `output` with one named vtkStructuredGrid per model block (the points written
  * by the mesher directly into the VTK array, no second copy) and a BlockId cell array.
- * Blocks not assigned to this piece (block index modulo pieceCount != piece) are left
+ * Blocks not assigned to this piece (model::balancedPieces: shared out by cells) are left
  * empty so every MPI rank has the same structure. `progress` gets a fraction in [0, 1].
  */
 void fillMultiBlock(const model::BlockModel& model, const model::MultiBlockMesher& mesher,

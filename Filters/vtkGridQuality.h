@@ -24,8 +24,10 @@
  * Periodic faces are paired when the input carries its block model (the mesher's output
  * does): the model's topology names the periodic pairs and their rotation, and across a
  * periodic face the partner cell's centre is rotated into place, as OpenFOAM's cyclic
- * patches do. Under MPI only pairs whose two blocks are on the same rank are paired so
- * far; the others count as boundary faces.
+ * patches do. Under MPI (the pipeline in pieces on several ranks) the ranks exchange the
+ * two node layers beside every interface and periodic face between their blocks, so
+ * every measure equals the serial run's bit for bit. Large blocks are measured on
+ * threads (vtkSMPTools), with the same bits.
  *
  * @sa vtkBlockMesher
  */

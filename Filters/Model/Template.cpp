@@ -2577,8 +2577,10 @@ private:
     {
       fail(line, entityText,
         "closed: " + what + " is open: its first and last points are " + shortNumber(gap) +
-          " apart (relative " + shortNumber(gap / size) +
-          "); the blade surface must close around every section");
+          " apart (" + shortNumber(100.0 * gap / size) +
+          " % of its size); the blade surface must close around every section (the "
+          "TurboPointSetsReader joins gaps up to 0.2 % of the chord and caps blunt "
+          "trailing edges up to 5 %)");
     }
   }
 

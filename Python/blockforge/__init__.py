@@ -14,7 +14,11 @@ import os
 from vtkmodules import vtkCommonCore, vtkCommonDataModel, vtkCommonExecutionModel  # noqa: F401
 
 from .BlockForgeFilters import (  # noqa: F401
+    vtkBlockCGNSWriter,
+    vtkBlockFoamWriter,
+    vtkBlockGridWriter,
     vtkBlockMesher,
+    vtkBlockPlot3DWriter,
     vtkBlockTemplate,
     vtkBlockTemplateAlgorithm,
     vtkBlockTemplateSource,
@@ -23,7 +27,11 @@ from .BlockForgeFilters import (  # noqa: F401
 )
 
 __all__ = [
+    "vtkBlockCGNSWriter",
+    "vtkBlockFoamWriter",
+    "vtkBlockGridWriter",
     "vtkBlockMesher",
+    "vtkBlockPlot3DWriter",
     "vtkBlockTemplate",
     "vtkBlockTemplateAlgorithm",
     "vtkBlockTemplateSource",

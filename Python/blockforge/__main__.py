@@ -18,6 +18,7 @@ import time
 import blockforge
 import blockforge.output
 from blockforge import printable
+from blockforge import writers
 
 
 def _parse_parameter(text):
@@ -72,7 +73,10 @@ def main(argv=None):
     parser.add_argument("-i", "--input", metavar="FILE",
                         help="point data for a template with inputs (BladeGen .inf, Info.txt "
                              "or point file, read by the TurboPointSetsReader)")
-    parser.add_argument("-o", "--output", help="grid file to write (.vtm)")
+    parser.add_argument("-o", "--output", help="grid file to write: .vtm, or DIR/NAME.foam "
+                        "(OpenFOAM case)")
+    parser.add_argument("--ascii", action="store_true",
+                        help="ASCII instead of binary where the format has both")
     parser.add_argument("-p", "--parameter", action="append", type=_parse_parameter,
                         default=[], metavar="NAME=EXPR", help="override a template parameter")
     parser.add_argument("-d", "--density", type=float, default=1.0,
@@ -85,8 +89,9 @@ def main(argv=None):
                         help="output a grid with inverted cells anyway, for inspection "
                              "(default: an error naming the block and the cell range)")
     args = parser.parse_args(argv)
-    if args.output and not args.output.endswith(".vtm"):
-        parser.error(f"the output must be a .vtm file (a multiblock grid), got '{printable(args.output)}'")
+    if args.output and not (args.output.endswith(".vtm") or writers.is_solver_format(args.output)):
+        parser.error(f"the output must be .vtm or {', '.join(writers.SOLVER_WRITERS)}, "
+                     f"got '{printable(args.output)}'")
     if not (args.max_memory >= 0.0) or args.max_memory == float("inf"):
         parser.error(f"--max-memory must be a number of GB >= 0 (0: no limit), got "
                      f"{args.max_memory}")
@@ -113,7 +118,11 @@ def main(argv=None):
     if args.output:
         start = time.perf_counter()
         try:
-            write_grid(quality.GetOutputDataObject(0), args.output)
+            if writers.is_solver_format(args.output):
+                writers.write_solver_grid(quality.GetOutputDataObject(0), args.output,
+                                          binary=not args.ascii)
+            else:
+                write_grid(quality.GetOutputDataObject(0), args.output)
         except (RuntimeError, OSError, ValueError) as error:
             print(f"error: {printable(error)}", file=sys.stderr)
             return 1

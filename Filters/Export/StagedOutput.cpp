@@ -1,0 +1,230 @@
+#include "StagedOutput.h"
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace blockforge
+{
+namespace exporting
+{
+namespace
+{
+std::string reason(int error)
+{
+  return std::strerror(error);
+}
+
+std::string folderOf(const std::string& path)
+{
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string(".") : path.substr(0, slash == 0 ? 1 : slash);
+}
+
+std::string nameOf(const std::string& path)
+{
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+} // namespace
+
+CheckedFile::CheckedFile(const std::string& path)
+  : Path(path)
+{
+  File = std::fopen(path.c_str(), "wb");
+  if (!File)
+  {
+    fail(errno);
+  }
+  // Large writes go straight through; the buffer only gathers the small ones.
+  std::setvbuf(File, nullptr, _IOFBF, 1 << 20);
+}
+
+CheckedFile::~CheckedFile()
+{
+  if (File)
+  {
+    std::fclose(File);
+  }
+}
+
+void CheckedFile::fail(int error) const
+{
+  throw std::runtime_error("could not write " + Path + ": " + reason(error ? error : EIO));
+}
+
+void CheckedFile::write(const void* data, std::size_t bytes)
+{
+  errno = 0;
+  if (bytes && std::fwrite(data, 1, bytes, File) != bytes)
+  {
+    fail(errno);
+  }
+}
+
+void CheckedFile::close()
+{
+  errno = 0;
+  const bool flushed = std::fflush(File) == 0;
+  const int flushError = errno;
+  const int closed = std::fclose(File);
+  const int closeError = errno;
+  File = nullptr;
+  if (!flushed)
+  {
+    fail(flushError);
+  }
+  if (closed != 0)
+  {
+    fail(closeError);
+  }
+}
+
+StagedOutput::StagedOutput(const std::string& target, Kind kind)
+  : Target(target)
+  , What(kind)
+{
+  makeDirectories(folderOf(target));
+  std::string pattern = folderOf(target) + "/." + nameOf(target) + ".XXXXXX";
+  std::vector<char> buffer(pattern.begin(), pattern.end());
+  buffer.push_back('\0');
+  if (kind == Kind::Directory)
+  {
+    if (!mkdtemp(buffer.data()))
+    {
+      throw std::runtime_error("could not write " + target + ": " + reason(errno));
+    }
+  }
+  else
+  {
+    const int descriptor = mkstemp(buffer.data());
+    if (descriptor < 0)
+    {
+      throw std::runtime_error("could not write " + target + ": " + reason(errno));
+    }
+    ::close(descriptor);
+  }
+  Staging = buffer.data();
+}
+
+StagedOutput::~StagedOutput()
+{
+  if (!Published)
+  {
+    removeTree(Staging);
+  }
+}
+
+void StagedOutput::publish()
+{
+  struct stat existing;
+  if (What == Kind::Directory && ::lstat(Target.c_str(), &existing) == 0 &&
+    S_ISDIR(existing.st_mode))
+  {
+    // One exchange publishes the new directory; the older one ends up at the staging
+    // path and is removed with it.
+    if (::renameat2(AT_FDCWD, Staging.c_str(), AT_FDCWD, Target.c_str(), RENAME_EXCHANGE) == 0)
+    {
+      removeTree(Staging);
+      Published = true;
+      return;
+    }
+    if (errno != EINVAL && errno != ENOSYS)
+    {
+      throw std::runtime_error("could not write " + Target + ": " + reason(errno));
+    }
+    // A file system without exchange: move the older directory aside first, back on failure.
+    const std::string old = Staging + ".old";
+    if (::rename(Target.c_str(), old.c_str()) != 0)
+    {
+      throw std::runtime_error("could not write " + Target + ": " + reason(errno));
+    }
+    if (::rename(Staging.c_str(), Target.c_str()) != 0)
+    {
+      const int error = errno;
+      ::rename(old.c_str(), Target.c_str());
+      throw std::runtime_error("could not write " + Target + ": " + reason(error));
+    }
+    removeTree(old);
+    Published = true;
+    return;
+  }
+  if (What == Kind::File)
+  {
+    ::chmod(Staging.c_str(), 0644 & ~[] {
+      const mode_t mask = ::umask(0);
+      ::umask(mask);
+      return mask;
+    }());
+  }
+  if (::rename(Staging.c_str(), Target.c_str()) != 0)
+  {
+    throw std::runtime_error("could not write " + Target + ": " + reason(errno));
+  }
+  Published = true;
+}
+
+void makeDirectories(const std::string& path)
+{
+  if (path.empty())
+  {
+    return;
+  }
+  std::size_t position = 0;
+  while (position != std::string::npos)
+  {
+    position = path.find('/', position + 1);
+    const std::string prefix = path.substr(0, position);
+    if (prefix.empty() || ::mkdir(prefix.c_str(), 0777) == 0 || errno == EEXIST)
+    {
+      continue;
+    }
+    throw std::runtime_error("could not make the folder " + prefix + ": " + reason(errno));
+  }
+  struct stat status;
+  if (::stat(path.c_str(), &status) != 0 || !S_ISDIR(status.st_mode))
+  {
+    throw std::runtime_error("could not make the folder " + path + ": it is not a folder");
+  }
+}
+
+void removeTree(const std::string& path)
+{
+  struct stat status;
+  if (path.empty() || ::lstat(path.c_str(), &status) != 0)
+  {
+    return;
+  }
+  if (S_ISDIR(status.st_mode))
+  {
+    if (DIR* directory = ::opendir(path.c_str()))
+    {
+      std::vector<std::string> entries;
+      while (dirent* entry = ::readdir(directory))
+      {
+        const std::string name = entry->d_name;
+        if (name != "." && name != "..")
+        {
+          entries.push_back(path + "/" + name);
+        }
+      }
+      ::closedir(directory);
+      for (const std::string& entry : entries)
+      {
+        removeTree(entry);
+      }
+    }
+    ::rmdir(path.c_str());
+    return;
+  }
+  ::unlink(path.c_str());
+}
+} // namespace exporting
+} // namespace blockforge

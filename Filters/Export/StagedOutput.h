@@ -1,0 +1,79 @@
+/**
+ * @file StagedOutput.h
+ * @brief Writing a grid file so that a failure never leaves half a grid behind: every
+ * write is checked (a short write, a full disk or a failing close is an error naming the
+ * file), files are written under a temporary name beside the target and published by one
+ * rename. No VTK types.
+ */
+#pragma once
+
+#include <cstddef>
+#include <cstdio>
+#include <string>
+
+namespace blockforge
+{
+namespace exporting
+{
+/**
+ * @class CheckedFile
+ * @brief A binary file opened for writing whose every write, flush and close is checked:
+ * throws std::runtime_error "could not write FILE: REASON" (e.g. "No space left on
+ * device") at the first failure.
+ */
+class CheckedFile
+{
+public:
+  explicit CheckedFile(const std::string& path);
+  ~CheckedFile(); ///< closes without checking (only after an exception)
+  CheckedFile(const CheckedFile&) = delete;
+  CheckedFile& operator=(const CheckedFile&) = delete;
+
+  void write(const void* data, std::size_t bytes);
+  void write(const std::string& text) { write(text.data(), text.size()); }
+  /// Flushes and closes; throws when the data did not reach the file system.
+  void close();
+  const std::string& path() const { return Path; }
+
+private:
+  [[noreturn]] void fail(int error) const;
+  std::string Path;
+  std::FILE* File = nullptr;
+};
+
+/**
+ * @class StagedOutput
+ * @brief A temporary file or directory beside `target` ("DIR/.NAME.XXXXXX"); publish()
+ * renames it onto `target` (a directory is exchanged atomically with an older one, which
+ * is then removed). Destroyed without publish() (an exception), it removes what it staged.
+ */
+class StagedOutput
+{
+public:
+  enum class Kind
+  {
+    File,
+    Directory
+  };
+  /// Creates the folder of `target` if needed and the staging entry in it.
+  StagedOutput(const std::string& target, Kind kind);
+  ~StagedOutput();
+  StagedOutput(const StagedOutput&) = delete;
+  StagedOutput& operator=(const StagedOutput&) = delete;
+
+  /// The temporary path to write (the file, or the directory to fill).
+  const std::string& path() const { return Staging; }
+  void publish();
+
+private:
+  std::string Target, Staging;
+  Kind What;
+  bool Published = false;
+};
+
+/// mkdir -p; throws std::runtime_error naming the folder that could not be made.
+void makeDirectories(const std::string& path);
+/// Removes a file or a directory tree; errors are ignored.
+void removeTree(const std::string& path);
+} // namespace exporting
+} // namespace blockforge
