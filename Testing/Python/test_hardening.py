@@ -175,6 +175,37 @@ class MemoryTest(unittest.TestCase):
                       blockforge._message(errors.messages[0]))
 
 
+@unittest.skipUnless(os.environ.get("BLOCKFORGE_CLI"), "BLOCKFORGE_CLI not set")
+class NativeCommandLineTest(unittest.TestCase):
+    """The native command line refuses and escapes like the Python one."""
+
+    def run_native(self, *arguments):
+        output = os.path.join(fresh_directory("native"), "case", "grid.foam")
+        return subprocess.run([os.environ["BLOCKFORGE_CLI"]] + list(arguments) +
+                              ["-o", output], capture_output=True, timeout=60)
+
+    def test_refusals(self):
+        for arguments, needle in (
+                (["-d", "1000"], b"the grid would need 209 TB for 8.2e+12 nodes"),
+                (["-d", "inf"], b"the density multiplier must be a number above 0"),
+                (["-m", "0.00001"], b"more than MaximumMemory (10.5 kB)")):
+            result = self.run_native(CYLINDER, *arguments)
+            self.assertEqual(result.returncode, 1, result.stderr)
+            self.assertIn(needle, result.stderr)
+
+    def test_stray_bytes(self):
+        template = os.path.join(fresh_directory("native_stray").encode(), b"bad\xfe.yaml")
+        with open(CYLINDER, "rb") as stream:
+            text = stream.read()
+        with open(template, "wb") as stream:
+            stream.write(text.replace(b"blocks:", b"blocks:\n  b\xff: {}", 1))
+        result = self.run_native(os.fsdecode(template))
+        self.assertEqual(result.returncode, 1)
+        self.assertIn(b"bad\\xfe.yaml:", result.stderr)
+        self.assertIn(b"block 'b\\xff'", result.stderr)
+        result.stderr.decode("utf-8")  # valid UTF-8
+
+
 class TemplateFileTest(unittest.TestCase):
     """The template reader's small cases, through the command line."""
 
