@@ -9,7 +9,8 @@ truncation) and/or the arguments (density multiplier, parameter overrides), runs
 puts the outcome in one class:
 
 - ``error``: exit status 1 with one clear message on stderr ("error: ..."), nothing written;
-- ``success``: exit status 0, a grid written, finite, no cell with ScaledJacobian <= 0;
+- ``success``: exit status 0, a grid written, finite, no cell with ScaledJacobian <= 0
+  (one case in ten writes a solver format, .foam, .xyz or .cgns, only checked to exist);
 - ``invalid``: exit status 0 but the grid is missing, not finite or has inverted cells, or
   exit status 1 with a grid written anyway, or a message that is not one readable line;
 - ``crash``: a Python traceback, a signal, any other exit status (the worker dies);
@@ -143,7 +144,9 @@ def make_case(rng, index, work):
     (argv, output path, description)."""
     folder = os.path.join(work, f"case{index}")
     os.makedirs(folder)
-    output = os.path.join(folder, "out", "grid.vtm")
+    # mostly .vtm (read back and checked cell by cell), sometimes a solver format
+    extension = rng.choice([".vtm"] * 17 + [".foam", ".xyz", ".cgns"])
+    output = os.path.join(folder, "out", "grid" + extension)
     use_passage = rng.random() < 0.4
     if use_passage:
         template, data_folder, main_file = rng.choice(PASSAGES)
@@ -193,6 +196,8 @@ def grid_problem(path):
 
     if not os.path.isfile(path):
         return "exit 0 but no grid written"
+    if not path.endswith(".vtm"):
+        return None if os.path.getsize(path) > 0 or path.endswith(".foam") else "empty file"
     reader = vtkXMLMultiBlockDataReader()
     reader.SetFileName(path)
     reader.Update()
