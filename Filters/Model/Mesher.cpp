@@ -5,6 +5,7 @@
 #include "../Core/Projection.h"
 #include "../Core/Transfinite.h"
 #include "CarrierGeometry.h"
+#include "MemoryBudget.h"
 #include "ModelSyntax.h"
 #include "Topology.h"
 
@@ -1432,31 +1433,8 @@ MultiBlockMesher::MultiBlockMesher(
   const BlockModel& model, const CarrierGeometry* carriers, double densityMultiplier)
   : P(new Impl)
 {
-  if (!std::isfinite(densityMultiplier) || !(densityMultiplier > 0.0) ||
-    densityMultiplier > MaxDensityMultiplier)
-  {
-    throw TemplateError(model.sourceFile, 0, entity("model", model.name),
-      "the density multiplier must be a number above 0 and at most " +
-        formatNumber(MaxDensityMultiplier) + ", got " + formatNumber(densityMultiplier));
-  }
+  checkDensityMultiplier(model, densityMultiplier);
   checkBasics(model);
-  static const char* const directionNames[3] = { "i", "j", "k" };
-  for (const Block& block : model.blocks)
-  {
-    for (int d = 0; d < 3; ++d)
-    {
-      const double scaled = std::round(block.cells[d] * densityMultiplier);
-      if (scaled > MaxScaledCellsPerDirection)
-      {
-        fail(block.where, entity("block", block.name),
-          std::string(directionNames[d]) + ": " + std::to_string(block.cells[d]) +
-            " cells x density multiplier " + formatNumber(densityMultiplier) + " = " +
-            formatNumber(scaled) + " cells, more than " +
-            formatNumber(MaxScaledCellsPerDirection) +
-            " per direction; lower the density multiplier or the cell counts");
-      }
-    }
-  }
   P->Model = model;
   P->Multiplier = densityMultiplier;
   P->Geometry = carriers ? *carriers : CarrierGeometry(P->Model);
