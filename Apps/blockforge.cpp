@@ -243,7 +243,7 @@ int main(int argc, char** argv)
     const auto meshStart = std::chrono::steady_clock::now();
     model::MultiBlockMesher mesher(model, carriers, args.density);
     mesher.computeBoundaries();
-    std::vector<std::vector<double>> nodes(mesher.blockCount());
+    std::vector<exporting::LargeVector<double>> nodes(mesher.blockCount());
     std::vector<exporting::GridBlock> blocks(mesher.blockCount());
     for (int b = 0; b < mesher.blockCount(); ++b)
     {

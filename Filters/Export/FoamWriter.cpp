@@ -101,7 +101,7 @@ void binaryList(CheckedFile& file, const T* values, std::size_t count, std::size
   file.write(")");
 }
 
-void labelList(CheckedFile& file, const std::vector<int>& values, bool binary)
+void labelList(CheckedFile& file, const LargeVector<int>& values, bool binary)
 {
   if (binary)
   {
@@ -190,7 +190,7 @@ void writeFaces(const std::string& path, const PolyMesh& mesh, bool binary)
   file.close();
 }
 
-void writeLabels(const std::string& path, const char* object, const std::vector<int>& values,
+void writeLabels(const std::string& path, const char* object, const LargeVector<int>& values,
   const PolyMesh& mesh, bool binary)
 {
   CheckedFile file(path);

@@ -47,7 +47,7 @@ public:
   }
 
 private:
-  std::vector<int> Parent;
+  LargeVector<int> Parent;
 };
 
 /// Corners (a, b) of the face of cell (ca, cb) on block face `face`, in the order whose
@@ -82,7 +82,7 @@ struct Builder
   const ExportGrid& grid;
   PolyMesh& mesh;
   std::vector<long long> nodeBase, cellBase;
-  std::vector<int> pointOf; ///< block node -> point id
+  LargeVector<int> pointOf; ///< block node -> point id
   /// Per block face: the global cell across an interface for each face cell, empty when
   /// the face is not an interface.
   std::vector<std::array<std::vector<int>, 6>> across;
@@ -135,26 +135,27 @@ struct Builder
       uniteCollapsed(sets, b);
     }
     // Points in order of their first node.
-    pointOf.assign(static_cast<std::size_t>(nodeBase.back()), -1);
-    mesh.points.clear();
-    mesh.points.reserve(static_cast<std::size_t>(nodeBase.back()) * 3);
+    pointOf.resize(static_cast<std::size_t>(nodeBase.back()));
     int next = 0;
+    for (int node = 0; node < static_cast<int>(pointOf.size()); ++node)
+    {
+      const int root = sets.find(node);
+      pointOf[node] = root == node ? next++ : pointOf[root];
+    }
+    mesh.points.resize(static_cast<std::size_t>(next) * 3);
+    double* out = mesh.points.data();
+    int expected = 0; // new points got the ids 0, 1, 2, ... in node order
     for (int b = 0; b < blockCount; ++b)
     {
       const double* xyz = grid.blocks[b].xyz;
+      const int* ids = pointOf.data() + nodeBase[b];
       const long long count = grid.blocks[b].nodeCount();
       for (long long n = 0; n < count; ++n)
       {
-        const int node = static_cast<int>(nodeBase[b] + n);
-        const int root = sets.find(node);
-        if (root == node)
+        if (ids[n] == expected)
         {
-          pointOf[node] = next++;
-          mesh.points.insert(mesh.points.end(), xyz + 3 * n, xyz + 3 * n + 3);
-        }
-        else
-        {
-          pointOf[node] = pointOf[root];
+          std::copy(xyz + 3 * n, xyz + 3 * n + 3, out + 3 * static_cast<std::size_t>(expected));
+          ++expected;
         }
       }
     }
@@ -278,6 +279,9 @@ struct Builder
       const int ci = ni - 1, cj = block.nodes[1] - 1, ck = block.nodes[2] - 1;
       const int* points = pointOf.data() + nodeBase[b];
       int cell = static_cast<int>(cellBase[b]);
+      // Without collapsed edges no cell face can lose a corner: no check needed.
+      const std::array<bool, 12>& collapsed = grid.collapsedEdges[b];
+      const bool regular = std::none_of(collapsed.begin(), collapsed.end(), [](bool c) { return c; });
       for (int k = 0; k < ck; ++k)
       {
         for (int j = 0; j < cj; ++j)
@@ -326,11 +330,17 @@ struct Builder
             {
               const int* loop = Loops[next[c].second];
               const int corners[4] = { p[loop[0]], p[loop[1]], p[loop[2]], p[loop[3]] };
-              if (addFace(corners, 4))
+              if (regular)
               {
-                mesh.owner.push_back(cell);
-                mesh.neighbour.push_back(next[c].first);
+                mesh.faceNodes.insert(mesh.faceNodes.end(), corners, corners + 4);
+                mesh.faceOffsets.push_back(static_cast<int>(mesh.faceNodes.size()));
               }
+              else if (!addFace(corners, 4))
+              {
+                continue;
+              }
+              mesh.owner.push_back(cell);
+              mesh.neighbour.push_back(next[c].first);
             }
           }
         }

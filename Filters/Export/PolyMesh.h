@@ -16,6 +16,7 @@
 #pragma once
 
 #include "ExportGrid.h"
+#include "LargeAllocator.h"
 
 #include <functional>
 #include <string>
@@ -40,11 +41,11 @@ struct FoamPatch
 
 struct PolyMesh
 {
-  std::vector<double> points; ///< x y z interleaved
-  std::vector<int> faceOffsets{ 0 }; ///< faces + 1 entries into faceNodes
-  std::vector<int> faceNodes;
-  std::vector<int> owner;     ///< one per face
-  std::vector<int> neighbour; ///< one per internal face
+  LargeVector<double> points;           ///< x y z interleaved
+  LargeVector<int> faceOffsets{ 0 };    ///< faces + 1 entries into faceNodes
+  LargeVector<int> faceNodes;
+  LargeVector<int> owner;               ///< one per face
+  LargeVector<int> neighbour;           ///< one per internal face
   int cellCount = 0;
   std::vector<FoamPatch> patches;
   int triangleFaces = 0; ///< faces that lost a corner to a collapsed edge (prism cells)
