@@ -193,13 +193,12 @@ void writeGrid(const exporting::ExportGrid& grid, const Arguments& args)
       grid.blocks.size(), grid.cellCount(), grid.nodeCount(), map.c_str());
     return;
   }
-  const exporting::PolyMesh mesh = exporting::buildPolyMesh(grid);
   exporting::FoamWriteOptions options;
   options.binary = !args.ascii;
-  exporting::writeFoamCase(mesh, args.output, options);
-  std::printf("blocks: %zu   cells: %lld   points: %d   faces: %d (%d internal, %d triangles)\n",
-    grid.blocks.size(), grid.cellCount(), mesh.pointCount(), mesh.faceCount(),
-    mesh.internalFaceCount(), mesh.triangleFaces);
+  const exporting::FoamSummary mesh = exporting::writeFoamCase(grid, args.output, options);
+  std::printf("blocks: %zu   cells: %d   points: %d   faces: %d (%d internal, %d triangles)\n",
+    grid.blocks.size(), mesh.cells, mesh.points, mesh.faces, mesh.internalFaces,
+    mesh.triangleFaces);
   for (const exporting::FoamPatch& patch : mesh.patches)
   {
     std::printf("  patch %-16s %-9s %8d faces\n", patch.name.c_str(), patch.type.c_str(),

@@ -78,5 +78,24 @@ struct FoamWriteOptions
  */
 void writeFoamCase(const PolyMesh& mesh, const std::string& foamFile,
   const FoamWriteOptions& options = {});
+
+/// What writeFoamCase wrote.
+struct FoamSummary
+{
+  int points = 0;
+  int cells = 0;
+  int faces = 0;
+  int internalFaces = 0;
+  int triangleFaces = 0;
+  std::vector<FoamPatch> patches;
+};
+
+/**
+ * The same case straight from the grid: binary files are streamed as the faces are
+ * walked (no polyMesh held in memory: a million cells need about a quarter of the memory
+ * and time), ASCII goes through buildPolyMesh. Same files, same guarantees as above.
+ */
+FoamSummary writeFoamCase(const ExportGrid& grid, const std::string& foamFile,
+  const FoamWriteOptions& options = {});
 } // namespace exporting
 } // namespace blockforge

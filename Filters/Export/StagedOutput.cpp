@@ -87,6 +87,89 @@ void CheckedFile::close()
   }
 }
 
+PositionalFile::PositionalFile(const std::string& path)
+  : Path(path)
+{
+  Descriptor = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (Descriptor < 0)
+  {
+    fail(errno);
+  }
+}
+
+PositionalFile::~PositionalFile()
+{
+  if (Descriptor >= 0)
+  {
+    ::close(Descriptor);
+  }
+}
+
+void PositionalFile::fail(int error) const
+{
+  throw std::runtime_error("could not write " + Path + ": " + reason(error ? error : EIO));
+}
+
+void PositionalFile::writeAt(unsigned long long offset, const void* data, std::size_t bytes)
+{
+  const char* next = static_cast<const char*>(data);
+  while (bytes > 0)
+  {
+    const ssize_t written = ::pwrite(Descriptor, next, bytes, static_cast<off_t>(offset));
+    if (written < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (written <= 0)
+    {
+      fail(written < 0 ? errno : ENOSPC);
+    }
+    next += written;
+    offset += static_cast<unsigned long long>(written);
+    bytes -= static_cast<std::size_t>(written);
+  }
+}
+
+void PositionalFile::close()
+{
+  const int descriptor = Descriptor;
+  Descriptor = -1;
+  if (::close(descriptor) != 0)
+  {
+    fail(errno);
+  }
+}
+
+PositionalFile::Region::Region(PositionalFile& file, unsigned long long offset)
+  : File(file)
+  , Offset(offset)
+  , Buffer(Capacity, '\0')
+{
+}
+
+void PositionalFile::Region::put(const void* data, std::size_t bytes)
+{
+  if (Used + bytes > Capacity)
+  {
+    flush();
+  }
+  if (bytes > Capacity)
+  {
+    File.writeAt(Offset, data, bytes);
+    Offset += bytes;
+    return;
+  }
+  std::memcpy(&Buffer[Used], data, bytes);
+  Used += bytes;
+}
+
+void PositionalFile::Region::flush()
+{
+  File.writeAt(Offset, Buffer.data(), Used);
+  Offset += Used;
+  Used = 0;
+}
+
 StagedOutput::StagedOutput(const std::string& target, Kind kind)
   : Target(target)
   , What(kind)

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 namespace blockforge
@@ -39,6 +40,56 @@ private:
   [[noreturn]] void fail(int error) const;
   std::string Path;
   std::FILE* File = nullptr;
+};
+
+/**
+ * @class PositionalFile
+ * @brief A file written at known offsets, region by region (pwrite), with every write
+ * and the close checked like CheckedFile: for binary files whose sections can be filled
+ * in one pass once their sizes are known.
+ */
+class PositionalFile
+{
+public:
+  explicit PositionalFile(const std::string& path);
+  ~PositionalFile();
+  PositionalFile(const PositionalFile&) = delete;
+  PositionalFile& operator=(const PositionalFile&) = delete;
+
+  void writeAt(unsigned long long offset, const void* data, std::size_t bytes);
+  void close();
+
+  /// Sequential writes into the file from `offset` on, gathered in a buffer.
+  class Region
+  {
+  public:
+    Region(PositionalFile& file, unsigned long long offset);
+    template <typename T>
+    void put(const T& value)
+    {
+      if (Used + sizeof(T) > Capacity)
+      {
+        flush();
+      }
+      std::memcpy(Buffer.data() + Used, &value, sizeof(T));
+      Used += sizeof(T);
+    }
+    void put(const void* data, std::size_t bytes);
+    void flush();
+    unsigned long long offset() const { return Offset + Used; }
+
+  private:
+    static constexpr std::size_t Capacity = std::size_t(1) << 20;
+    PositionalFile& File;
+    unsigned long long Offset;
+    std::string Buffer;
+    std::size_t Used = 0;
+  };
+
+private:
+  [[noreturn]] void fail(int error) const;
+  std::string Path;
+  int Descriptor = -1;
 };
 
 /**
