@@ -13,6 +13,8 @@
  */
 #include "Quality.h"
 
+#include "Parallel.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -869,6 +871,8 @@ struct BlockView
   int ni, nj, nk; // nodes
   int ci, cj, ck; // cells
   long cellCount;
+  /// A neighbour layer (another rank's cells) takes part with this side only; -1: all.
+  int onlySide = -1;
 
   explicit BlockView(const StructuredBlock& b)
     : xyz(b.xyz)
@@ -1081,7 +1085,7 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     for (int side = 0; side < 6; ++side)
     {
       table.sideOffset[6 * blockIndex + side] = count;
-      if (view.cellCount > 0)
+      if (view.cellCount > 0 && (view.onlySide < 0 || view.onlySide == side))
       {
         count += static_cast<long>(view.sideWidth(side)) * view.sideHeight(side);
       }
@@ -1101,6 +1105,10 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     }
     for (int side = 0; side < 6; ++side)
     {
+      if (view.onlySide >= 0 && view.onlySide != side)
+      {
+        continue;
+      }
       for (int b = 0; b < view.sideHeight(side); ++b)
       {
         for (int a = 0; a < view.sideWidth(side); ++a)
@@ -1189,7 +1197,9 @@ bool linkMatches(const std::vector<BlockView>& views, const PeriodicSideLink& li
   }
   const BlockView& source = views[link.sourceBlock];
   const BlockView& image = views[link.imageBlock];
-  if (source.cellCount == 0 || image.cellCount == 0)
+  if (source.cellCount == 0 || image.cellCount == 0 ||
+    (source.onlySide >= 0 && source.onlySide != link.sourceSide) ||
+    (image.onlySide >= 0 && image.onlySide != link.imageSide))
   {
     return false;
   }
@@ -1454,13 +1464,15 @@ public:
     maxSkewness_ = quality.skewness;
   }
 
-  /// Shape measures of every cell of layer k and the faces below and beside them.
+  /// Shape measures of every cell of layer k and the faces below and beside them. The
+  /// first layer passed starts the pass: its faces below are left to the layer under it.
   void layer(int k)
   {
-    if (k == 0)
+    if (first_ < 0)
     {
-      loadPlane(view_, 0, planes_[0]);
-      planeEdges(0);
+      first_ = k;
+      loadPlane(view_, k, planes_[k % 2]);
+      planeEdges(k % 2);
     }
     lower_ = k % 2;
     upper_ = 1 - lower_;
@@ -1559,7 +1571,7 @@ private:
       const V3<T> q[4] = { c[0], c[4], c[5], c[1] };
       lowerFace<T>(q, centres, inLayer - view_.ci, cell - view_.ci, centre, cell);
     }
-    if (k_ > 0)
+    if (k_ > first_)
     {
       const V3<T> q[4] = { c[0], c[1], c[2], c[3] };
       lowerFace<T>(q, centres_[1 - k_ % 2], inLayer, cell - layerCells_, centre, cell);
@@ -1608,6 +1620,7 @@ private:
   double* minCosine2_;
   double* maxSkewness_;
   int lower_ = 0, upper_ = 1, j_ = 0, k_ = 0;
+  int first_ = -1;
 };
 
 /// Block-boundary faces: interfaces are measured with the other cell's centre, true
@@ -1687,11 +1700,43 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
   std::fill_n(quality.skewness, cellCount, 0.0);
   std::fill_n(quality.aspectRatio, cellCount, 0.0);
   std::fill_n(quality.scaledJacobian, cellCount, 0.0);
-  BlockPass pass(view, quality, scratch);
-  for (int k = 0; k < view.ck; ++k)
+  // Layers in chunks of at least two, on threads when a runner is installed. A chunk
+  // [k0, k1) first re-evaluates layer k0 - 1 (the same values again: idempotent writes and
+  // min/max updates), whose centres its lowest faces need, and updates cells of layers
+  // k0 - 1 .. k1 - 1 only. Even chunks run first, then odd ones, so no two chunks that
+  // touch the same layer run at once; min and max do not depend on the order, so every
+  // chunking gives the same bits.
+  const long layerCells = static_cast<long>(view.ci) * view.cj;
+  const int chunks =
+    static_cast<int>(chunkCount(cellCount, 1L << 16, std::max(1, view.ck / 2)));
+  if (chunks == 1)
   {
-    pass.layer(k);
-    progress.advance(static_cast<double>(view.ci) * view.cj);
+    BlockPass pass(view, quality, scratch);
+    for (int k = 0; k < view.ck; ++k)
+    {
+      pass.layer(k);
+      progress.advance(static_cast<double>(layerCells));
+    }
+  }
+  else
+  {
+    auto runChunk = [&](long chunk)
+    {
+      const int k0 = static_cast<int>(view.ck * chunk / chunks);
+      const int k1 = static_cast<int>(view.ck * (chunk + 1) / chunks);
+      std::vector<double> chunkScratch;
+      BlockPass pass(view, quality, chunkScratch);
+      for (int k = std::max(k0 - 1, 0); k < k1; ++k)
+      {
+        pass.layer(k);
+      }
+    };
+    for (int parity = 0; parity < 2; ++parity)
+    {
+      const long count = (chunks - parity + 1) / 2;
+      forEachChunk(count, [&](long n) { runChunk(2 * n + parity); });
+      progress.advance(static_cast<double>(layerCells) * view.ck * 0.5);
+    }
   }
   boundaryFaces(views, blockIndex, interfaces, quality);
   for (long cell = 0; cell < cellCount; ++cell)
@@ -1824,7 +1869,27 @@ std::vector<BlockView> blockViews(const std::vector<StructuredBlock>& blocks, do
   return views;
 }
 
-void evaluateBlocks(const std::vector<BlockView>& views, double totalCells,
+/// Appends the views of neighbour layers (one side each) after the measured blocks'.
+void addNeighbourViews(std::vector<BlockView>& views, const std::vector<NeighbourLayer>& neighbours)
+{
+  for (std::size_t n = 0; n < neighbours.size(); ++n)
+  {
+    const NeighbourLayer& neighbour = neighbours[n];
+    const StructuredBlock& cells = neighbour.cells;
+    const int across[3] = { cells.ni, cells.nj, cells.nk };
+    if (neighbour.side < 0 || neighbour.side > 5 || across[neighbour.side / 2] != 2 ||
+      cells.ni < 2 || cells.nj < 2 || cells.nk < 2 || !cells.xyz)
+    {
+      throw GeometryError("grid quality: neighbour layer " + std::to_string(n) +
+        " is not two node layers at a block side");
+    }
+    views.emplace_back(cells);
+    views.back().onlySide = neighbour.side;
+  }
+}
+
+/// Measures the first `measured` views; the views after them are neighbour layers.
+void evaluateBlocks(const std::vector<BlockView>& views, std::size_t measured, double totalCells,
   const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
   const std::function<void(double)>& progress)
 {
@@ -1833,7 +1898,7 @@ void evaluateBlocks(const std::vector<BlockView>& views, double totalCells,
   InterfaceTable interfaces = matchBlockInterfaces(views);
   addPeriodicLinks(interfaces, views, periodic);
   std::vector<double> scratch;
-  for (std::size_t n = 0; n < views.size(); ++n)
+  for (std::size_t n = 0; n < measured; ++n)
   {
     evaluateBlock(views, static_cast<int>(n), interfaces, outputs[n], scratch, reporter);
   }
@@ -1861,7 +1926,7 @@ std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBl
     outputs[n] = { q.minAngle.data(), q.maxAngle.data(), q.nonOrthogonality.data(),
       q.skewness.data(), q.aspectRatio.data(), q.scaledJacobian.data() };
   }
-  evaluateBlocks(views, totalCells, periodic, outputs, progress);
+  evaluateBlocks(views, views.size(), totalCells, periodic, outputs, progress);
   return quality;
 }
 
@@ -1881,14 +1946,53 @@ void computeGridQuality(const std::vector<StructuredBlock>& blocks,
   const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
   const std::function<void(double)>& progress)
 {
+  computeGridQuality(blocks, periodic, std::vector<NeighbourLayer>(), outputs, progress);
+}
+
+void computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::vector<NeighbourLayer>& neighbours,
+  const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress)
+{
   if (outputs.size() != blocks.size())
   {
     throw GeometryError("grid quality: " + std::to_string(outputs.size()) +
       " output buffers for " + std::to_string(blocks.size()) + " blocks");
   }
   double totalCells = 0.0;
-  const std::vector<BlockView> views = blockViews(blocks, totalCells);
-  evaluateBlocks(views, totalCells, periodic, outputs, progress);
+  std::vector<BlockView> views = blockViews(blocks, totalCells);
+  addNeighbourViews(views, neighbours);
+  evaluateBlocks(views, blocks.size(), totalCells, periodic, outputs, progress);
+}
+
+StructuredBlock sideLayer(const StructuredBlock& block, int side, std::vector<double>& nodes)
+{
+  if (side < 0 || side > 5 || block.ni < 2 || block.nj < 2 || block.nk < 2 || !block.xyz)
+  {
+    throw GeometryError("grid quality: no side " + std::to_string(side) + " to take a layer of");
+  }
+  int begin[3] = { 0, 0, 0 };
+  int count[3] = { block.ni, block.nj, block.nk };
+  const int axis = side / 2;
+  begin[axis] = side % 2 == 0 ? 0 : count[axis] - 2;
+  count[axis] = 2;
+  nodes.resize(3 * static_cast<std::size_t>(count[0]) * count[1] * count[2]);
+  double* out = nodes.data();
+  for (int k = 0; k < count[2]; ++k)
+  {
+    for (int j = 0; j < count[1]; ++j)
+    {
+      const double* row = block.xyz +
+        3 * (begin[0] + static_cast<long>(block.ni) * (begin[1] + j + static_cast<long>(block.nj) * (begin[2] + k)));
+      std::copy_n(row, 3 * static_cast<std::size_t>(count[0]), out);
+      out += 3 * count[0];
+    }
+  }
+  StructuredBlock layer;
+  layer.xyz = nodes.data();
+  layer.ni = count[0];
+  layer.nj = count[1];
+  layer.nk = count[2];
+  return layer;
 }
 
 void prepareOutputMemory(void* begin, std::size_t bytes)

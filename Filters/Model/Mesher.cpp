@@ -1290,8 +1290,9 @@ struct MultiBlockMesher::Impl
     std::array<int, 3> nodes{};
     for (int d = 0; d < 3; ++d)
     {
+      // validated in the constructor: at most MaxScaledCellsPerDirection
       const double scaled = std::round(Model.blocks[block].cells[d] * Multiplier);
-      int cells = static_cast<int>(std::max(1.0, std::min(scaled, 1.0e6)));
+      int cells = static_cast<int>(std::max(1.0, scaled));
       if (Cap > 0)
       {
         cells = std::min(cells, Cap);
@@ -1317,13 +1318,31 @@ MultiBlockMesher::MultiBlockMesher(
   const BlockModel& model, const CarrierGeometry* carriers, double densityMultiplier)
   : P(new Impl)
 {
-  if (!std::isfinite(densityMultiplier) || !(densityMultiplier > 0.0))
+  if (!std::isfinite(densityMultiplier) || !(densityMultiplier > 0.0) ||
+    densityMultiplier > MaxDensityMultiplier)
   {
     throw TemplateError(model.sourceFile, 0, entity("model", model.name),
-      "the density multiplier must be a positive number, got " +
-        formatNumber(densityMultiplier));
+      "the density multiplier must be a number above 0 and at most " +
+        formatNumber(MaxDensityMultiplier) + ", got " + formatNumber(densityMultiplier));
   }
   checkBasics(model);
+  static const char* const directionNames[3] = { "i", "j", "k" };
+  for (const Block& block : model.blocks)
+  {
+    for (int d = 0; d < 3; ++d)
+    {
+      const double scaled = std::round(block.cells[d] * densityMultiplier);
+      if (scaled > MaxScaledCellsPerDirection)
+      {
+        fail(block.where, entity("block", block.name),
+          std::string(directionNames[d]) + ": " + std::to_string(block.cells[d]) +
+            " cells x density multiplier " + formatNumber(densityMultiplier) + " = " +
+            formatNumber(scaled) + " cells, more than " +
+            formatNumber(MaxScaledCellsPerDirection) +
+            " per direction; lower the density multiplier or the cell counts");
+      }
+    }
+  }
   P->Model = model;
   P->Multiplier = densityMultiplier;
   P->Geometry = carriers ? *carriers : CarrierGeometry(P->Model);
