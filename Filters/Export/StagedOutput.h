@@ -94,9 +94,12 @@ private:
 
 /**
  * @class StagedOutput
- * @brief A temporary file or directory beside `target` ("DIR/.NAME.XXXXXX"); publish()
- * renames it onto `target` (a directory is exchanged atomically with an older one, which
- * is then removed). Destroyed without publish() (an exception), it removes what it staged.
+ * @brief A temporary file or directory beside `target`, named as blockforge.output (the
+ * Python command line's verified writing) names its staging folders,
+ * "DIR/.NAME.<pid>-<token>.staging"; publish() renames it onto `target` (a directory is
+ * exchanged atomically with an older one, which is then removed). Destroyed without
+ * publish() (an exception), it removes what it staged; what a killed process left is
+ * removed by the next run for the same target (removeStaleStaging).
  */
 class StagedOutput
 {
@@ -121,6 +124,9 @@ private:
   Kind What;
   bool Published = false;
 };
+
+/// Removes the staging entries of `target` left by processes that no longer run.
+void removeStaleStaging(const std::string& target);
 
 /// mkdir -p; throws std::runtime_error naming the folder that could not be made.
 void makeDirectories(const std::string& path);

@@ -13,6 +13,7 @@
 
 #include <dirent.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 using namespace blockforge;
 using namespace blockforge::exporting;
@@ -398,4 +399,29 @@ TEST(FoamCase, StreamedBinaryEqualsTheMeshInMemory)
     EXPECT_FALSE(streamed.empty()) << name;
     EXPECT_EQ(streamed, read("memory")) << name;
   }
+}
+
+TEST(FoamCase, LeftoversOfKilledRunsAreRemovedOthersKept)
+{
+  std::vector<OwnedBlock> blocks;
+  blocks.push_back(makeBlock("box", { 2, 2, 2 }, [](int i, int j, int k) {
+    return Vec3(i, j, k);
+  }));
+  const ExportGrid grid = gridOf(blocks);
+  const std::string dir = std::string(BLOCKFORGE_TEST_OUTPUT) + "/foam_leftovers";
+  removeTree(dir);
+  makeDirectories(dir + "/constant");
+  // Named as blockforge.output names staging folders: .NAME.<pid>-<token>.staging. This
+  // process's own are stale (one process writes one target at a time); pid 1 runs.
+  const std::string stale = dir + "/constant/.polyMesh." + std::to_string(::getpid()) + "-0badc0de.staging";
+  const std::string running = dir + "/constant/.polyMesh.1-0badc0de.staging";
+  const std::string unrelated = dir + "/constant/.polyMesh.notes";
+  for (const std::string& path : { stale, running, unrelated })
+    makeDirectories(path);
+  writeFoamCase(grid, dir + "/box.foam");
+  struct stat status;
+  EXPECT_NE(::stat(stale.c_str(), &status), 0);
+  EXPECT_EQ(::stat(running.c_str(), &status), 0);
+  EXPECT_EQ(::stat(unrelated.c_str(), &status), 0);
+  EXPECT_EQ(::stat((dir + "/constant/polyMesh/faces").c_str(), &status), 0);
 }
