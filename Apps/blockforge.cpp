@@ -15,7 +15,7 @@
 #include "Plot3D.h"
 #include "PolyMesh.h"
 #include "Template.h"
-#include "TurboPointSets.h"
+#include "TurboTemplateInputs.h"
 
 #include <chrono>
 #include <cstdio>
@@ -140,36 +140,7 @@ model::TemplateInputs readInputs(const std::string& file)
   {
     std::fprintf(stderr, "warning: %s\n", warning.c_str());
   }
-  model::TemplateInputs inputs;
-  auto curve = [&](const io::PointSet& set) {
-    model::InputCurve result;
-    result.name = set.name;
-    for (const Eigen::Vector3d& p : set.points)
-    {
-      result.points.push_back(p * sets.scale);
-    }
-    return result;
-  };
-  model::InputPointSet hub, shroud, profiles;
-  hub.name = "Hub";
-  if (!sets.hub.points.empty())
-    hub.curves.push_back(curve(sets.hub));
-  shroud.name = "Shroud";
-  if (!sets.shroud.points.empty())
-    shroud.curves.push_back(curve(sets.shroud));
-  profiles.name = "Profiles";
-  profiles.isList = true;
-  for (const io::ProfileSection& section : sets.profiles)
-  {
-    profiles.curves.push_back(curve(section));
-    profiles.curves.back().span = section.spanPercent / 100.0;
-  }
-  inputs.pointSets = { hub, shroud, profiles };
-  inputs.hasMachine = true;
-  inputs.axis = sets.axis.normalized();
-  inputs.bladeCount = sets.bladeCount;
-  inputs.origin = file;
-  return inputs;
+  return io::templateInputs(sets, file);
 }
 
 /// Writes the grid in the format of the output's extension; prints what was written.
