@@ -193,8 +193,10 @@ std::string findModelDocument(vtkDataObject* object)
 } // namespace blockforge
 
 #include "../Core/Quality.h"
+#include "../Model/MemoryBudget.h"
 #include "../Model/GridCheck.h"
 #include "../Model/Mesher.h"
+#include "../Model/PrintableText.h"
 
 #include <deque>
 #include <mutex>
@@ -237,6 +239,12 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
     const vtkIdType nodeCount = static_cast<vtkIdType>(nodes[0]) * nodes[1] * nodes[2];
     vtkNew<vtkDoubleArray> coordinates;
     coordinates->SetNumberOfComponents(3);
+    if (!coordinates->Resize(nodeCount) || coordinates->GetPointer(0) == nullptr)
+    {
+      throw model::ResourceError("block '" + blockModel.blocks[b].name + "': cannot allocate " +
+        model::formatBytes(24.0 * static_cast<double>(nodeCount)) + " for " +
+        std::to_string(nodeCount) + " nodes");
+    }
     coordinates->SetNumberOfTuples(nodeCount);
     // Fresh memory faulted in one go is much cheaper than page by page on some VMs.
     prepareOutputMemory(coordinates->GetPointer(0), sizeof(double) * 3 * nodeCount);
@@ -336,7 +344,7 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
   double densityMultiplier, int cellCap, int piece, int pieceCount,
   vtkMultiBlockDataSet* output, const std::function<void(double)>& progress,
   const model::CarrierGeometry* carriers, InvertedCellPolicy policy,
-  std::vector<model::InvertedCellReport>* reports)
+  std::vector<model::InvertedCellReport>* reports, double maximumMemoryGigabytes)
 {
   useSMPTools();
   model::CarrierGeometry known;
@@ -358,6 +366,18 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
     CarrierCache::instance().store(document, mesher.carriers());
   }
   mesher.setCellCap(cellCap);
+  model::BlockNodeCounts nodes;
+  for (int b = 0; b < mesher.blockCount(); ++b)
+  {
+    if (pieceCount <= 1 || b % pieceCount == piece)
+    {
+      nodes.push_back(mesher.nodeCounts(b));
+    }
+  }
+  model::checkGridMemory(nodes, maximumMemoryGigabytes,
+    cellCap > 0 || policy == InvertedCellPolicy::Skip // the template's preview
+      ? "lower PreviewCells or the cell counts"
+                : "lower the density multiplier or the cell counts");
   mesher.computeBoundaries();
   if (progress)
   {
@@ -375,6 +395,11 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
     policy, reports);
   attachModel(grid->GetFieldData(), document);
   output->ShallowCopy(grid);
+}
+
+std::string printable(const char* text)
+{
+  return printableText(text ? text : "");
 }
 } // namespace vtkglue
 } // namespace blockforge

@@ -29,9 +29,19 @@ public:
 
   ///@{
   /// The paper's grid density multiplier: every cell count of the template is multiplied
-  /// by it and rounded (at least one cell). Dimensionless, > 0; default 1.
-  vtkSetClampMacro(DensityMultiplier, double, 0.01, 100.0);
+  /// by it and rounded (at least one cell). Dimensionless, in (0, 1000]; default 1. Not
+  /// clamped: a value outside the range (NaN, infinity, 0, negative) or one that makes a
+  /// block direction exceed 1,000,000 cells is an error when the filter runs.
+  vtkSetMacro(DensityMultiplier, double);
   vtkGetMacro(DensityMultiplier, double);
+  ///@}
+
+  ///@{
+  /// Largest memory the grid may take, in GB (2^30 bytes); 0 (default) = only what the
+  /// machine has available. A grid estimated to need more is refused before anything is
+  /// allocated, with an error saying how much it would need.
+  vtkSetMacro(MaximumMemory, double);
+  vtkGetMacro(MaximumMemory, double);
   ///@}
 
   ///@{
@@ -54,6 +64,7 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   double DensityMultiplier = 1.0;
+  double MaximumMemory = 0.0;
   bool AllowInvertedCells = false;
 
 private:

@@ -18,6 +18,7 @@
 #include <vtkSmartPointer.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStringArray.h>
+#include <vtkFieldData.h>
 #include <vtkStructuredGrid.h>
 
 #include <iomanip>
@@ -270,11 +271,21 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
       pieceCount, output, [this](double fraction) { this->UpdateProgress(0.4 + 0.55 * fraction); },
       &geometry,
       // The preview's capped cell counts are not the grid: BlockMesher checks the cells.
-      blockforge::vtkglue::InvertedCellPolicy::Skip);
+      blockforge::vtkglue::InvertedCellPolicy::Skip, nullptr, this->MaximumMemory);
     if (carriers && piece == 0)
     {
       fillCarriers(blockModel, geometry, carriers);
     }
+    // What the template chose (its notes): a warning each, and the field data
+    // TemplateNotes, so that the choice is seen in the GUI, in scripts and on the command line.
+    vtkNew<vtkStringArray> notes;
+    notes->SetName("TemplateNotes");
+    for (const std::string& note : blockModel.notes)
+    {
+      vtkWarningMacro(<< this->TemplateFile << ": " << note);
+      notes->InsertNextValue(note);
+    }
+    output->GetFieldData()->AddArray(notes);
     this->ModelDocument = document;
     for (const auto& parameter : blockModel.parameters)
     {
@@ -283,7 +294,7 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro(<< error.what());
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
     output->Initialize();
     if (carriers)
     {
@@ -301,6 +312,7 @@ void vtkBlockTemplateAlgorithm::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "TemplateFile: " << (this->TemplateFile ? this->TemplateFile : "(none)")
      << "\n";
   os << indent << "PreviewCells: " << this->PreviewCells << "\n";
+  os << indent << "MaximumMemory: " << this->MaximumMemory << " GB\n";
   for (const auto& parameter : this->Parameters)
   {
     os << indent << "Parameter " << parameter.first << " = " << parameter.second << "\n";

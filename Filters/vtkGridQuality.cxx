@@ -1,6 +1,7 @@
 #include "vtkGridQuality.h"
 
 #include "../Core/Quality.h"
+#include "../Model/MemoryBudget.h"
 #include "../Model/ModelDocument.h"
 #include "../Model/Topology.h"
 #include "BlockForgeModelIO.h"
@@ -28,6 +29,7 @@
 #include <vtkTable.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <array>
 #include <limits>
 #include <map>
@@ -147,6 +149,25 @@ int vtkGridQuality::RequestData(
         : "");
   }
 
+  try
+  {
+    double cellTotal = 0.0;
+    for (vtkStructuredGrid* grid : grids)
+    {
+      cellTotal += static_cast<double>(grid->GetNumberOfCells());
+    }
+    char count[64];
+    std::snprintf(count, sizeof(count), "%.2g cells", cellTotal);
+    blockforge::model::checkMemory(blockforge::model::qualityMemoryBytes(cellTotal),
+      this->MaximumMemory, "the quality measures", count,
+      "lower the density multiplier or the cell counts");
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
+    return 0;
+  }
+
   // The measures are written straight into the output arrays: no copy, and the fresh
   // memory is prepared in one go rather than faulted page by page.
   std::vector<vtkSmartPointer<vtkStructuredGrid>> measuredGrids;
@@ -208,7 +229,7 @@ int vtkGridQuality::RequestData(
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro(<< error.what());
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
     return 0;
   }
 
@@ -346,4 +367,5 @@ int vtkGridQuality::RequestData(
 void vtkGridQuality::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
+  os << indent << "MaximumMemory: " << this->MaximumMemory << " GB\n";
 }

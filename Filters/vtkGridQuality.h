@@ -46,6 +46,13 @@ public:
   vtkTypeMacro(vtkGridQuality, vtkMultiBlockDataSetAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
+  ///@{
+  /// Largest memory the quality arrays may take, in GB (2^30 bytes); 0 (default) = only
+  /// what the machine has available. Checked before anything is allocated.
+  vtkSetMacro(MaximumMemory, double);
+  vtkGetMacro(MaximumMemory, double);
+  ///@}
+
 protected:
   vtkGridQuality();
   ~vtkGridQuality() override = default;
@@ -53,6 +60,8 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int FillOutputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  double MaximumMemory = 0.0;
 
 private:
   vtkGridQuality(const vtkGridQuality&) = delete;
