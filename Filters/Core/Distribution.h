@@ -20,7 +20,8 @@ struct DistributionLaw
     Uniform,   ///< equal cells
     Geometric, ///< paper eq. 7: each cell is ExpansionRatio times the previous one
     TwoSided,  ///< cells grow by ExpansionRatio from both ends towards the middle
-    FirstCell  ///< first cell of FirstCellSize, growing by at most ExpansionRatio
+    FirstCell, ///< first cell of FirstCellSize, growing by at most ExpansionRatio
+    Ends       ///< first and last cells FirstCellSize and LastCellSize times the mean cell
   };
   Kind kind = Kind::Uniform;
   /// Geometric/TwoSided: ratio of successive cell sizes (k in eq. 7, > 0).
@@ -29,12 +30,17 @@ struct DistributionLaw
   /// FirstCell means "solve the ratio so that all cells grow geometrically".
   double expansionRatio = 1.0;
   /// FirstCell: size of the first cell in length units of the edge (> 0).
+  /// Ends: size of the first cell over the mean cell (edge length / cells, > 0).
   double firstCellSize = 0.0;
+  /// Ends: size of the last cell over the mean cell (> 0). Relative sizes do not change
+  /// with the cell count, so a refined grid keeps the shape: neighbour blocks whose end
+  /// cells match at one density match at all.
+  double lastCellSize = 0.0;
 
   bool operator==(const DistributionLaw& o) const
   {
     return kind == o.kind && expansionRatio == o.expansionRatio &&
-      firstCellSize == o.firstCellSize;
+      firstCellSize == o.firstCellSize && lastCellSize == o.lastCellSize;
   }
   bool operator!=(const DistributionLaw& o) const { return !(*this == o); }
 };
@@ -48,7 +54,7 @@ struct DistributionLaw
 std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
   double edgeLength = 1.0);
 
-/// The law seen from the other end of the edge (Geometric k -> 1/k). FirstCell cannot be
+/// The law seen from the other end of the edge (Geometric k -> 1/k, Ends swapped). FirstCell cannot be
 /// reversed into a law of the same kind; callers reverse its node parameters instead.
 DistributionLaw reversedLaw(const DistributionLaw& law);
 } // namespace blockforge
