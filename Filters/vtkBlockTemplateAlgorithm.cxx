@@ -181,7 +181,7 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
       pieceCount, output, [this](double fraction) { this->UpdateProgress(0.4 + 0.55 * fraction); },
       &geometry,
       // The preview's capped cell counts are not the grid: BlockMesher checks the cells.
-      blockforge::vtkglue::InvertedCellPolicy::Skip);
+      blockforge::vtkglue::InvertedCellPolicy::Skip, nullptr, this->MaximumMemory);
     if (carriers && piece == 0)
     {
       fillCarriers(blockModel, geometry, carriers);
@@ -200,7 +200,7 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro(<< error.what());
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
     output->Initialize();
     if (carriers)
     {
@@ -218,6 +218,7 @@ void vtkBlockTemplateAlgorithm::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "TemplateFile: " << (this->TemplateFile ? this->TemplateFile : "(none)")
      << "\n";
   os << indent << "PreviewCells: " << this->PreviewCells << "\n";
+  os << indent << "MaximumMemory: " << this->MaximumMemory << " GB\n";
   for (const auto& parameter : this->Parameters)
   {
     os << indent << "Parameter " << parameter.first << " = " << parameter.second << "\n";

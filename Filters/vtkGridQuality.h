@@ -7,8 +7,9 @@
  * - MinAngle, MaxAngle: smallest/largest corner angle of the cell's 6 faces [degrees]
  *   (the paper's criterion; below 20 degrees harms accuracy and convergence);
  * - NonOrthogonality: OpenFOAM's angle between a face normal and the line joining the
- *   two cell centres, maximum over the cell's faces, block interfaces included [degrees];
- * - Skewness: OpenFOAM's face skewness, maximum over the cell's faces [-];
+ *   two cell centres (OpenFOAM's cell centres: volume centroids), maximum over the cell's
+ *   faces, block interfaces and periodic faces included [degrees];
+ * - Skewness: OpenFOAM's face skewness (checkMesh's), maximum over the cell's faces [-];
  * - AspectRatio: longest over shortest mean cell width [-];
  * - ScaledJacobian: Verdict's hex scaled Jacobian (1 = cube, negative = inverted) [-];
  * - BlockId: index of the block.
@@ -19,6 +20,14 @@
  * Output port 1 is a table of the MinAngle classes for a bar chart (columns Class,
  * Cells, Percent); output port 2 a table of the statistics (Measure, Min, Mean, Max).
  * Under MPI the class counts and statistics are global.
+ *
+ * Periodic faces are paired when the input carries its block model (the mesher's output
+ * does): the model's topology names the periodic pairs and their rotation, and across a
+ * periodic face the partner cell's centre is rotated into place, as OpenFOAM's cyclic
+ * patches do. Under MPI (the pipeline in pieces on several ranks) the ranks exchange the
+ * two node layers beside every interface and periodic face between their blocks, so
+ * every measure equals the serial run's bit for bit. Large blocks are measured on
+ * threads (vtkSMPTools), with the same bits.
  *
  * @sa vtkBlockMesher
  */
@@ -35,6 +44,13 @@ public:
   vtkTypeMacro(vtkGridQuality, vtkMultiBlockDataSetAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
+  ///@{
+  /// Largest memory the quality arrays may take, in GB (2^30 bytes); 0 (default) = only
+  /// what the machine has available. Checked before anything is allocated.
+  vtkSetMacro(MaximumMemory, double);
+  vtkGetMacro(MaximumMemory, double);
+  ///@}
+
 protected:
   vtkGridQuality();
   ~vtkGridQuality() override = default;
@@ -42,6 +58,8 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int FillOutputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  double MaximumMemory = 0.0;
 
 private:
   vtkGridQuality(const vtkGridQuality&) = delete;

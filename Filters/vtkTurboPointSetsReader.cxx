@@ -2,6 +2,8 @@
 
 #include "TurboPointSets.h"
 
+#include "BlockForgeModelIO.h"
+
 #include <vtkCellArray.h>
 #include <vtkCompositeDataSet.h>
 #include <vtkDoubleArray.h>
@@ -168,7 +170,7 @@ int vtkTurboPointSetsReader::RequestData(
         [this](double fraction) { this->UpdateProgress(0.8 * fraction); });
     for (const auto& warning : sets.warnings)
     {
-      vtkWarningMacro(<< warning);
+      vtkWarningMacro(<< blockforge::vtkglue::printable(warning.c_str()));
     }
 
     const bool holdsData = piece == 0;
@@ -225,7 +227,7 @@ int vtkTurboPointSetsReader::RequestData(
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro(<< error.what());
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
     output->Initialize();
     return 0;
   }

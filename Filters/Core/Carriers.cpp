@@ -888,6 +888,7 @@ public:
 
   double f(double s, double t) const
   {
+    WorkBudget::charge();
     return Revolution.signedMeridionalDistance(Surface.point(s, t));
   }
 
@@ -998,8 +999,12 @@ private:
 } // namespace
 
 std::shared_ptr<SurfaceCurve> intersectWithRevolution(std::shared_ptr<const GordonSurface> surface,
-  const SurfaceOfRevolution& revolution, double tMin, double tMax, int samples)
+  const SurfaceOfRevolution& revolution, double tMin, double tMax, int samples,
+  WorkBudget* budget)
 {
+  WorkBudget ownBudget(IntersectionWorkLimit, "intersection with a surface of revolution");
+  WorkBudget& work = budget ? *budget : ownBudget;
+  const WorkBudget::Scope scope(work);
   if (!surface)
   {
     throw GeometryError("intersection with a surface of revolution: no surface given");
@@ -1315,6 +1320,8 @@ std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
     throw GeometryError("offset on a surface: the curve is said to be closed but its ends "
                         "do not meet");
   }
+  WorkBudget work(OffsetWorkLimit, "offset on a surface");
+  const WorkBudget::Scope scope(work);
   constexpr int InitialSteps = 512;
   constexpr std::size_t MaxSamples = 65536;
   const double turnLimit = std::cos(3.0 * std::acos(-1.0) / 180.0);

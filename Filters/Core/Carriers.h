@@ -13,6 +13,7 @@
 #include "BSpline.h"
 #include "Projection.h"
 #include "Surface.h"
+#include "WorkBudget.h"
 
 #include <Eigen/Core>
 
@@ -205,10 +206,19 @@ private:
  * Closed sections (P(0, t) == P(1, t)) get the same t at s = 0 and s = 1, so the curve
  * closes exactly. Throws GeometryError naming the s where no intersection exists in the
  * range.
+ *
+ * The whole search is bounded: every curve evaluation of the meridional projections and
+ * every evaluation of the distance is charged to `budget` (default: a fresh one of
+ * IntersectionWorkLimit units, over 6 times what the Rotor 37 and distributor blades
+ * need), and a GeometryError ends it when the budget is spent, so kinked or spiky input
+ * fails in a fraction of a second.
  */
 std::shared_ptr<SurfaceCurve> intersectWithRevolution(std::shared_ptr<const GordonSurface> surface,
   const SurfaceOfRevolution& revolution, double tMin = -0.5, double tMax = 1.5,
-  int samples = 64);
+  int samples = 64, WorkBudget* budget = nullptr);
+
+/// Work units intersectWithRevolution may spend by default (see there).
+constexpr std::size_t IntersectionWorkLimit = 1000000;
 
 /// Closest point of a surface to p, as its parameters (s, t): how offsetOnSurface maps the
 /// offset points back onto the surface.
@@ -244,8 +254,13 @@ using SurfaceParameterFunction = std::function<Eigen::Vector2d(const Vec3& p)>;
  * Throws GeometryError when |distance| is zero or not finite, when a `closed` curve's ends
  * do not meet, when the offset folds back without crossing itself nearby (the distance
  * is larger than the curve is wide: an inward offset past the middle), naming the
- * parameter u where it folds, and when the tangent or the surface normal vanish.
+ * parameter u where it folds, when the tangent or the surface normal vanish, and when
+ * the projections of the samples (`toParameters`, charged to the current WorkBudget)
+ * need more than OffsetWorkLimit curve evaluations in all.
  */
 std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
   const Surface& surface, const SurfaceParameterFunction& toParameters, double distance);
+
+/// Work units offsetOnSurface may spend (see there).
+constexpr std::size_t OffsetWorkLimit = 500000;
 } // namespace blockforge

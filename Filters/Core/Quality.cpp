@@ -13,6 +13,8 @@
  */
 #include "Quality.h"
 
+#include "Parallel.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -687,6 +689,132 @@ inline int usableLanes(const FaceGeometry<T>& face, const FaceMeasures<T>& m)
 }
 
 // ---------------------------------------------------------------------------------------
+// Cell centres
+
+/// The six faces of a hexahedron (outward area vectors for a right-handed cell).
+template <typename T>
+inline void hexFaceGeometry(const V3<T> (&c)[8], FaceGeometry<T> (&faces)[6])
+{
+  for (int f = 0; f < 6; ++f)
+  {
+    const V3<T> p[4] = { c[hexFaces[f][0]], c[hexFaces[f][1]], c[hexFaces[f][2]],
+      c[hexFaces[f][3]] };
+    faces[f] = quadFace(p);
+  }
+}
+
+/**
+ * OpenFOAM's cell centre (primitiveMesh::makeCellCentresAndVols): the volume-weighted
+ * centre of the pyramids from each face to the mean of the face centres, which is the
+ * cell's volume centroid (the mean of the corners is not, unless the cell is a
+ * parallelepiped). Branch-free; `usable` gets the lanes (bits) where the result holds:
+ * every face has a regular centre and no face is collapsed, and the volume is not zero.
+ * The others take cellCentroidSpecialCase.
+ */
+template <typename T>
+inline V3<T> cellCentroidKernel(const V3<T> (&c)[8], int& usable)
+{
+  FaceGeometry<T> faces[6];
+  hexFaceGeometry(c, faces);
+  const V3<T> estimate = (1.0 / 6.0) *
+    (((faces[0].centre + faces[1].centre) + (faces[2].centre + faces[3].centre)) +
+      (faces[4].centre + faces[5].centre));
+  V3<T> weighted = { splat<T>(0.0), splat<T>(0.0), splat<T>(0.0) };
+  T volume = splat<T>(0.0);
+  for (const FaceGeometry<T>& face : faces)
+  {
+    const T pyramid3 = dot(face.area, face.centre - estimate);
+    weighted = weighted + pyramid3 * (0.75 * face.centre + 0.25 * estimate);
+    volume = volume + pyramid3;
+  }
+  constexpr int lanes = laneCount<T>;
+  double volumes[lanes];
+  extractLanes(volume, volumes);
+  usable = 0;
+  for (int l = 0; l < lanes; ++l)
+  {
+    usable |= (std::abs(volumes[l]) > vSmall) << l;
+  }
+  for (const FaceGeometry<T>& face : faces)
+  {
+    double area2[lanes], diagonals2[lanes], weightSum[lanes];
+    extractLanes(face.area2, area2);
+    extractLanes(face.diagonals2, diagonals2);
+    extractLanes(face.weightSum, weightSum);
+    for (int l = 0; l < lanes; ++l)
+    {
+      const bool regular = !faceCollapsed(area2[l], diagonals2[l]) && weightSum[l] > 0.0 &&
+        weightSum[l] * weightSum[l] > 4.0 * vSmall * vSmall * area2[l];
+      usable &= ~(static_cast<int>(!regular) << l);
+    }
+  }
+  return (1.0 / volume) * weighted;
+}
+
+/// The centre of a cell with collapsed faces or edges, or no volume: as OpenFOAM's mesh
+/// of it would have it (blockMesh drops collapsed faces), the estimate alone when the
+/// volume is zero, the mean of the corners when no face is left.
+P3 cellCentroidSpecialCase(const P3 (&c)[8])
+{
+  FaceGeometry<double> faces[6];
+  bool kept[6];
+  P3 estimate = { 0.0, 0.0, 0.0 };
+  int count = 0;
+  for (int f = 0; f < 6; ++f)
+  {
+    const P3 p[4] = { c[hexFaces[f][0]], c[hexFaces[f][1]], c[hexFaces[f][2]], c[hexFaces[f][3]] };
+    faces[f] = scalarFace(p);
+    kept[f] = !faceCollapsed(faces[f].area2, faces[f].diagonals2);
+    if (kept[f])
+    {
+      estimate = estimate + faces[f].centre;
+      ++count;
+    }
+  }
+  if (count == 0)
+  {
+    return 0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7])));
+  }
+  estimate = (1.0 / count) * estimate;
+  P3 weighted = { 0.0, 0.0, 0.0 };
+  double volume = 0.0;
+  for (int f = 0; f < 6; ++f)
+  {
+    if (kept[f])
+    {
+      const double pyramid3 = dot(faces[f].area, faces[f].centre - estimate);
+      weighted = weighted + pyramid3 * (0.75 * faces[f].centre + 0.25 * estimate);
+      volume += pyramid3;
+    }
+  }
+  return std::abs(volume) > vSmall ? (1.0 / volume) * weighted : estimate;
+}
+
+/// OpenFOAM's cell centre of every lane.
+template <typename T>
+inline V3<T> cellCentroid(const V3<T> (&c)[8])
+{
+  int usable = 0;
+  V3<T> centre = cellCentroidKernel(c, usable);
+  for (int l = 0; usable != (1 << laneCount<T>)-1 && l < laneCount<T>; ++l)
+  {
+    if (!(usable & (1 << l)))
+    {
+      P3 corners[8];
+      for (int v = 0; v < 8; ++v)
+      {
+        corners[v] = laneOf(c[v], l);
+      }
+      const P3 special = cellCentroidSpecialCase(corners);
+      setLane(centre.x, l, special.x);
+      setLane(centre.y, l, special.y);
+      setLane(centre.z, l, special.z);
+    }
+  }
+  return centre;
+}
+
+// ---------------------------------------------------------------------------------------
 // Memory
 
 /**
@@ -743,6 +871,8 @@ struct BlockView
   int ni, nj, nk; // nodes
   int ci, cj, ck; // cells
   long cellCount;
+  /// A neighbour layer (another rank's cells) takes part with this side only; -1: all.
+  int onlySide = -1;
 
   explicit BlockView(const StructuredBlock& b)
     : xyz(b.xyz)
@@ -778,7 +908,7 @@ struct BlockView
   {
     P3 c[8];
     cellCorners(i, j, k, c);
-    return 0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7])));
+    return cellCentroid(c);
   }
   /// Face grid size of a block side: 0/1 are i = 0 / i = ni-1 (indexed j, k),
   /// 2/3 are j = 0 / nj-1 (i, k), 4/5 are k = 0 / nk-1 (i, j).
@@ -898,6 +1028,25 @@ struct InterfaceTable
 
   std::vector<long> partner;
   std::vector<long> sideOffset; // first face of each (block, side), block-major
+  /// Periodic faces: 2 l + 0 when the partner cell is rotated by link l's rotation into
+  /// this face's frame, 2 l + 1 by its inverse; -1 for interfaces and boundaries. Empty
+  /// when there are no periodic links.
+  std::vector<int> periodic;
+  std::vector<PeriodicSideLink> links;
+
+  /// The neighbour centre as the face at `index` sees it.
+  P3 neighbourCentre(long index, const P3& centre) const
+  {
+    const int code = periodic.empty() ? -1 : periodic[index];
+    if (code < 0)
+    {
+      return centre;
+    }
+    const PeriodicSideLink& link = links[code / 2];
+    const Vec3 relative = toVec3(centre) - link.origin;
+    return toP3(link.origin +
+      (code % 2 == 0 ? Vec3(link.rotation * relative) : Vec3(link.rotation.transpose() * relative)));
+  }
 
   long index(int block, int side, int a, int b, const BlockView& view) const
   {
@@ -936,7 +1085,7 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     for (int side = 0; side < 6; ++side)
     {
       table.sideOffset[6 * blockIndex + side] = count;
-      if (view.cellCount > 0)
+      if (view.cellCount > 0 && (view.onlySide < 0 || view.onlySide == side))
       {
         count += static_cast<long>(view.sideWidth(side)) * view.sideHeight(side);
       }
@@ -956,6 +1105,10 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     }
     for (int side = 0; side < 6; ++side)
     {
+      if (view.onlySide >= 0 && view.onlySide != side)
+      {
+        continue;
+      }
       for (int b = 0; b < view.sideHeight(side); ++b)
       {
         for (int a = 0; a < view.sideWidth(side); ++a)
@@ -1019,6 +1172,107 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     first = last;
   }
   return table;
+}
+
+/// Cells along the a and b directions of a block side.
+void sideCells(const BlockView& view, int side, int& width, int& height)
+{
+  width = view.sideWidth(side);
+  height = view.sideHeight(side);
+}
+
+/**
+ * Whether the image side of `link` is its source side rotated, cell face for cell face:
+ * the side sizes agree under the transform and the four corner nodes land within 1e-9
+ * of the side's size.
+ */
+bool linkMatches(const std::vector<BlockView>& views, const PeriodicSideLink& link)
+{
+  const int blocks = static_cast<int>(views.size());
+  if (link.sourceBlock < 0 || link.sourceBlock >= blocks || link.imageBlock < 0 ||
+    link.imageBlock >= blocks || link.sourceSide < 0 || link.sourceSide > 5 ||
+    link.imageSide < 0 || link.imageSide > 5)
+  {
+    return false;
+  }
+  const BlockView& source = views[link.sourceBlock];
+  const BlockView& image = views[link.imageBlock];
+  if (source.cellCount == 0 || image.cellCount == 0 ||
+    (source.onlySide >= 0 && source.onlySide != link.sourceSide) ||
+    (image.onlySide >= 0 && image.onlySide != link.imageSide))
+  {
+    return false;
+  }
+  int sw = 0, sh = 0, iw = 0, ih = 0;
+  sideCells(source, link.sourceSide, sw, sh);
+  sideCells(image, link.imageSide, iw, ih);
+  if ((link.transform.swap() ? ih : iw) != sw || (link.transform.swap() ? iw : ih) != sh)
+  {
+    return false;
+  }
+  // Corner nodes of the image side's cell faces at the four corners of the side.
+  const int cornerA[4] = { 0, iw - 1, iw - 1, 0 }, cornerB[4] = { 0, 0, ih - 1, ih - 1 };
+  double size = 0.0, miss = 0.0;
+  for (int n = 0; n < 4; ++n)
+  {
+    int a = 0, b = 0;
+    link.transform.map(cornerA[n], cornerB[n], sw, sh, a, b);
+    P3 q[4], r[4];
+    int ijk[3];
+    image.sideFace(link.imageSide, cornerA[n], cornerB[n], q, ijk);
+    source.sideFace(link.sourceSide, a, b, r, ijk);
+    // The face centroids (corner means) must coincide after the rotation.
+    const P3 imageMean = 0.25 * ((q[0] + q[1]) + (q[2] + q[3]));
+    const P3 sourceMean = 0.25 * ((r[0] + r[1]) + (r[2] + r[3]));
+    const Vec3 rotated = link.origin + link.rotation * (toVec3(sourceMean) - link.origin);
+    miss = std::max(miss, (rotated - toVec3(imageMean)).norm());
+    for (const P3& p : q)
+    {
+      size = std::max(size, (toVec3(p) - toVec3(imageMean)).norm());
+    }
+  }
+  return miss <= 1e-6 * size;
+}
+
+/// Pairs the faces of periodic sides (replacing what hashing found there).
+void addPeriodicLinks(InterfaceTable& table, const std::vector<BlockView>& views,
+  const std::vector<PeriodicSideLink>& links)
+{
+  if (links.empty())
+  {
+    return;
+  }
+  table.links = links;
+  table.periodic.assign(table.partner.size(), -1);
+  for (std::size_t l = 0; l < links.size(); ++l)
+  {
+    const PeriodicSideLink& link = links[l];
+    if (!linkMatches(views, link))
+    {
+      throw GeometryError("grid quality: side " + std::to_string(link.imageSide) + " of block " +
+        std::to_string(link.imageBlock) + " is not the periodic image of side " +
+        std::to_string(link.sourceSide) + " of block " + std::to_string(link.sourceBlock));
+    }
+    const BlockView& source = views[link.sourceBlock];
+    const BlockView& image = views[link.imageBlock];
+    int sw = 0, sh = 0, iw = 0, ih = 0;
+    sideCells(source, link.sourceSide, sw, sh);
+    sideCells(image, link.imageSide, iw, ih);
+    for (int b = 0; b < ih; ++b)
+    {
+      for (int a = 0; a < iw; ++a)
+      {
+        int sa = 0, sb = 0;
+        link.transform.map(a, b, sw, sh, sa, sb);
+        const long imageIndex = table.index(link.imageBlock, link.imageSide, a, b, image);
+        const long sourceIndex = table.index(link.sourceBlock, link.sourceSide, sa, sb, source);
+        table.partner[imageIndex] = sourceIndex;
+        table.partner[sourceIndex] = imageIndex;
+        table.periodic[imageIndex] = static_cast<int>(2 * l);
+        table.periodic[sourceIndex] = static_cast<int>(2 * l + 1);
+      }
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -1210,13 +1464,15 @@ public:
     maxSkewness_ = quality.skewness;
   }
 
-  /// Shape measures of every cell of layer k and the faces below and beside them.
+  /// Shape measures of every cell of layer k and the faces below and beside them. The
+  /// first layer passed starts the pass: its faces below are left to the layer under it.
   void layer(int k)
   {
-    if (k == 0)
+    if (first_ < 0)
     {
-      loadPlane(view_, 0, planes_[0]);
-      planeEdges(0);
+      first_ = k;
+      loadPlane(view_, k, planes_[k % 2]);
+      planeEdges(k % 2);
     }
     lower_ = k % 2;
     upper_ = 1 - lower_;
@@ -1297,8 +1553,7 @@ private:
       quality_.aspectRatio[cell + l] = shape.aspectRatio;
     }
 
-    const V3<T> centre =
-      0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7])));
+    const V3<T> centre = cellCentroid(c);
     const long inLayer = i + static_cast<long>(view_.ci) * j_;
     const CoordinateArrays& centres = centres_[k_ % 2];
     storeLanes(centres.x + inLayer, centre.x);
@@ -1316,7 +1571,7 @@ private:
       const V3<T> q[4] = { c[0], c[4], c[5], c[1] };
       lowerFace<T>(q, centres, inLayer - view_.ci, cell - view_.ci, centre, cell);
     }
-    if (k_ > 0)
+    if (k_ > first_)
     {
       const V3<T> q[4] = { c[0], c[1], c[2], c[3] };
       lowerFace<T>(q, centres_[1 - k_ % 2], inLayer, cell - layerCells_, centre, cell);
@@ -1365,6 +1620,7 @@ private:
   double* minCosine2_;
   double* maxSkewness_;
   int lower_ = 0, upper_ = 1, j_ = 0, k_ = 0;
+  int first_ = -1;
 };
 
 /// Block-boundary faces: interfaces are measured with the other cell's centre, true
@@ -1380,7 +1636,9 @@ void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
     {
       for (int a = 0; a < view.sideWidth(side); ++a)
       {
-        const long partner = interfaces.partner[interfaces.index(blockIndex, side, a, b, view)];
+        const long faceIndex = interfaces.index(blockIndex, side, a, b, view);
+        const long partner = interfaces.partner[faceIndex];
+        const bool periodic = !interfaces.periodic.empty() && interfaces.periodic[faceIndex] >= 0;
         P3 q[4];
         int ijk[3];
         view.sideFace(side, a, b, q, ijk);
@@ -1402,14 +1660,16 @@ void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
           const BoundaryFaceRef other = interfaces.face(partner, views);
           otherView = &views[other.block];
           otherView->sideFace(other.side, other.a, other.b, otherCorners, otherIjk);
-          if (!sameCorners(q, otherCorners))
+          if (!periodic && !sameCorners(q, otherCorners))
           {
             otherView = nullptr; // hashes collided: a true boundary face
           }
         }
         if (otherView)
         {
-          const P3 d = otherView->cellCentre(otherIjk[0], otherIjk[1], otherIjk[2]) - ownerCentre;
+          const P3 d = interfaces.neighbourCentre(faceIndex,
+                         otherView->cellCentre(otherIjk[0], otherIjk[1], otherIjk[2])) -
+            ownerCentre;
           minCosine2 = std::min(minCosine2, signedSquare(orthogonalityCosine(d, outward)));
           maxSkewness =
             std::max(maxSkewness, skewness(ownerCentre, d, 0.2, outward, face.centre, q));
@@ -1440,11 +1700,43 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
   std::fill_n(quality.skewness, cellCount, 0.0);
   std::fill_n(quality.aspectRatio, cellCount, 0.0);
   std::fill_n(quality.scaledJacobian, cellCount, 0.0);
-  BlockPass pass(view, quality, scratch);
-  for (int k = 0; k < view.ck; ++k)
+  // Layers in chunks of at least two, on threads when a runner is installed. A chunk
+  // [k0, k1) first re-evaluates layer k0 - 1 (the same values again: idempotent writes and
+  // min/max updates), whose centres its lowest faces need, and updates cells of layers
+  // k0 - 1 .. k1 - 1 only. Even chunks run first, then odd ones, so no two chunks that
+  // touch the same layer run at once; min and max do not depend on the order, so every
+  // chunking gives the same bits.
+  const long layerCells = static_cast<long>(view.ci) * view.cj;
+  const int chunks =
+    static_cast<int>(chunkCount(cellCount, 1L << 16, std::max(1, view.ck / 2)));
+  if (chunks == 1)
   {
-    pass.layer(k);
-    progress.advance(static_cast<double>(view.ci) * view.cj);
+    BlockPass pass(view, quality, scratch);
+    for (int k = 0; k < view.ck; ++k)
+    {
+      pass.layer(k);
+      progress.advance(static_cast<double>(layerCells));
+    }
+  }
+  else
+  {
+    auto runChunk = [&](long chunk)
+    {
+      const int k0 = static_cast<int>(view.ck * chunk / chunks);
+      const int k1 = static_cast<int>(view.ck * (chunk + 1) / chunks);
+      std::vector<double> chunkScratch;
+      BlockPass pass(view, quality, chunkScratch);
+      for (int k = std::max(k0 - 1, 0); k < k1; ++k)
+      {
+        pass.layer(k);
+      }
+    };
+    for (int parity = 0; parity < 2; ++parity)
+    {
+      const long count = (chunks - parity + 1) / 2;
+      forEachChunk(count, [&](long n) { runChunk(2 * n + parity); });
+      progress.advance(static_cast<double>(layerCells) * view.ck * 0.5);
+    }
   }
   boundaryFaces(views, blockIndex, interfaces, quality);
   for (long cell = 0; cell < cellCount; ++cell)
@@ -1498,7 +1790,7 @@ Vec3 hexCentre(const std::array<Vec3, 8>& corners)
 {
   P3 c[8];
   loadCorners(corners, c);
-  return toVec3(0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7]))));
+  return toVec3(cellCentroid(c));
 }
 
 void quadAreaAndCentre(
@@ -1577,14 +1869,36 @@ std::vector<BlockView> blockViews(const std::vector<StructuredBlock>& blocks, do
   return views;
 }
 
-void evaluateBlocks(const std::vector<BlockView>& views, double totalCells,
-  const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress)
+/// Appends the views of neighbour layers (one side each) after the measured blocks'.
+void addNeighbourViews(std::vector<BlockView>& views, const std::vector<NeighbourLayer>& neighbours)
+{
+  for (std::size_t n = 0; n < neighbours.size(); ++n)
+  {
+    const NeighbourLayer& neighbour = neighbours[n];
+    const StructuredBlock& cells = neighbour.cells;
+    const int across[3] = { cells.ni, cells.nj, cells.nk };
+    if (neighbour.side < 0 || neighbour.side > 5 || across[neighbour.side / 2] != 2 ||
+      cells.ni < 2 || cells.nj < 2 || cells.nk < 2 || !cells.xyz)
+    {
+      throw GeometryError("grid quality: neighbour layer " + std::to_string(n) +
+        " is not two node layers at a block side");
+    }
+    views.emplace_back(cells);
+    views.back().onlySide = neighbour.side;
+  }
+}
+
+/// Measures the first `measured` views; the views after them are neighbour layers.
+void evaluateBlocks(const std::vector<BlockView>& views, std::size_t measured, double totalCells,
+  const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
+  const std::function<void(double)>& progress)
 {
   ProgressReporter reporter(progress, totalCells);
   reporter.start();
-  const InterfaceTable interfaces = matchBlockInterfaces(views);
+  InterfaceTable interfaces = matchBlockInterfaces(views);
+  addPeriodicLinks(interfaces, views, periodic);
   std::vector<double> scratch;
-  for (std::size_t n = 0; n < views.size(); ++n)
+  for (std::size_t n = 0; n < measured; ++n)
   {
     evaluateBlock(views, static_cast<int>(n), interfaces, outputs[n], scratch, reporter);
   }
@@ -1594,6 +1908,12 @@ void evaluateBlocks(const std::vector<BlockView>& views, double totalCells,
 
 std::vector<CellQualityArrays> computeGridQuality(
   const std::vector<StructuredBlock>& blocks, const std::function<void(double)>& progress)
+{
+  return computeGridQuality(blocks, std::vector<PeriodicSideLink>(), progress);
+}
+
+std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::function<void(double)>& progress)
 {
   double totalCells = 0.0;
   const std::vector<BlockView> views = blockViews(blocks, totalCells);
@@ -1606,11 +1926,31 @@ std::vector<CellQualityArrays> computeGridQuality(
     outputs[n] = { q.minAngle.data(), q.maxAngle.data(), q.nonOrthogonality.data(),
       q.skewness.data(), q.aspectRatio.data(), q.scaledJacobian.data() };
   }
-  evaluateBlocks(views, totalCells, outputs, progress);
+  evaluateBlocks(views, views.size(), totalCells, periodic, outputs, progress);
   return quality;
 }
 
 void computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress)
+{
+  computeGridQuality(blocks, std::vector<PeriodicSideLink>(), outputs, progress);
+}
+
+bool periodicSidesMatch(const std::vector<StructuredBlock>& blocks, const PeriodicSideLink& link)
+{
+  double totalCells = 0.0;
+  return linkMatches(blockViews(blocks, totalCells), link);
+}
+
+void computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
+  const std::function<void(double)>& progress)
+{
+  computeGridQuality(blocks, periodic, std::vector<NeighbourLayer>(), outputs, progress);
+}
+
+void computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::vector<NeighbourLayer>& neighbours,
   const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress)
 {
   if (outputs.size() != blocks.size())
@@ -1619,8 +1959,40 @@ void computeGridQuality(const std::vector<StructuredBlock>& blocks,
       " output buffers for " + std::to_string(blocks.size()) + " blocks");
   }
   double totalCells = 0.0;
-  const std::vector<BlockView> views = blockViews(blocks, totalCells);
-  evaluateBlocks(views, totalCells, outputs, progress);
+  std::vector<BlockView> views = blockViews(blocks, totalCells);
+  addNeighbourViews(views, neighbours);
+  evaluateBlocks(views, blocks.size(), totalCells, periodic, outputs, progress);
+}
+
+StructuredBlock sideLayer(const StructuredBlock& block, int side, std::vector<double>& nodes)
+{
+  if (side < 0 || side > 5 || block.ni < 2 || block.nj < 2 || block.nk < 2 || !block.xyz)
+  {
+    throw GeometryError("grid quality: no side " + std::to_string(side) + " to take a layer of");
+  }
+  int begin[3] = { 0, 0, 0 };
+  int count[3] = { block.ni, block.nj, block.nk };
+  const int axis = side / 2;
+  begin[axis] = side % 2 == 0 ? 0 : count[axis] - 2;
+  count[axis] = 2;
+  nodes.resize(3 * static_cast<std::size_t>(count[0]) * count[1] * count[2]);
+  double* out = nodes.data();
+  for (int k = 0; k < count[2]; ++k)
+  {
+    for (int j = 0; j < count[1]; ++j)
+    {
+      const double* row = block.xyz +
+        3 * (begin[0] + static_cast<long>(block.ni) * (begin[1] + j + static_cast<long>(block.nj) * (begin[2] + k)));
+      std::copy_n(row, 3 * static_cast<std::size_t>(count[0]), out);
+      out += 3 * count[0];
+    }
+  }
+  StructuredBlock layer;
+  layer.xyz = nodes.data();
+  layer.ni = count[0];
+  layer.nj = count[1];
+  layer.nk = count[2];
+  return layer;
 }
 
 void prepareOutputMemory(void* begin, std::size_t bytes)

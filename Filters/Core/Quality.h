@@ -8,7 +8,10 @@
  */
 #pragma once
 
+#include "FaceTransform.h"
 #include "Types.h"
+
+#include <Eigen/Core>
 
 #include <array>
 #include <functional>
@@ -29,7 +32,10 @@ double hexScaledJacobian(const std::array<Vec3, 8>& corners);
 /// 1e30 when a width is zero.
 double hexAspectRatio(const std::array<Vec3, 8>& corners);
 
-/// Cell centre (mean of the corners, as OpenFOAM's cell centre for a planar hex).
+/// Cell centre as OpenFOAM computes it (primitiveMesh::makeCellCentresAndVols): the
+/// volume-weighted centre of the pyramids from each face to the mean of the face centres,
+/// i.e. the volume centroid (not the mean of the corners, unless the cell is a
+/// parallelepiped). Collapsed faces are left out, as blockMesh drops them.
 Vec3 hexCentre(const std::array<Vec3, 8>& corners);
 
 /// Face area vector (sum of the triangle fan about the face centre) and face centre,
@@ -80,9 +86,29 @@ struct CellQualityArrays
 };
 
 /**
+ * Two block sides that are periodic images of each other: side `imageSide` of block
+ * `imageBlock` is side `sourceSide` of block `sourceBlock` rotated, x_image = origin +
+ * rotation (x_source - origin). Sides are 0..5 = i0 i1 j0 j1 k0 k1; `transform` maps a
+ * cell face (a, b) of the image side to the source side's (see FaceTransform.h).
+ * model::Topology::periodicSideLinks() gives them for a block model.
+ */
+struct PeriodicSideLink
+{
+  int sourceBlock = -1, sourceSide = -1;
+  int imageBlock = -1, imageSide = -1;
+  FaceTransform transform;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Vec3 origin = Vec3::Zero();
+};
+
+/// Whether `link` fits the grid: both blocks exist and have cells, the sides have the same
+/// cell counts under the transform and the rotated source side lands on the image side.
+bool periodicSidesMatch(const std::vector<StructuredBlock>& blocks, const PeriodicSideLink& link);
+
+/**
  * Computes all measures for every cell of every block. NonOrthogonality and Skewness of a
- * cell are the maxima over its faces; faces on a block boundary that coincide with a
- * face of another block (same four node coordinates, bit for bit) are treated as
+ * cell are the maxima over its faces, with OpenFOAM's cell centres (hexCentre); faces on
+ * a block boundary that coincide with a face of another block (same four node coordinates, bit for bit) are treated as
  * internal faces, so interfaces are measured like the interior. `progress` (may be
  * empty) is called with a fraction in [0, 1].
  *
@@ -102,6 +128,15 @@ struct CellQualityArrays
 std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBlock>& blocks,
   const std::function<void(double)>& progress = {});
 
+/**
+ * Same, with periodic sides measured like interfaces: across a periodic face, the
+ * neighbour is the partner cell with its centre rotated into this face's frame (as
+ * OpenFOAM's cyclic patches do), for non-orthogonality and skewness alike. Throws
+ * GeometryError when a link does not fit the grid (periodicSidesMatch).
+ */
+std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::function<void(double)>& progress = {});
+
 /// Caller-owned output buffers of one block, each with (ni-1)(nj-1)(nk-1) doubles.
 struct CellQualityPointers
 {
@@ -118,6 +153,36 @@ struct CellQualityPointers
 void computeGridQuality(const std::vector<StructuredBlock>& blocks,
   const std::vector<CellQualityPointers>& outputs,
   const std::function<void(double)>& progress = {});
+/// With periodic sides, into caller-owned buffers.
+void computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
+  const std::function<void(double)>& progress = {});
+
+/**
+ * Cells of a block that is measured elsewhere (on another MPI rank), next to its side
+ * `side` (0..5 = i0 i1 j0 j1 k0 k1): the block's two node layers at that side, in the
+ * block's own index order (sideLayer() copies them out). The measured blocks see that
+ * side as they would see the whole block's: a face coinciding with one of theirs is an
+ * interface, and a periodic link may name the layer. Cell centres next to the side are
+ * the whole block's bit for bit, so the measures equal those of a run with every block.
+ */
+struct NeighbourLayer
+{
+  StructuredBlock cells;
+  int side = -1;
+};
+
+/// The two node layers of `block` at `side` (see NeighbourLayer), copied into `nodes`.
+StructuredBlock sideLayer(const StructuredBlock& block, int side, std::vector<double>& nodes);
+
+/**
+ * With neighbour layers of blocks measured elsewhere: only `blocks` are measured (one
+ * output per block); periodic link block indices from blocks.size() on name
+ * neighbours[index - blocks.size()].
+ */
+void computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::vector<NeighbourLayer>& neighbours,
+  const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress = {});
 
 /// Advisory: asks the system to back a large fresh output buffer with huge pages and to
 /// fault it in at once. On virtual machines where a first-touch page fault costs ~10 us,

@@ -5,7 +5,9 @@
 #include "../Core/Projection.h"
 #include "../Core/Transfinite.h"
 #include "CarrierGeometry.h"
+#include "MemoryBudget.h"
 #include "ModelSyntax.h"
+#include "Topology.h"
 
 #include <Eigen/Geometry>
 
@@ -37,37 +39,7 @@ std::string blockEntity(const BlockModel& model, int block)
   return entity("block", model.blocks[block].name);
 }
 
-std::string faceText(const BlockModel& model, int block, int face)
-{
-  return model.blocks[block].name + "." + faceName(face);
-}
-
 using syntax::shortNumber;
-
-/// "w_ne-b_ne" or "'wall_n' (w_ne-b_ne)": how messages name the edge between a and b.
-std::string edgeText(const BlockModel& model, int a, int b)
-{
-  const std::string ends = model.vertices[a].name + "-" + model.vertices[b].name;
-  const int named = model.findEdge(a, b);
-  return named >= 0 ? "'" + model.edges[named].name + "' (" + ends + ")" : ends;
-}
-
-/// Model size for tolerances: the diagonal of the vertices' bounding box.
-double modelSize(const BlockModel& model)
-{
-  if (model.vertices.empty())
-  {
-    return 1.0;
-  }
-  Vec3 low = model.vertices[0].position, high = low;
-  for (const Vertex& vertex : model.vertices)
-  {
-    low = low.cwiseMin(vertex.position);
-    high = high.cwiseMax(vertex.position);
-  }
-  const double size = (high - low).norm();
-  return size > 0.0 ? size : 1.0;
-}
 
 // -------------------------------------------------------------------- edge geometry
 /// The curve of a named edge in its own direction (from -> to), with what it takes to
@@ -440,180 +412,68 @@ std::vector<double> reversedParameters(const std::vector<double>& params)
   return reversed;
 }
 
-// -------------------------------------------------------------------- face orientation
-/// Unit (a, b) coordinates of face corners 0..3 (see faceCorners()).
-const int CornerA[4] = { 0, 1, 1, 0 };
-const int CornerB[4] = { 0, 0, 1, 1 };
-
-/**
- * One of the 8 symmetries of a square, mapping a face grid index (a, b) as one block sees
- * it to the owner block's (a, b): bit 2 swaps a and b, then bits 0 and 1 flip a and b.
- */
-struct FaceTransform
+// -------------------------------------------------------------------- mesh topology
+/// A shared edge with its nodes: parameters in the canonical direction (from the first
+/// block that uses it) and coordinates.
+struct UniqueEdge : TopologyEdge
 {
-  int code = 0;
-  bool swap() const { return (code & 4) != 0; }
-  bool flipA() const { return (code & 1) != 0; }
-  bool flipB() const { return (code & 2) != 0; }
-  /// Owner index of (a, b); (ownerA, ownerB) are the owner's node counts.
-  void map(int a, int b, int ownerA, int ownerB, int& outA, int& outB) const
-  {
-    const int x = swap() ? b : a;
-    const int y = swap() ? a : b;
-    outA = flipA() ? ownerA - 1 - x : x;
-    outB = flipB() ? ownerB - 1 - y : y;
-  }
-  int mapCorner(int corner) const
-  {
-    int a = 0, b = 0;
-    map(CornerA[corner], CornerB[corner], 2, 2, a, b);
-    for (int c = 0; c < 4; ++c)
-    {
-      if (CornerA[c] == a && CornerB[c] == b)
-      {
-        return c;
-      }
-    }
-    return -1;
-  }
-};
-
-// -------------------------------------------------------------------- topology
-struct EdgeUse
-{
-  int block = -1;
-  int localEdge = -1;
-  bool reversed = false; ///< the block runs this edge from the higher vertex index
-};
-
-/// An edge shared by every block that uses it, in canonical direction a -> b (a < b).
-struct UniqueEdge
-{
-  int a = -1, b = -1;
-  int named = -1; ///< index into model.edges, -1 for a straight edge
-  int nodeCount = 0;
   double length = 0.0;
-  std::vector<double> params; ///< canonical direction, from the first block that uses it
-  std::vector<double> xyz;
-  std::vector<EdgeUse> uses;
-};
-
-struct FaceUse
-{
-  int block = -1;
-  int face = -1;
-  FaceTransform transform;
-};
-
-/// A face with at least three distinct vertices; its grid is stored in the orientation of
-/// its first block (the owner).
-struct UniqueFace
-{
-  std::array<int, 4> ownerIds{};
-  int na = 0, nb = 0;
-  std::vector<FaceUse> uses;
+  std::vector<double> params;
   std::vector<double> xyz;
 };
 
-struct BlockLinks
+/// A shared face with its grid, stored in the orientation of its owner.
+struct UniqueFace : TopologyFace
 {
-  std::array<int, 3> nodes{};
-  std::array<int, 12> edge{};      ///< unique edge, -1 when collapsed
-  std::array<bool, 12> reversed{};
+  std::vector<double> xyz;
+};
+
+struct MeshLinks : BlockLinks
+{
   std::array<std::vector<double>, 12> collapsedParams; ///< for collapsed edges only
-  std::array<int, 6> face{};       ///< unique face, -1 when collapsed to a line or point
-  std::array<FaceTransform, 6> transform{};
 };
 
-struct Topology
+/// The model's public topology with what the mesher adds to its edges, faces and blocks.
+struct MeshTopology
 {
+  Topology connectivity;
   std::vector<UniqueEdge> edges;
   std::vector<UniqueFace> faces;
-  std::vector<BlockLinks> blocks;
+  std::vector<MeshLinks> blocks;
 };
 
-int faceNodeCount(const BlockLinks& links, int face, int which)
-{
-  return links.nodes[faceDirections(face)[which]];
-}
-
-std::array<int, 4> faceVertexIds(const Block& block, int face)
-{
-  std::array<int, 4> ids{};
-  const std::array<int, 4> corners = faceCorners(face);
-  for (int c = 0; c < 4; ++c)
-  {
-    ids[c] = block.vertices[corners[c]];
-  }
-  return ids;
-}
-
-int distinctCount(std::array<int, 4> ids)
-{
-  std::sort(ids.begin(), ids.end());
-  return static_cast<int>(std::unique(ids.begin(), ids.end()) - ids.begin());
-}
-
 /**
- * Unique edges and faces of the model for the given node counts, with every consistency
- * check that depends on them: node counts and laws on shared edges, faces shared by more
- * than two blocks, faces that share vertices but do not match.
+ * The topology of the model for the given node counts (buildConnectivity's checks) with
+ * the node parameters of every edge, checked on shared edges: the same laws must put the
+ * nodes at the same places.
  */
-Topology buildTopology(const BlockModel& model, const std::vector<NamedCurve>& curves,
+MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedCurve>& curves,
   const std::vector<std::array<int, 3>>& nodes, bool allowFallback)
 {
-  Topology topology;
-  const int blockCount = static_cast<int>(model.blocks.size());
-  topology.blocks.resize(blockCount);
-  std::map<std::pair<int, int>, int> edgeIndex;
-
-  for (int b = 0; b < blockCount; ++b)
+  MeshTopology topology;
+  topology.connectivity = buildConnectivity(model, nodes);
+  for (const TopologyEdge& edge : topology.connectivity.edges)
   {
-    const Block& block = model.blocks[b];
-    BlockLinks& links = topology.blocks[b];
-    links.nodes = nodes[b];
-    for (int e = 0; e < 12; ++e)
-    {
-      const std::array<int, 2> ends = edgeVertices(e);
-      const int from = block.vertices[ends[0]], to = block.vertices[ends[1]];
-      const int count = links.nodes[edgeDirection(e)];
-      if (from == to)
-      {
-        links.edge[e] = -1;
-        continue;
-      }
-      const std::pair<int, int> key(std::min(from, to), std::max(from, to));
-      auto found = edgeIndex.find(key);
-      if (found == edgeIndex.end())
-      {
-        UniqueEdge edge;
-        edge.a = key.first;
-        edge.b = key.second;
-        edge.named = model.findEdge(edge.a, edge.b);
-        edge.nodeCount = count;
-        edge.length = edge.named >= 0
-          ? curves[edge.named].length
-          : (model.vertices[edge.b].position - model.vertices[edge.a].position).norm();
-        found = edgeIndex.emplace(key, static_cast<int>(topology.edges.size())).first;
-        topology.edges.push_back(std::move(edge));
-      }
-      UniqueEdge& edge = topology.edges[found->second];
-      if (edge.nodeCount != count)
-      {
-        const EdgeUse& first = edge.uses.front();
-        fail(block.where, blockEntity(model, b),
-          "edge " + edgeText(model, from, to) + " (" + syntax::edgeLabel(e) + ") has " +
-            std::to_string(count - 1) + " cells here but " + std::to_string(edge.nodeCount - 1) +
-            " in block '" + model.blocks[first.block].name + "' (" +
-            syntax::edgeLabel(first.localEdge) +
-            "); blocks sharing an edge need the same cell count along it");
-      }
-      edge.uses.push_back(EdgeUse{ b, e, from > to });
-      links.edge[e] = found->second;
-      links.reversed[e] = from > to;
-    }
+    UniqueEdge unique;
+    static_cast<TopologyEdge&>(unique) = edge;
+    unique.length = edge.named >= 0
+      ? curves[edge.named].length
+      : (model.vertices[edge.b].position - model.vertices[edge.a].position).norm();
+    topology.edges.push_back(std::move(unique));
   }
-
+  for (const TopologyFace& face : topology.connectivity.faces)
+  {
+    UniqueFace unique;
+    static_cast<TopologyFace&>(unique) = face;
+    topology.faces.push_back(std::move(unique));
+  }
+  for (const BlockLinks& links : topology.connectivity.blocks)
+  {
+    MeshLinks mesh;
+    static_cast<BlockLinks&>(mesh) = links;
+    topology.blocks.push_back(std::move(mesh));
+  }
+  const int blockCount = static_cast<int>(model.blocks.size());
   // Node parameters: the first block's law defines the edge; every other block must give
   // the same parameters, compared in the edge's canonical direction.
   for (UniqueEdge& edge : topology.edges)
@@ -670,7 +530,7 @@ Topology buildTopology(const BlockModel& model, const std::vector<NamedCurve>& c
   // inside the block: take the block's law over the length of the longest parallel edge.
   for (int b = 0; b < blockCount; ++b)
   {
-    BlockLinks& links = topology.blocks[b];
+    MeshLinks& links = topology.blocks[b];
     for (int e = 0; e < 12; ++e)
     {
       if (links.edge[e] >= 0)
@@ -692,77 +552,6 @@ Topology buildTopology(const BlockModel& model, const std::vector<NamedCurve>& c
     }
   }
 
-  std::map<std::array<int, 4>, int> faceIndex;
-  for (int b = 0; b < blockCount; ++b)
-  {
-    const Block& block = model.blocks[b];
-    BlockLinks& links = topology.blocks[b];
-    for (int f = 0; f < 6; ++f)
-    {
-      const std::array<int, 4> ids = faceVertexIds(block, f);
-      links.face[f] = -1;
-      if (distinctCount(ids) < 3)
-      {
-        continue;
-      }
-      std::array<int, 4> key = ids;
-      std::sort(key.begin(), key.end());
-      auto found = faceIndex.find(key);
-      const int na = faceNodeCount(links, f, 0), nb = faceNodeCount(links, f, 1);
-      if (found == faceIndex.end())
-      {
-        UniqueFace face;
-        face.ownerIds = ids;
-        face.na = na;
-        face.nb = nb;
-        face.uses.push_back(FaceUse{ b, f, FaceTransform{ 0 } });
-        faceIndex.emplace(key, static_cast<int>(topology.faces.size()));
-        links.face[f] = static_cast<int>(topology.faces.size());
-        topology.faces.push_back(std::move(face));
-        continue;
-      }
-      UniqueFace& face = topology.faces[found->second];
-      const FaceUse& owner = face.uses.front();
-      if (face.uses.size() >= 2)
-      {
-        std::string blocks;
-        for (const FaceUse& use : face.uses)
-        {
-          blocks += faceText(model, use.block, use.face) + ", ";
-        }
-        fail(block.where, blockEntity(model, b),
-          "face " + faceText(model, b, f) + " is also a face of " + blocks +
-            "but a face can join at most two blocks");
-      }
-      bool matched = false;
-      for (int code = 0; code < 8 && !matched; ++code)
-      {
-        const FaceTransform transform{ code };
-        bool same = true;
-        for (int c = 0; c < 4 && same; ++c)
-        {
-          same = face.ownerIds[transform.mapCorner(c)] == ids[c];
-        }
-        const int mappedA = transform.swap() ? nb : na;
-        const int mappedB = transform.swap() ? na : nb;
-        if (same && mappedA == face.na && mappedB == face.nb)
-        {
-          face.uses.push_back(FaceUse{ b, f, transform });
-          links.face[f] = found->second;
-          links.transform[f] = transform;
-          matched = true;
-        }
-      }
-      if (!matched)
-      {
-        fail(block.where, blockEntity(model, b),
-          "face " + faceText(model, b, f) + " has the same vertices as face " +
-            faceText(model, owner.block, owner.face) +
-            " but the two do not match edge for edge (or differ in node counts); check the "
-            "vertex order of both blocks");
-      }
-    }
-  }
   return topology;
 }
 
@@ -948,7 +737,7 @@ void checkBasics(const BlockModel& model)
 }
 
 /// Named edges must lie on some block edge, or they are almost certainly a typo.
-void checkNamedEdgesUsed(const BlockModel& model, const Topology& topology)
+void checkNamedEdgesUsed(const BlockModel& model, const MeshTopology& topology)
 {
   std::vector<bool> used(model.edges.size(), false);
   for (const UniqueEdge& edge : topology.edges)
@@ -970,160 +759,6 @@ void checkNamedEdgesUsed(const BlockModel& model, const Topology& topology)
   }
 }
 
-Eigen::Matrix3d periodicRotation(const Patch& patch)
-{
-  return Eigen::AngleAxisd(patch.periodicAngle, patch.periodicAxis.normalized())
-    .toRotationMatrix();
-}
-
-void checkPatches(const BlockModel& model, const Topology& topology, double size)
-{
-  const int blockCount = static_cast<int>(model.blocks.size());
-  std::map<std::pair<int, int>, int> patchOfFace;
-  for (int p = 0; p < static_cast<int>(model.patches.size()); ++p)
-  {
-    const Patch& patch = model.patches[p];
-    const std::string entityText = entity("patch", patch.name);
-    for (const BlockFace& face : patch.faces)
-    {
-      if (face.block < 0 || face.block >= blockCount || face.face < 0 || face.face > 5)
-      {
-        fail(patch.where, entityText, "refers to a face that does not exist");
-      }
-      const std::string name = faceText(model, face.block, face.face);
-      const int unique = topology.blocks[face.block].face[face.face];
-      if (unique < 0)
-      {
-        fail(patch.where, entityText,
-          "face " + name + " is collapsed to a line or a point and cannot be a patch face");
-      }
-      const std::vector<FaceUse>& uses = topology.faces[unique].uses;
-      if (uses.size() > 1)
-      {
-        const FaceUse& other =
-          uses[0].block == face.block && uses[0].face == face.face ? uses[1] : uses[0];
-        fail(patch.where, entityText,
-          "face " + name + " is internal (it is also face " +
-            faceText(model, other.block, other.face) +
-            "); patch faces must lie on the domain boundary");
-      }
-      const auto inserted = patchOfFace.emplace(std::make_pair(face.block, face.face), p);
-      if (!inserted.second)
-      {
-        const int other = inserted.first->second;
-        fail(patch.where, entityText,
-          other == p ? "face " + name + " is listed twice"
-                     : "face " + name + " is already in patch '" + model.patches[other].name +
-              "'; a face belongs to at most one patch");
-      }
-    }
-  }
-
-  const double tolerance = 1e-9 * size;
-  for (const Patch& patch : model.patches)
-  {
-    if (patch.type != "periodic")
-    {
-      continue;
-    }
-    const std::string entityText = entity("patch", patch.name);
-    const auto partnerIt = std::find_if(model.patches.begin(), model.patches.end(),
-      [&](const Patch& other) { return other.name == patch.periodicPartner; });
-    if (patch.periodicPartner.empty() || partnerIt == model.patches.end())
-    {
-      fail(patch.where, entityText,
-        patch.periodicPartner.empty()
-          ? std::string("a periodic patch needs a partner")
-          : "periodic partner '" + patch.periodicPartner + "' does not exist");
-    }
-    const Patch& partner = *partnerIt;
-    if (partner.type != "periodic" || partner.periodicPartner != patch.name)
-    {
-      fail(patch.where, entityText,
-        "periodic partner '" + partner.name + "' must be periodic and name '" + patch.name +
-          "' as its partner");
-    }
-    if (!patch.periodicAxis.allFinite() || !(patch.periodicAxis.norm() > 0.0) ||
-      !patch.periodicAxisPoint.allFinite() || !std::isfinite(patch.periodicAngle))
-    {
-      fail(patch.where, entityText, "the periodic rotation (axis, origin, angle) is invalid");
-    }
-    if (partner.faces.size() != patch.faces.size())
-    {
-      fail(patch.where, entityText,
-        "has " + std::to_string(patch.faces.size()) + " faces but its periodic partner '" +
-          partner.name + "' has " + std::to_string(partner.faces.size()));
-    }
-    const Eigen::Matrix3d rotation = periodicRotation(patch);
-    std::vector<bool> taken(partner.faces.size(), false);
-    for (const BlockFace& face : patch.faces)
-    {
-      const std::array<int, 4> ids = faceVertexIds(model.blocks[face.block], face.face);
-      std::array<Vec3, 4> image;
-      for (int c = 0; c < 4; ++c)
-      {
-        image[c] = patch.periodicAxisPoint +
-          rotation * (model.vertices[ids[c]].position - patch.periodicAxisPoint);
-      }
-      const UniqueFace& grid = topology.faces[topology.blocks[face.block].face[face.face]];
-      int match = -1;
-      double nearest = std::numeric_limits<double>::infinity();
-      for (std::size_t q = 0; q < partner.faces.size() && match < 0; ++q)
-      {
-        const BlockFace& candidate = partner.faces[q];
-        const std::array<int, 4> other =
-          faceVertexIds(model.blocks[candidate.block], candidate.face);
-        double worst = 0.0;
-        for (int c = 0; c < 4; ++c)
-        {
-          double best = std::numeric_limits<double>::infinity();
-          for (int d = 0; d < 4; ++d)
-          {
-            best = std::min(best, (image[c] - model.vertices[other[d]].position).norm());
-          }
-          worst = std::max(worst, best);
-        }
-        nearest = std::min(nearest, worst);
-        if (worst <= tolerance && !taken[q])
-        {
-          match = static_cast<int>(q);
-        }
-      }
-      const std::string name = faceText(model, face.block, face.face);
-      if (match < 0)
-      {
-        fail(patch.where, entityText,
-          "face " + name + " rotated by " + shortNumber(patch.periodicAngle * 180.0 / Pi) +
-            " deg does not land on a face of periodic partner '" + partner.name +
-            "' (nearest miss " + shortNumber(nearest) + "); check axis, origin and angle");
-      }
-      taken[match] = true;
-      const BlockFace& image_face = partner.faces[match];
-      const UniqueFace& other =
-        topology.faces[topology.blocks[image_face.block].face[image_face.face]];
-      if (std::min(grid.na, grid.nb) != std::min(other.na, other.nb) ||
-        std::max(grid.na, grid.nb) != std::max(other.na, other.nb))
-      {
-        fail(patch.where, entityText,
-          "face " + name + " has " + std::to_string(grid.na - 1) + " x " +
-            std::to_string(grid.nb - 1) + " cells but its periodic image " +
-            faceText(model, image_face.block, image_face.face) + " has " +
-            std::to_string(other.na - 1) + " x " + std::to_string(other.nb - 1));
-      }
-    }
-  }
-}
-
-std::vector<std::array<int, 3>> baseNodeCounts(const BlockModel& model)
-{
-  std::vector<std::array<int, 3>> nodes;
-  for (const Block& block : model.blocks)
-  {
-    nodes.push_back({ block.cells[0] + 1, block.cells[1] + 1, block.cells[2] + 1 });
-  }
-  return nodes;
-}
-
 // -------------------------------------------------------------------- grids
 /// Nodes of one edge as a block sees it (its local direction), possibly borrowed.
 struct LocalEdge
@@ -1141,9 +776,9 @@ struct LocalEdge
 };
 
 LocalEdge localEdge(
-  const BlockModel& model, const Topology& topology, int block, int localEdgeIndex)
+  const BlockModel& model, const MeshTopology& topology, int block, int localEdgeIndex)
 {
-  const BlockLinks& links = topology.blocks[block];
+  const MeshLinks& links = topology.blocks[block];
   LocalEdge local;
   local.count = links.nodes[edgeDirection(localEdgeIndex)];
   const int unique = links.edge[localEdgeIndex];
@@ -1184,7 +819,7 @@ LocalEdge localEdge(
  * right-handed frame. This is the real shape of the corner cells, whatever the curvature
  * of the edges; corners where an edge is collapsed (wedges) are skipped.
  */
-void checkCornerCells(const BlockModel& model, const Topology& topology, double size)
+void checkCornerCells(const BlockModel& model, const MeshTopology& topology, double size)
 {
   for (int b = 0; b < static_cast<int>(model.blocks.size()); ++b)
   {
@@ -1221,7 +856,7 @@ void checkCornerCells(const BlockModel& model, const Topology& topology, double 
 }
 
 /// Face grid of `face` of `block` in the block's own orientation, from its four edges.
-void faceFromEdges(const BlockModel& model, const Topology& topology, int block, int face,
+void faceFromEdges(const BlockModel& model, const MeshTopology& topology, int block, int face,
   std::vector<double>& out)
 {
   const std::array<int, 4> edges = faceEdges(face);
@@ -1284,7 +919,7 @@ void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& cu
   }
 }
 
-std::map<std::pair<int, int>, int> edgeLookup(const Topology& topology)
+std::map<std::pair<int, int>, int> edgeLookup(const MeshTopology& topology)
 {
   std::map<std::pair<int, int>, int> lookup;
   for (std::size_t e = 0; e < topology.edges.size(); ++e)
@@ -1305,7 +940,7 @@ int findUniqueEdge(const std::map<std::pair<int, int>, int>& lookup, int a, int 
  * `source` (running sourceFrom -> sourceTo): interior nodes rotated, end nodes the vertices
  * themselves. The node parameters of both must agree (the same grading).
  */
-void rotateEdgeNodes(const BlockModel& model, Topology& topology, int source, int sourceFrom,
+void rotateEdgeNodes(const BlockModel& model, MeshTopology& topology, int source, int sourceFrom,
   int image, int imageFrom, const Vec3& axisPoint, const Vec3& axis, double angle,
   const SourceLocation& where, const std::string& entityText)
 {
@@ -1350,7 +985,7 @@ void rotateEdgeNodes(const BlockModel& model, Topology& topology, int source, in
 }
 
 /// Named periodic edges: rotated copies of their source edges.
-void computePeriodicEdges(const BlockModel& model, Topology& topology)
+void computePeriodicEdges(const BlockModel& model, MeshTopology& topology)
 {
   const auto lookup = edgeLookup(topology);
   for (std::size_t e = 0; e < topology.edges.size(); ++e)
@@ -1374,107 +1009,11 @@ void computePeriodicEdges(const BlockModel& model, Topology& topology)
   }
 }
 
-/// A face of a periodic patch whose grid is the rotation of a face of its partner.
-struct PeriodicImage
-{
-  int source = -1, image = -1; ///< unique faces
-  FaceTransform transform;     ///< image owner (a, b) -> source owner (a, b)
-  Vec3 axisPoint, axis;
-  double angle = 0.0;
-  int patch = -1;              ///< the patch the source face belongs to
-};
-
-/**
- * For every periodic pair, the faces of the later patch are images of the faces of the
- * earlier one (rotated by the earlier patch's angle).
- */
-std::vector<PeriodicImage> periodicImages(const BlockModel& model, const Topology& topology, double size)
-{
-  std::vector<PeriodicImage> images;
-  const double tolerance = 1e-9 * size;
-  const int count = static_cast<int>(model.patches.size());
-  for (int p = 0; p < count; ++p)
-  {
-    const Patch& patch = model.patches[p];
-    if (patch.type != "periodic")
-    {
-      continue;
-    }
-    int partner = -1;
-    for (int q = 0; q < count; ++q)
-    {
-      if (model.patches[q].name == patch.periodicPartner)
-      {
-        partner = q;
-      }
-    }
-    if (partner <= p)
-    {
-      continue; // the pair is handled from its first patch
-    }
-    const std::string entityText = entity("patch", model.patches[partner].name);
-    for (const BlockFace& face : patch.faces)
-    {
-      const int source = topology.blocks[face.block].face[face.face];
-      const UniqueFace& from = topology.faces[source];
-      std::array<Vec3, 4> rotated;
-      for (int c = 0; c < 4; ++c)
-      {
-        rotated[c] = rotateAboutAxis(model.vertices[from.ownerIds[c]].position,
-          patch.periodicAxisPoint, patch.periodicAxis.normalized(), patch.periodicAngle);
-      }
-      bool found = false;
-      for (const BlockFace& other : model.patches[partner].faces)
-      {
-        const int image = topology.blocks[other.block].face[other.face];
-        const UniqueFace& to = topology.faces[image];
-        for (int code = 0; code < 8 && !found; ++code)
-        {
-          const FaceTransform transform{ code };
-          bool same = true;
-          for (int c = 0; c < 4 && same; ++c)
-          {
-            same = (rotated[transform.mapCorner(c)] - model.vertices[to.ownerIds[c]].position)
-                     .norm() <= tolerance;
-          }
-          const int mappedA = transform.swap() ? to.nb : to.na;
-          const int mappedB = transform.swap() ? to.na : to.nb;
-          if (same && mappedA == from.na && mappedB == from.nb)
-          {
-            PeriodicImage entry;
-            entry.source = source;
-            entry.image = image;
-            entry.transform = transform;
-            entry.axisPoint = patch.periodicAxisPoint;
-            entry.axis = patch.periodicAxis.normalized();
-            entry.angle = patch.periodicAngle;
-            entry.patch = p;
-            images.push_back(entry);
-            found = true;
-          }
-        }
-        if (found)
-        {
-          break;
-        }
-      }
-      if (!found)
-      {
-        fail(model.patches[partner].where, entityText,
-          "no face matches the rotation of face " + faceText(model, face.block, face.face) +
-            " of periodic partner '" + patch.name + "' node for node");
-      }
-    }
-  }
-  return images;
-}
-
 /// The edges of every periodic image face: rotations of the source face's edges.
-void computePeriodicPatchEdges(const BlockModel& model, Topology& topology,
-  const std::vector<PeriodicImage>& images)
+void computePeriodicPatchEdges(const BlockModel& model, MeshTopology& topology)
 {
   const auto lookup = edgeLookup(topology);
-  for (const PeriodicImage& entry : images)
+  for (const PeriodicPair& entry : topology.connectivity.periodic)
   {
     const UniqueFace& from = topology.faces[entry.source];
     const UniqueFace& to = topology.faces[entry.image];
@@ -1501,7 +1040,7 @@ void computePeriodicPatchEdges(const BlockModel& model, Topology& topology,
 }
 
 /// Copies the boundary nodes of a face grid from its block's edges (bit for bit).
-void copyFaceBoundary(const BlockModel& model, const Topology& topology, int block, int face,
+void copyFaceBoundary(const BlockModel& model, const MeshTopology& topology, int block, int face,
   int na, int nb, std::vector<double>& grid);
 
 /**
@@ -1552,7 +1091,7 @@ void closestNear(const CarrierGeometry& geometry, int carrier, const Vec3& targe
 /// the TFI node in the surface's (s, t) space. TFI in (s, t) alone follows the
 /// parametrisation, which is far from even on a blade (aligned sections crowd the round
 /// edges into small s ranges): at high densities it put nodes behind their neighbours.
-void surfaceFace(const BlockModel& model, const Topology& topology, const CarrierGeometry& geometry,
+void surfaceFace(const BlockModel& model, const MeshTopology& topology, const CarrierGeometry& geometry,
   int carrier, int block, int face, std::vector<double>& out)
 {
   const std::array<int, 4> edges = faceEdges(face);
@@ -1641,7 +1180,7 @@ void surfaceFace(const BlockModel& model, const Topology& topology, const Carrie
   copyFaceBoundary(model, topology, block, face, na, nb, out);
 }
 
-void copyFaceBoundary(const BlockModel& model, const Topology& topology, int block, int face,
+void copyFaceBoundary(const BlockModel& model, const MeshTopology& topology, int block, int face,
   int na, int nb, std::vector<double>& grid)
 {
   const std::array<int, 4> edges = faceEdges(face);
@@ -1662,7 +1201,7 @@ void copyFaceBoundary(const BlockModel& model, const Topology& topology, int blo
 }
 
 /// Grid of a periodic image face: the source face's nodes rotated; boundary from its edges.
-void periodicFace(const BlockModel& model, const Topology& topology, const PeriodicImage& entry,
+void periodicFace(const BlockModel& model, const MeshTopology& topology, const PeriodicPair& entry,
   std::vector<double>& out)
 {
   const UniqueFace& from = topology.faces[entry.source];
@@ -1684,7 +1223,7 @@ void periodicFace(const BlockModel& model, const Topology& topology, const Perio
 }
 
 /// Unique face -> surface carrier of the model's surface face sets.
-std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const Topology& topology)
+std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopology& topology)
 {
   std::map<int, int> carriers;
   for (const SurfaceFaces& set : model.surfaceFaces)
@@ -1789,7 +1328,7 @@ void checkCarriers(const BlockModel& model, const CarrierGeometry& geometry, dou
 }
 
 void checkSurfaceFaces(const BlockModel& model, const CarrierGeometry& geometry,
-  const Topology& topology, double size)
+  const MeshTopology& topology, double size)
 {
   const int carrierCount = static_cast<int>(model.carriers.size());
   for (const SurfaceFaces& set : model.surfaceFaces)
@@ -1809,7 +1348,7 @@ void checkSurfaceFaces(const BlockModel& model, const CarrierGeometry& geometry,
       if (topology.blocks[face.block].face[face.face] < 0)
       {
         fail(set.where, entityText,
-          "face " + faceText(model, face.block, face.face) + " is collapsed to a line or a point");
+          "face " + blockFaceText(model, face.block, face.face) + " is collapsed to a line or a point");
       }
       for (int corner : faceVertexIds(model.blocks[face.block], face.face))
       {
@@ -1819,7 +1358,7 @@ void checkSurfaceFaces(const BlockModel& model, const CarrierGeometry& geometry,
         {
           fail(set.where, entityText,
             "corner '" + model.vertices[corner].name + "' of face " +
-              faceText(model, face.block, face.face) + " is " + shortNumber(distance) +
+              blockFaceText(model, face.block, face.face) + " is " + shortNumber(distance) +
               " away from surface '" + model.carriers[set.carrier].name + "'");
         }
       }
@@ -1835,12 +1374,12 @@ void checkModelWith(const BlockModel& model, const CarrierGeometry& geometry)
   const double size = modelSize(model);
   checkCarriers(model, geometry, size);
   const std::vector<NamedCurve> curves = buildNamedCurves(model, geometry);
-  const Topology topology = buildTopology(model, curves, baseNodeCounts(model), false);
+  MeshTopology topology = buildMeshTopology(model, curves, baseNodeCounts(model), false);
   checkNamedEdgesUsed(model, topology);
   checkSurfaceFaces(model, geometry, topology, size);
   checkOrientation(model, curves, size);
-  checkPatches(model, topology, size);
-  periodicImages(model, topology, size); // the rotated copies must match node for node
+  checkPatches(model, topology.connectivity);
+  findPeriodicPairs(model, topology.connectivity); // the rotated copies must match node for node
 }
 } // namespace
 
@@ -1864,7 +1403,7 @@ struct MultiBlockMesher::Impl
   int Cap = 0;
   CarrierGeometry Geometry;
   std::vector<NamedCurve> Curves;
-  Topology Topo;
+  MeshTopology Topo;
   bool Ready = false;
 
   std::array<int, 3> nodeCounts(int block) const
@@ -1872,8 +1411,9 @@ struct MultiBlockMesher::Impl
     std::array<int, 3> nodes{};
     for (int d = 0; d < 3; ++d)
     {
+      // validated in the constructor: at most MaxScaledCellsPerDirection
       const double scaled = std::round(Model.blocks[block].cells[d] * Multiplier);
-      int cells = static_cast<int>(std::max(1.0, std::min(scaled, 1.0e6)));
+      int cells = static_cast<int>(std::max(1.0, scaled));
       if (Cap > 0)
       {
         cells = std::min(cells, Cap);
@@ -1899,12 +1439,7 @@ MultiBlockMesher::MultiBlockMesher(
   const BlockModel& model, const CarrierGeometry* carriers, double densityMultiplier)
   : P(new Impl)
 {
-  if (!std::isfinite(densityMultiplier) || !(densityMultiplier > 0.0))
-  {
-    throw TemplateError(model.sourceFile, 0, entity("model", model.name),
-      "the density multiplier must be a positive number, got " +
-        formatNumber(densityMultiplier));
-  }
+  checkDensityMultiplier(model, densityMultiplier);
   checkBasics(model);
   P->Model = model;
   P->Multiplier = densityMultiplier;
@@ -1935,8 +1470,8 @@ void MultiBlockMesher::computeBoundaries()
     nodes.push_back(P->nodeCounts(b));
   }
   const bool countsChanged = nodes != baseNodeCounts(model);
-  P->Topo = buildTopology(model, P->Curves, nodes, countsChanged);
-  Topology& topology = P->Topo;
+  P->Topo = buildMeshTopology(model, P->Curves, nodes, countsChanged);
+  MeshTopology& topology = P->Topo;
   for (UniqueEdge& edge : topology.edges)
   {
     computeEdgeNodes(model, P->Curves, P->Geometry, edge);
@@ -1944,11 +1479,12 @@ void MultiBlockMesher::computeBoundaries()
   // Periodic copies: named periodic edges, then the edges and faces of every periodic
   // patch's partner, rotated node for node from the first patch of the pair.
   computePeriodicEdges(model, topology);
-  const std::vector<PeriodicImage> images = periodicImages(model, topology, modelSize(model));
-  computePeriodicPatchEdges(model, topology, images);
+  findPeriodicPairs(model, topology.connectivity);
+  const std::vector<PeriodicPair>& images = topology.connectivity.periodic;
+  computePeriodicPatchEdges(model, topology);
   checkCornerCells(model, topology, modelSize(model));
-  std::map<int, const PeriodicImage*> imageOf;
-  for (const PeriodicImage& entry : images)
+  std::map<int, const PeriodicPair*> imageOf;
+  for (const PeriodicPair& entry : images)
   {
     imageOf[entry.image] = &entry;
   }
@@ -1976,14 +1512,23 @@ void MultiBlockMesher::computeBoundaries()
     catch (const GeometryError& error)
     {
       fail(model.blocks[owner.block].where, blockEntity(model, owner.block),
-        "face " + faceText(model, owner.block, owner.face) + ": " + error.what());
+        "face " + blockFaceText(model, owner.block, owner.face) + ": " + error.what());
     }
   }
-  for (const PeriodicImage& entry : images)
+  for (const PeriodicPair& entry : images)
   {
     periodicFace(model, topology, entry, topology.faces[entry.image].xyz);
   }
   P->Ready = true;
+}
+
+const Topology& MultiBlockMesher::topology() const
+{
+  if (!P->Ready)
+  {
+    throw std::logic_error("MultiBlockMesher::topology: call computeBoundaries() first");
+  }
+  return P->Topo.connectivity;
 }
 
 int MultiBlockMesher::blockCount() const
@@ -2007,8 +1552,8 @@ void MultiBlockMesher::meshBlock(int block, double* out) const
     throw std::out_of_range("MultiBlockMesher::meshBlock: no block " + std::to_string(block));
   }
   const BlockModel& model = P->Model;
-  const Topology& topology = P->Topo;
-  const BlockLinks& links = topology.blocks[block];
+  const MeshTopology& topology = P->Topo;
+  const MeshLinks& links = topology.blocks[block];
 
   BlockBoundary boundary;
   std::array<std::vector<double>, 6> faceStorage;

@@ -10,7 +10,8 @@
 
 #include "BlockModel.h"
 #include "CarrierGeometry.h"
-#include "Template.h"
+#include "Errors.h"
+#include "Topology.h"
 
 #include <functional>
 #include <memory>
@@ -50,7 +51,10 @@ class MultiBlockMesher
 {
 public:
   /// `densityMultiplier` scales every cell count: cells = max(1, round(cells * m)).
-  /// Calls checkModel(); throws TemplateError on any problem.
+  /// Calls checkModel(); throws TemplateError on any problem, also when the multiplier is
+  /// not in (0, MaxDensityMultiplier] or a scaled count exceeds MaxScaledCellsPerDirection
+  /// (checkDensityMultiplier; errors, not clamps: the user asked for something else than
+  /// what would be meshed).
   MultiBlockMesher(const BlockModel& model, double densityMultiplier = 1.0);
   /// Same with the model's carriers already built (loadTemplate's `carriers`).
   MultiBlockMesher(const BlockModel& model, const CarrierGeometry& carriers,
@@ -71,6 +75,9 @@ public:
   const CarrierGeometry& carriers() const;
   /// Node counts (ni, nj, nk) of block b.
   std::array<int, 3> nodeCounts(int block) const;
+  /// The model's topology at the mesher's node counts (shared edges and faces, interfaces,
+  /// periodic pairs, patches). computeBoundaries() must have been called.
+  const Topology& topology() const;
   /// Writes the nodes of block b (ni*nj*nk*3 doubles, i fastest) into `out`.
   /// computeBoundaries() must have been called. Thread-safe for different blocks.
   void meshBlock(int block, double* out) const;

@@ -1,7 +1,7 @@
 #include "ModelDocument.h"
 
 #include "ModelSyntax.h"
-#include "Template.h"
+#include "Errors.h"
 
 #include <algorithm>
 #include <cmath>

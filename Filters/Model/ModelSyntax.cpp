@@ -1,6 +1,6 @@
 #include "ModelSyntax.h"
 
-#include "Template.h"
+#include "Errors.h"
 
 #include <algorithm>
 #include <charconv>

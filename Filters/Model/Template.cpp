@@ -21,38 +21,12 @@
 #include <set>
 #include <sstream>
 
+#include <sys/stat.h>
+
 namespace blockforge
 {
 namespace model
 {
-namespace
-{
-std::string composeMessage(
-  const std::string& file, int line, const std::string& entity, const std::string& message)
-{
-  std::string text = file.empty() ? std::string("<template>") : file;
-  if (line > 0)
-  {
-    text += ":" + std::to_string(line);
-  }
-  text += ": ";
-  if (!entity.empty())
-  {
-    text += entity + ": ";
-  }
-  return text + message;
-}
-} // namespace
-
-TemplateError::TemplateError(const std::string& file, int line, const std::string& entity,
-  const std::string& message)
-  : std::runtime_error(composeMessage(file, line, entity, message))
-  , File(file)
-  , Entity(entity)
-  , Line(line)
-{
-}
-
 namespace
 {
 using syntax::entity;
@@ -64,6 +38,7 @@ constexpr int TemplateFormatVersion = 2;
 constexpr double Pi = 3.14159265358979323846;
 /// Cells per block direction; keeps node arrays well inside int range.
 constexpr double MaxCellsPerDirection = 1.0e6;
+constexpr double MaxBladeCount = 1.0e5;
 
 /// Failure of one expression, in user terms; the caller adds file, line and entity.
 struct ExpressionError
@@ -613,7 +588,13 @@ private:
     YAML::Node root;
     try
     {
-      root = YAML::Load(Text);
+      const std::vector<YAML::Node> documents = YAML::LoadAll(Text);
+      if (documents.size() > 1)
+      {
+        fail(documents[1].Mark().line >= 0 ? documents[1].Mark().line + 1 : 0, "",
+          "a second YAML document (after '---' or '...'): a template is one document");
+      }
+      root = documents.empty() ? YAML::Node() : documents.front();
     }
     catch (const YAML::Exception& error)
     {
@@ -1483,7 +1464,7 @@ private:
       if (const MapEntry* count = syntax::findEntry(keys, "blade_count"))
       {
         bladeCount = number(count->value, count->line, entityText, "blade_count");
-        if (bladeCount != std::floor(bladeCount) || bladeCount < 1 || bladeCount > 100000)
+        if (bladeCount != std::floor(bladeCount) || bladeCount < 1 || bladeCount > MaxBladeCount)
         {
           fail(count->line, entityText, "blade_count must be a whole number from 1 to 100000");
         }
@@ -1497,6 +1478,12 @@ private:
     if (Inputs && Inputs->bladeCount > 0)
     {
       bladeCount = Inputs->bladeCount;
+      if (bladeCount > MaxBladeCount)
+      {
+        fail(0, "machine",
+          Inputs->origin + " gives blade count " + std::to_string(Inputs->bladeCount) +
+            "; the blade count must be a whole number from 1 to 100000");
+      }
     }
     machine.bladeCount = static_cast<int>(bladeCount);
     Evaluator.define("axis_x", machine.axis.x());
@@ -2826,7 +2813,8 @@ private:
     const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
     double c = b - ratio * (b - a), d = a + ratio * (b - a);
     double fc = f(c), fd = f(d);
-    while (b - a > 1e-14)
+    // bounded: far from 0 the bracket stops shrinking at the spacing of doubles
+    for (int iteration = 0; b - a > 1e-14 && iteration < 200; ++iteration)
     {
       if (fc < fd)
       {
@@ -2935,7 +2923,7 @@ private:
       }
       double a = std::max(0.0, (best - 1.0) / samples), b = std::min(1.0, (best + 1.0) / samples);
       const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-      while (b - a > 1e-15)
+      for (int iteration = 0; b - a > 1e-15 && iteration < 200; ++iteration)
       {
         const double c = b - ratio * (b - a), d = a + ratio * (b - a);
         if (f(c) < f(d))
@@ -3604,8 +3592,19 @@ private:
   std::vector<ParameterInfo> Infos;
 };
 
+/// Templates are a few kilobytes; this bound keeps /dev/zero or a grid picked by mistake
+/// from being read until memory runs out.
+constexpr std::size_t MaxTemplateBytes = 16u << 20;
+
+/// The template's text with line ends made "\n" (Windows "\r\n" and old Mac lone "\r",
+/// which YAML would otherwise read as one long line).
 std::string readFile(const std::string& path)
 {
+  struct stat status;
+  if (::stat(path.c_str(), &status) == 0 && S_ISDIR(status.st_mode))
+  {
+    throw TemplateError(path, 0, "", "'" + path + "' is a folder, not a template file");
+  }
   std::ifstream stream(path, std::ios::binary);
   if (!stream)
   {
@@ -3614,9 +3613,38 @@ std::string readFile(const std::string& path)
       "cannot open template file '" + path + "'" +
         (error ? std::string(": ") + std::strerror(error) : std::string()));
   }
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
+  std::string text(MaxTemplateBytes + 1, '\0');
+  stream.read(&text[0], static_cast<std::streamsize>(text.size()));
+  if (stream.bad() || (stream.fail() && !stream.eof()))
+  {
+    const int error = errno;
+    throw TemplateError(path, 0, "",
+      "cannot read template file '" + path + "'" +
+        (error ? std::string(": ") + std::strerror(error) : std::string()));
+  }
+  text.resize(static_cast<std::size_t>(stream.gcount()));
+  if (text.size() > MaxTemplateBytes)
+  {
+    throw TemplateError(path, 0, "",
+      "'" + path + "' is larger than " + std::to_string(MaxTemplateBytes >> 20) +
+        " MB: not a template file");
+  }
+  std::string normalized;
+  normalized.reserve(text.size());
+  for (std::size_t i = 0; i < text.size(); ++i)
+  {
+    if (text[i] == '\r')
+    {
+      normalized += '\n';
+      if (i + 1 < text.size() && text[i + 1] == '\n')
+      {
+        ++i;
+      }
+      continue;
+    }
+    normalized += text[i];
+  }
+  return normalized;
 }
 } // namespace
 

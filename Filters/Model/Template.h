@@ -7,6 +7,7 @@
 #pragma once
 
 #include "BlockModel.h"
+#include "Errors.h"
 
 #include <limits>
 #include <stdexcept>
@@ -15,24 +16,6 @@ namespace blockforge
 {
 namespace model
 {
-/**
- * @class TemplateError
- * @brief A problem in a template or model, located: "file:line: entity: message".
- */
-class TemplateError : public std::runtime_error
-{
-public:
-  TemplateError(const std::string& file, int line, const std::string& entity,
-    const std::string& message);
-  const std::string& file() const { return File; }
-  int line() const { return Line; }
-  const std::string& entity() const { return Entity; }
-
-private:
-  std::string File, Entity;
-  int Line;
-};
-
 /// Parameter overrides: name -> expression (may use other parameters).
 using ParameterOverrides = std::map<std::string, std::string>;
 

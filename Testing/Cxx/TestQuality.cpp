@@ -435,7 +435,9 @@ TEST(Quality, OGridSeamIsAnInternalFace)
   {
     const double r = 1.0 + 0.4 * j + 0.05 * j * j;
     const double theta = angles[((i % n) + n) % n];
-    return Vec3(r * std::cos(theta), r * std::sin(theta), 0.3 * k);
+    // k downwards: i (around) x j (outwards) points down, so the cells are right-handed
+    // (an inverted ring puts NonOrthogonality near 180, where acos amplifies round-off).
+    return Vec3(r * std::cos(theta), r * std::sin(theta), -0.3 * k);
   };
   const int m = 7;
   const Grid original = makeGrid(n + 1, nr, 2, ringNode);
@@ -457,6 +459,20 @@ TEST(Quality, OGridSeamIsAnInternalFace)
     }
   }
   EXPECT_TRUE(anySkew); // the test would be vacuous on a perfectly orthogonal ring
+}
+
+TEST(Quality, CellCentreIsTheVolumeCentroid)
+{
+  // A right trapezoid (0,0) (2,0) (1,1) (0,1) extruded along z by 1: its centroid is
+  // (7/9, 4/9, 1/2), not the mean of its corners (3/4, 1/2, 1/2). OpenFOAM's cell centre
+  // is the centroid, and so is hexCentre.
+  const Corners trapezoid = { Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0),
+    Vec3(0, 0, 1), Vec3(2, 0, 1), Vec3(1, 1, 1), Vec3(0, 1, 1) };
+  EXPECT_NEAR((hexCentre(trapezoid) - Vec3(7.0 / 9.0, 4.0 / 9.0, 0.5)).norm(), 0.0, 1e-15);
+  // A wedge (corner 3 collapsed onto 0, 7 onto 4): the triangle's centroid (1/3, 1/3).
+  const Corners wedge = { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 0),
+    Vec3(0, 0, 1), Vec3(1, 0, 1), Vec3(0, 1, 1), Vec3(0, 0, 1) };
+  EXPECT_NEAR((hexCentre(wedge) - Vec3(1.0 / 3.0, 1.0 / 3.0, 0.5)).norm(), 0.0, 1e-15);
 }
 
 TEST(Quality, MinAngleClasses)
