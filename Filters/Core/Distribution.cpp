@@ -329,6 +329,10 @@ std::vector<double> endSizes(double first, double last, int nodeCount)
     throw GeometryError("ends distribution: the end cell sizes (relative to the mean cell) "
                         "must be positive numbers");
   }
+  if (first == 1.0 && last == 1.0)
+  {
+    return uniform(nodeCount); // the same nodes, bit for bit, as the uniform law
+  }
   const int cells = nodeCount - 1;
   auto sizes = [&](double beta) {
     std::vector<double> h(cells);
