@@ -18,7 +18,7 @@
 #include "PolyMesh.h"
 #include "PrintableText.h"
 #include "Template.h"
-#include "TurboPointSets.h"
+#include "TurboTemplateInputs.h"
 
 #include <chrono>
 #include <cmath>
@@ -160,36 +160,7 @@ model::TemplateInputs readInputs(const std::string& file)
   {
     std::fprintf(stderr, "warning: %s\n", printableText(warning).c_str());
   }
-  model::TemplateInputs inputs;
-  auto curve = [&](const io::PointSet& set) {
-    model::InputCurve result;
-    result.name = set.name;
-    for (const Eigen::Vector3d& p : set.points)
-    {
-      result.points.push_back(p * sets.scale);
-    }
-    return result;
-  };
-  model::InputPointSet hub, shroud, profiles;
-  hub.name = "Hub";
-  if (!sets.hub.points.empty())
-    hub.curves.push_back(curve(sets.hub));
-  shroud.name = "Shroud";
-  if (!sets.shroud.points.empty())
-    shroud.curves.push_back(curve(sets.shroud));
-  profiles.name = "Profiles";
-  profiles.isList = true;
-  for (const io::ProfileSection& section : sets.profiles)
-  {
-    profiles.curves.push_back(curve(section));
-    profiles.curves.back().span = section.spanPercent / 100.0;
-  }
-  inputs.pointSets = { hub, shroud, profiles };
-  inputs.hasMachine = true;
-  inputs.axis = sets.axis.normalized();
-  inputs.bladeCount = sets.bladeCount;
-  inputs.origin = file;
-  return inputs;
+  return io::templateInputs(sets, file);
 }
 
 /// Writes the grid in the format of the output's extension; prints what was written.
@@ -213,13 +184,12 @@ void writeGrid(const exporting::ExportGrid& grid, const Arguments& args)
       grid.blocks.size(), grid.cellCount(), grid.nodeCount(), map.c_str());
     return;
   }
-  const exporting::PolyMesh mesh = exporting::buildPolyMesh(grid);
   exporting::FoamWriteOptions options;
   options.binary = !args.ascii;
-  exporting::writeFoamCase(mesh, args.output, options);
-  std::printf("blocks: %zu   cells: %lld   points: %d   faces: %d (%d internal, %d triangles)\n",
-    grid.blocks.size(), grid.cellCount(), mesh.pointCount(), mesh.faceCount(),
-    mesh.internalFaceCount(), mesh.triangleFaces);
+  const exporting::FoamSummary mesh = exporting::writeFoamCase(grid, args.output, options);
+  std::printf("blocks: %zu   cells: %d   points: %d   faces: %d (%d internal, %d triangles)\n",
+    grid.blocks.size(), mesh.cells, mesh.points, mesh.faces, mesh.internalFaces,
+    mesh.triangleFaces);
   for (const exporting::FoamPatch& patch : mesh.patches)
   {
     std::printf("  patch %-16s %-9s %8d faces\n", patch.name.c_str(), patch.type.c_str(),
@@ -270,7 +240,7 @@ int main(int argc, char** argv)
     model::checkGridMemory(
       counts, args.maximumMemory, "lower the density multiplier or the cell counts");
     mesher.computeBoundaries();
-    std::vector<std::vector<double>> nodes(mesher.blockCount());
+    std::vector<exporting::LargeVector<double>> nodes(mesher.blockCount());
     std::vector<exporting::GridBlock> blocks(mesher.blockCount());
     for (int b = 0; b < mesher.blockCount(); ++b)
     {

@@ -1,9 +1,11 @@
 // Writing an OpenFOAM case: constant/polyMesh in OpenFOAM's own binary or ASCII layout.
 #include "PolyMesh.h"
 
+#include "PolyMeshFaces.h"
 #include "StagedOutput.h"
 
 #include <charconv>
+#include <memory>
 #include <cstdio>
 #include <stdexcept>
 
@@ -101,7 +103,7 @@ void binaryList(CheckedFile& file, const T* values, std::size_t count, std::size
   file.write(")");
 }
 
-void labelList(CheckedFile& file, const std::vector<int>& values, bool binary)
+void labelList(CheckedFile& file, const LargeVector<int>& values, bool binary)
 {
   if (binary)
   {
@@ -190,7 +192,7 @@ void writeFaces(const std::string& path, const PolyMesh& mesh, bool binary)
   file.close();
 }
 
-void writeLabels(const std::string& path, const char* object, const std::vector<int>& values,
+void writeLabels(const std::string& path, const char* object, const LargeVector<int>& values,
   const PolyMesh& mesh, bool binary)
 {
   CheckedFile file(path);
@@ -295,9 +297,9 @@ std::string folderOf(const std::string& path)
   const std::size_t slash = path.find_last_of('/');
   return slash == std::string::npos ? std::string(".") : path.substr(0, slash == 0 ? 1 : slash);
 }
-} // namespace
 
-void writeFoamCase(const PolyMesh& mesh, const std::string& foamFile, const FoamWriteOptions& options)
+/// The case folder with its NAME.foam and system/ files, and the staged polyMesh folder.
+std::unique_ptr<StagedOutput> prepareCase(const std::string& foamFile)
 {
   const std::string caseDir = folderOf(foamFile);
   const std::string constant = caseDir + "/constant";
@@ -312,8 +314,146 @@ void writeFoamCase(const PolyMesh& mesh, const std::string& foamFile, const Foam
     CheckedFile failing(foamFile); // throws with the reason
   }
   writeSystemFilesIfAbsent(caseDir);
-  StagedOutput staged(constant + "/polyMesh", StagedOutput::Kind::Directory);
-  const std::string dir = staged.path() + "/";
+  return std::make_unique<StagedOutput>(constant + "/polyMesh", StagedOutput::Kind::Directory);
+}
+
+/// Counts the faces and collects the patches of a walk.
+struct CountingSink
+{
+  std::vector<FoamPatch> patches;
+  void internalFace(int, int, const int*, int) {}
+  void boundaryFace(int, const int*, int) {}
+  void patch(const FoamPatch& entry) { patches.push_back(entry); }
+};
+
+/// Streams the faces into the faces, owner and neighbour files, each list at its offset.
+struct FileSink
+{
+  PositionalFile::Region offsets, corners, owner, neighbour;
+  int cornerTotal = 0;
+  void internalFace(int cell, int across, const int* nodes, int count)
+  {
+    boundaryFace(cell, nodes, count);
+    neighbour.put(across);
+  }
+  void boundaryFace(int cell, const int* nodes, int count)
+  {
+    cornerTotal += count;
+    offsets.put(cornerTotal);
+    corners.put(nodes, sizeof(int) * static_cast<std::size_t>(count));
+    owner.put(cell);
+  }
+  void patch(const FoamPatch&) {}
+  void flush()
+  {
+    offsets.flush();
+    corners.flush();
+    owner.flush();
+    neighbour.flush();
+  }
+};
+
+/// A binary list's opening ("N\n(") and closing (")") around `bytes` of data at `at`;
+/// returns the offset of the data.
+unsigned long long binaryListFrame(PositionalFile& file, unsigned long long at,
+  std::size_t count, std::size_t bytes, const std::string& after)
+{
+  const std::string opening = std::to_string(count) + "\n(";
+  file.writeAt(at, opening.data(), opening.size());
+  const unsigned long long data = at + opening.size();
+  const std::string closing = ")" + after;
+  file.writeAt(data + bytes, closing.data(), closing.size());
+  return data;
+}
+} // namespace
+
+FoamSummary writeFoamCase(const ExportGrid& grid, const std::string& foamFile,
+  const FoamWriteOptions& options)
+{
+  auto progress = [&](double fraction) {
+    if (options.progress)
+    {
+      options.progress(fraction);
+    }
+  };
+  FoamSummary summary;
+  if (!options.binary)
+  {
+    const PolyMesh mesh = buildPolyMesh(grid);
+    writeFoamCase(mesh, foamFile, options);
+    summary = { mesh.pointCount(), mesh.cellCount, mesh.faceCount(), mesh.internalFaceCount(),
+      mesh.triangleFaces, mesh.patches };
+    return summary;
+  }
+  polymesh::FaceWalker walker(grid);
+  CountingSink counting;
+  walker.walk(counting);
+  summary = { walker.points(), static_cast<int>(walker.cells()), walker.faceCount,
+    walker.internalFaceCount, walker.triangleCount, counting.patches };
+  progress(0.2);
+  const std::unique_ptr<StagedOutput> staged = prepareCase(foamFile);
+  const std::string dir = staged->path() + "/";
+  {
+    CheckedFile points(dir + "points");
+    points.write(header("vectorField", "points", true));
+    points.write(std::to_string(summary.points) + "\n(");
+    std::vector<double> buffer;
+    buffer.reserve(3 << 16);
+    walker.forEachPoint([&](const double* xyz) {
+      buffer.insert(buffer.end(), xyz, xyz + 3);
+      if (buffer.size() >= (3 << 16))
+      {
+        points.write(buffer.data(), buffer.size() * sizeof(double));
+        buffer.clear();
+      }
+    });
+    points.write(buffer.data(), buffer.size() * sizeof(double));
+    points.write(")");
+    points.write(Footer);
+    points.close();
+  }
+  progress(0.4);
+  const std::string note = "nPoints:" + std::to_string(summary.points) +
+    "  nCells:" + std::to_string(summary.cells) + "  nFaces:" + std::to_string(summary.faces) +
+    "  nInternalFaces:" + std::to_string(summary.internalFaces);
+  PositionalFile faces(dir + "faces"), owner(dir + "owner"), neighbour(dir + "neighbour");
+  const std::string facesHeader = header("faceCompactList", "faces", true);
+  faces.writeAt(0, facesHeader.data(), facesHeader.size());
+  const std::size_t offsetBytes = sizeof(int) * (static_cast<std::size_t>(summary.faces) + 1);
+  const unsigned long long offsetsAt =
+    binaryListFrame(faces, facesHeader.size(), summary.faces + 1, offsetBytes, "\n\n");
+  const std::size_t cornerBytes = sizeof(int) * static_cast<std::size_t>(walker.cornerCount);
+  const unsigned long long cornersAt = binaryListFrame(faces, offsetsAt + offsetBytes + 3,
+    static_cast<std::size_t>(walker.cornerCount), cornerBytes, Footer);
+  const std::string ownerHeader = header("labelList", "owner", true, note);
+  owner.writeAt(0, ownerHeader.data(), ownerHeader.size());
+  const unsigned long long ownerAt = binaryListFrame(owner, ownerHeader.size(), summary.faces,
+    sizeof(int) * static_cast<std::size_t>(summary.faces), Footer);
+  const std::string neighbourHeader = header("labelList", "neighbour", true, note);
+  neighbour.writeAt(0, neighbourHeader.data(), neighbourHeader.size());
+  const unsigned long long neighbourAt = binaryListFrame(neighbour, neighbourHeader.size(),
+    summary.internalFaces, sizeof(int) * static_cast<std::size_t>(summary.internalFaces), Footer);
+  FileSink sink{ { faces, offsetsAt }, { faces, cornersAt }, { owner, ownerAt },
+    { neighbour, neighbourAt } };
+  sink.offsets.put(0);
+  walker.walk(sink);
+  sink.flush();
+  faces.close();
+  owner.close();
+  neighbour.close();
+  progress(0.9);
+  PolyMesh boundaryOnly;
+  boundaryOnly.patches = summary.patches;
+  writeBoundary(dir + "boundary", boundaryOnly);
+  staged->publish();
+  progress(1.0);
+  return summary;
+}
+
+void writeFoamCase(const PolyMesh& mesh, const std::string& foamFile, const FoamWriteOptions& options)
+{
+  const std::unique_ptr<StagedOutput> staged = prepareCase(foamFile);
+  const std::string dir = staged->path() + "/";
   const bool binary = options.binary;
   auto progress = [&](double fraction) {
     if (options.progress)
@@ -330,7 +470,7 @@ void writeFoamCase(const PolyMesh& mesh, const std::string& foamFile, const Foam
   progress(0.8);
   writeLabels(dir + "neighbour", "neighbour", mesh.neighbour, mesh, binary);
   writeBoundary(dir + "boundary", mesh);
-  staged.publish();
+  staged->publish();
   progress(1.0);
 }
 } // namespace exporting

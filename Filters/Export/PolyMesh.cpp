@@ -1,486 +1,156 @@
-#include "PolyMesh.h"
-
-#include "StagedOutput.h"
-
-#include <algorithm>
-#include <charconv>
-#include <cmath>
-#include <limits>
-#include <numeric>
-#include <stdexcept>
+#include "PolyMeshFaces.h"
 
 namespace blockforge
 {
 namespace exporting
 {
+namespace polymesh
+{
+FaceWalker::FaceWalker(const ExportGrid& g)
+  : grid(g)
+{
+  numberPoints();
+  linkInterfaces();
+}
+
+void FaceWalker::numberPoints()
+{
+  const int blockCount = static_cast<int>(grid.blocks.size());
+  nodeBase.assign(blockCount + 1, 0);
+  cellBase.assign(blockCount + 1, 0);
+  for (int b = 0; b < blockCount; ++b)
+  {
+    nodeBase[b + 1] = nodeBase[b] + grid.blocks[b].nodeCount();
+    cellBase[b + 1] = cellBase[b] + grid.blocks[b].cellCount();
+  }
+  if (nodeBase.back() >= std::numeric_limits<int>::max() ||
+    cellBase.back() * 3 + 1 >= std::numeric_limits<int>::max())
+  {
+    throw std::runtime_error("the grid is too large for OpenFOAM's 32-bit labels");
+  }
+  NodeSets sets(static_cast<std::size_t>(nodeBase.back()));
+  for (const FaceMatch& match : grid.interfaces)
+  {
+    const GridBlock& from = grid.blocks[match.from.block];
+    const GridBlock& to = grid.blocks[match.to.block];
+    const std::array<int, 2> n = faceNodeCounts(from, match.from.face);
+    const std::array<int, 2> m = faceNodeCounts(to, match.to.face);
+    for (int b = 0; b < n[1]; ++b)
+    {
+      for (int a = 0; a < n[0]; ++a)
+      {
+        const std::array<int, 2> image = mapFaceNode(match.transform, a, b, m[0], m[1]);
+        sets.unite(static_cast<int>(nodeBase[match.from.block] + faceNode(from, match.from.face, a, b)),
+          static_cast<int>(nodeBase[match.to.block] + faceNode(to, match.to.face, image[0], image[1])));
+      }
+    }
+  }
+  for (int b = 0; b < blockCount; ++b)
+  {
+    uniteCollapsed(sets, b);
+  }
+  // Points in order of their first node.
+  pointOf.resize(static_cast<std::size_t>(nodeBase.back()));
+  int next = 0;
+  for (int node = 0; node < static_cast<int>(pointOf.size()); ++node)
+  {
+    const int root = sets.find(node);
+    pointOf[node] = root == node ? next++ : pointOf[root];
+  }
+  pointCount = next;
+}
+
+/// Collapsed edges merge their nodes; a face with two opposite collapsed edges merges
+/// every line of nodes parallel to them (the face is a line: a wedge's axis).
+void FaceWalker::uniteCollapsed(NodeSets& sets, int b)
+{
+  const GridBlock& block = grid.blocks[b];
+  const std::array<bool, 12>& collapsed = grid.collapsedEdges[b];
+  const int base = static_cast<int>(nodeBase[b]);
+  for (int f = 0; f < 6; ++f)
+  {
+    const std::array<int, 4> edges = model::faceEdges(f); // bottom, top, left, right
+    const std::array<int, 2> n = faceNodeCounts(block, f);
+    const bool alongA = collapsed[edges[0]] && collapsed[edges[1]];
+    const bool alongB = collapsed[edges[2]] && collapsed[edges[3]];
+    for (int b2 = 0; b2 < n[1]; ++b2)
+    {
+      for (int a = 0; a < n[0]; ++a)
+      {
+        const int node = base + static_cast<int>(faceNode(block, f, a, b2));
+        const bool onBottom = b2 == 0 && collapsed[edges[0]];
+        const bool onTop = b2 == n[1] - 1 && collapsed[edges[1]];
+        const bool onLeft = a == 0 && collapsed[edges[2]];
+        const bool onRight = a == n[0] - 1 && collapsed[edges[3]];
+        if (alongA || onBottom || onTop)
+        {
+          sets.unite(node, base + static_cast<int>(faceNode(block, f, 0, b2)));
+        }
+        if (alongB || onLeft || onRight)
+        {
+          sets.unite(node, base + static_cast<int>(faceNode(block, f, a, 0)));
+        }
+      }
+    }
+  }
+}
+
+/// Fills `across` for both sides of every interface.
+void FaceWalker::linkInterfaces()
+{
+  across.assign(grid.blocks.size(), {});
+  for (const FaceMatch& match : grid.interfaces)
+  {
+    linkSide(match.from, match.to, match.transform);
+    linkSide(match.to, match.from, inverse(match.transform));
+  }
+}
+
+void FaceWalker::linkSide(model::BlockFace from, model::BlockFace to, FaceTransform transform)
+{
+  const GridBlock& fromBlock = grid.blocks[from.block];
+  const GridBlock& toBlock = grid.blocks[to.block];
+  const std::array<int, 2> n = faceNodeCounts(fromBlock, from.face);
+  const std::array<int, 2> m = faceNodeCounts(toBlock, to.face);
+  std::vector<int>& cells = across[from.block][from.face];
+  cells.assign(static_cast<std::size_t>(n[0] - 1) * (n[1] - 1), -1);
+  for (int cb = 0; cb + 1 < n[1]; ++cb)
+  {
+    for (int ca = 0; ca + 1 < n[0]; ++ca)
+    {
+      // The transform maps cell indices as it maps node indices (with cell counts).
+      const std::array<int, 2> image = mapFaceNode(transform, ca, cb, m[0] - 1, m[1] - 1);
+      cells[ca + static_cast<std::size_t>(n[0] - 1) * cb] = static_cast<int>(
+        cellBase[to.block] + faceCell(toBlock, to.face, image[0], image[1]));
+    }
+  }
+}
+
+} // namespace polymesh
+
 namespace
 {
-constexpr double Pi = 3.14159265358979323846;
-
-/// Union-find over every block node; the root of a set is always its smallest index, so
-/// the first node of a set in block order is its representative (deterministic numbering).
-class NodeSets
+/// Fills a PolyMesh.
+struct MemorySink
 {
-public:
-  explicit NodeSets(std::size_t count)
-    : Parent(count)
-  {
-    std::iota(Parent.begin(), Parent.end(), 0);
-  }
-  int find(int x)
-  {
-    while (Parent[x] != x)
-    {
-      Parent[x] = Parent[Parent[x]];
-      x = Parent[x];
-    }
-    return x;
-  }
-  void unite(int x, int y)
-  {
-    x = find(x);
-    y = find(y);
-    if (x != y)
-    {
-      Parent[std::max(x, y)] = std::min(x, y);
-    }
-  }
-
-private:
-  std::vector<int> Parent;
-};
-
-/// Corners (a, b) of the face of cell (ca, cb) on block face `face`, in the order whose
-/// right-hand normal points out of the block (and so out of the cell).
-std::array<std::array<int, 2>, 4> outwardCorners(int face, int ca, int cb)
-{
-  std::array<std::array<int, 2>, 4> corners{ { { ca, cb }, { ca + 1, cb }, { ca + 1, cb + 1 },
-    { ca, cb + 1 } } };
-  // (a, b) order runs out of the block on i1, j0 and k1 (right-handed blocks).
-  if (!(face == 1 || face == 2 || face == 5))
-  {
-    std::swap(corners[1], corners[3]);
-  }
-  return corners;
-}
-
-/// Cell index (in its block) of the cell at (ca, cb) next to a block face.
-long long faceCell(const GridBlock& block, int face, int ca, int cb)
-{
-  const std::array<int, 2> directions = model::faceDirections(face);
-  const std::array<int, 3> cells{ block.nodes[0] - 1, block.nodes[1] - 1, block.nodes[2] - 1 };
-  std::array<long long, 3> index{ 0, 0, 0 };
-  const int normal = face / 2;
-  index[normal] = face % 2 == 0 ? 0 : cells[normal] - 1;
-  index[directions[0]] = ca;
-  index[directions[1]] = cb;
-  return index[0] + cells[0] * (index[1] + static_cast<long long>(cells[1]) * index[2]);
-}
-
-struct Builder
-{
-  const ExportGrid& grid;
   PolyMesh& mesh;
-  std::vector<long long> nodeBase, cellBase;
-  std::vector<int> pointOf; ///< block node -> point id
-  /// Per block face: the global cell across an interface for each face cell, empty when
-  /// the face is not an interface.
-  std::vector<std::array<std::vector<int>, 6>> across;
-
-  Builder(const ExportGrid& g, PolyMesh& m)
-    : grid(g)
-    , mesh(m)
+  void add(const int* corners, int count)
   {
-  }
-
-  int point(int block, long long node) const
-  {
-    return pointOf[static_cast<std::size_t>(nodeBase[block] + node)];
-  }
-
-  void numberPoints()
-  {
-    const int blockCount = static_cast<int>(grid.blocks.size());
-    nodeBase.assign(blockCount + 1, 0);
-    cellBase.assign(blockCount + 1, 0);
-    for (int b = 0; b < blockCount; ++b)
-    {
-      nodeBase[b + 1] = nodeBase[b] + grid.blocks[b].nodeCount();
-      cellBase[b + 1] = cellBase[b] + grid.blocks[b].cellCount();
-    }
-    if (nodeBase.back() >= std::numeric_limits<int>::max() ||
-      cellBase.back() * 3 + 1 >= std::numeric_limits<int>::max())
-    {
-      throw std::runtime_error("the grid is too large for OpenFOAM's 32-bit labels");
-    }
-    NodeSets sets(static_cast<std::size_t>(nodeBase.back()));
-    for (const FaceMatch& match : grid.interfaces)
-    {
-      const GridBlock& from = grid.blocks[match.from.block];
-      const GridBlock& to = grid.blocks[match.to.block];
-      const std::array<int, 2> n = faceNodeCounts(from, match.from.face);
-      const std::array<int, 2> m = faceNodeCounts(to, match.to.face);
-      for (int b = 0; b < n[1]; ++b)
-      {
-        for (int a = 0; a < n[0]; ++a)
-        {
-          const std::array<int, 2> image = mapFaceNode(match.transform, a, b, m[0], m[1]);
-          sets.unite(static_cast<int>(nodeBase[match.from.block] + faceNode(from, match.from.face, a, b)),
-            static_cast<int>(nodeBase[match.to.block] + faceNode(to, match.to.face, image[0], image[1])));
-        }
-      }
-    }
-    for (int b = 0; b < blockCount; ++b)
-    {
-      uniteCollapsed(sets, b);
-    }
-    // Points in order of their first node.
-    pointOf.assign(static_cast<std::size_t>(nodeBase.back()), -1);
-    mesh.points.clear();
-    mesh.points.reserve(static_cast<std::size_t>(nodeBase.back()) * 3);
-    int next = 0;
-    for (int b = 0; b < blockCount; ++b)
-    {
-      const double* xyz = grid.blocks[b].xyz;
-      const long long count = grid.blocks[b].nodeCount();
-      for (long long n = 0; n < count; ++n)
-      {
-        const int node = static_cast<int>(nodeBase[b] + n);
-        const int root = sets.find(node);
-        if (root == node)
-        {
-          pointOf[node] = next++;
-          mesh.points.insert(mesh.points.end(), xyz + 3 * n, xyz + 3 * n + 3);
-        }
-        else
-        {
-          pointOf[node] = pointOf[root];
-        }
-      }
-    }
-  }
-
-  /// Collapsed edges merge their nodes; a face with two opposite collapsed edges merges
-  /// every line of nodes parallel to them (the face is a line: a wedge's axis).
-  void uniteCollapsed(NodeSets& sets, int b)
-  {
-    const GridBlock& block = grid.blocks[b];
-    const std::array<bool, 12>& collapsed = grid.collapsedEdges[b];
-    const int base = static_cast<int>(nodeBase[b]);
-    auto index = [&](int i, int j, int k) {
-      return base + i + block.nodes[0] * (j + block.nodes[1] * k);
-    };
-    for (int f = 0; f < 6; ++f)
-    {
-      const std::array<int, 4> edges = model::faceEdges(f); // bottom, top, left, right
-      const std::array<int, 2> n = faceNodeCounts(block, f);
-      const bool alongA = collapsed[edges[0]] && collapsed[edges[1]];
-      const bool alongB = collapsed[edges[2]] && collapsed[edges[3]];
-      for (int b2 = 0; b2 < n[1]; ++b2)
-      {
-        for (int a = 0; a < n[0]; ++a)
-        {
-          const int node = base + static_cast<int>(faceNode(block, f, a, b2));
-          const bool onBottom = b2 == 0 && collapsed[edges[0]];
-          const bool onTop = b2 == n[1] - 1 && collapsed[edges[1]];
-          const bool onLeft = a == 0 && collapsed[edges[2]];
-          const bool onRight = a == n[0] - 1 && collapsed[edges[3]];
-          if (alongA || onBottom || onTop)
-          {
-            sets.unite(node, base + static_cast<int>(faceNode(block, f, 0, b2)));
-          }
-          if (alongB || onLeft || onRight)
-          {
-            sets.unite(node, base + static_cast<int>(faceNode(block, f, a, 0)));
-          }
-        }
-      }
-    }
-    (void)index;
-  }
-
-  /// Fills `across` for both sides of every interface.
-  void linkInterfaces()
-  {
-    across.assign(grid.blocks.size(), {});
-    for (const FaceMatch& match : grid.interfaces)
-    {
-      linkSide(match.from, match.to, match.transform);
-      linkSide(match.to, match.from, inverse(match.transform));
-    }
-  }
-
-  void linkSide(model::BlockFace from, model::BlockFace to, FaceTransform transform)
-  {
-    const GridBlock& fromBlock = grid.blocks[from.block];
-    const GridBlock& toBlock = grid.blocks[to.block];
-    const std::array<int, 2> n = faceNodeCounts(fromBlock, from.face);
-    const std::array<int, 2> m = faceNodeCounts(toBlock, to.face);
-    std::vector<int>& cells = across[from.block][from.face];
-    cells.assign(static_cast<std::size_t>(n[0] - 1) * (n[1] - 1), -1);
-    for (int cb = 0; cb + 1 < n[1]; ++cb)
-    {
-      for (int ca = 0; ca + 1 < n[0]; ++ca)
-      {
-        // The transform maps cell indices as it maps node indices (with cell counts).
-        const std::array<int, 2> image = mapFaceNode(transform, ca, cb, m[0] - 1, m[1] - 1);
-        cells[ca + static_cast<std::size_t>(n[0] - 1) * cb] = static_cast<int>(
-          cellBase[to.block] + faceCell(toBlock, to.face, image[0], image[1]));
-      }
-    }
-  }
-
-  /// Appends a face (dropping repeated corners); false when fewer than 3 corners remain.
-  bool addFace(const int* corners, int count)
-  {
-    int kept[4];
-    int size = 0;
-    for (int c = 0; c < count; ++c)
-    {
-      if (size == 0 || kept[size - 1] != corners[c])
-      {
-        kept[size++] = corners[c];
-      }
-    }
-    while (size > 1 && kept[size - 1] == kept[0])
-    {
-      --size;
-    }
-    if (size < 3)
-    {
-      return false;
-    }
-    if (size == 3)
-    {
-      ++mesh.triangleFaces;
-    }
-    mesh.faceNodes.insert(mesh.faceNodes.end(), kept, kept + size);
+    mesh.faceNodes.insert(mesh.faceNodes.end(), corners, corners + count);
     mesh.faceOffsets.push_back(static_cast<int>(mesh.faceNodes.size()));
-    return true;
   }
-
-  void internalFaces()
+  void internalFace(int owner, int neighbour, const int* corners, int count)
   {
-    const long long cells = cellBase.back();
-    mesh.cellCount = static_cast<int>(cells);
-    mesh.faceNodes.reserve(static_cast<std::size_t>(cells) * 12 + 64);
-    mesh.faceOffsets.reserve(static_cast<std::size_t>(cells) * 3 + 16);
-    mesh.owner.reserve(static_cast<std::size_t>(cells) * 3 + 16);
-    mesh.neighbour.reserve(static_cast<std::size_t>(cells) * 3 + 16);
-    // Corners of the outward face of a cell towards -i, +i, -j, +j, -k, +k (VTK hexahedron
-    // numbering of the cell's 8 nodes).
-    static const int Loops[6][4] = { { 0, 4, 7, 3 }, { 1, 2, 6, 5 }, { 0, 1, 5, 4 },
-      { 3, 7, 6, 2 }, { 0, 3, 2, 1 }, { 4, 5, 6, 7 } };
-    for (std::size_t b = 0; b < grid.blocks.size(); ++b)
-    {
-      const GridBlock& block = grid.blocks[b];
-      const int ni = block.nodes[0], nj = block.nodes[1];
-      const int ci = ni - 1, cj = block.nodes[1] - 1, ck = block.nodes[2] - 1;
-      const int* points = pointOf.data() + nodeBase[b];
-      int cell = static_cast<int>(cellBase[b]);
-      for (int k = 0; k < ck; ++k)
-      {
-        for (int j = 0; j < cj; ++j)
-        {
-          for (int i = 0; i < ci; ++i, ++cell)
-          {
-            const long long n0 = i + static_cast<long long>(ni) * (j + static_cast<long long>(nj) * k);
-            const long long layer = static_cast<long long>(ni) * nj;
-            const int p[8] = { points[n0], points[n0 + 1], points[n0 + ni + 1], points[n0 + ni],
-              points[n0 + layer], points[n0 + layer + 1], points[n0 + layer + ni + 1],
-              points[n0 + layer + ni] };
-            // Up to 6 neighbours with a higher number, emitted in increasing order.
-            std::pair<int, int> next[6];
-            int count = 0;
-            auto consider = [&](int neighbour, int side) {
-              if (neighbour > cell)
-              {
-                next[count++] = { neighbour, side };
-              }
-            };
-            if (i + 1 < ci)
-              consider(cell + 1, 1);
-            if (j + 1 < cj)
-              consider(cell + ci, 3);
-            if (k + 1 < ck)
-              consider(cell + ci * cj, 5);
-            if (i == 0 || i + 1 == ci || j == 0 || j + 1 == cj || k == 0 || k + 1 == ck)
-            {
-              const int position[3] = { i, j, k };
-              const int last[3] = { ci - 1, cj - 1, ck - 1 };
-              for (int f = 0; f < 6; ++f)
-              {
-                const int direction = f / 2;
-                const std::vector<int>& cross = across[b][f];
-                if (cross.empty() || position[direction] != (f % 2 == 0 ? 0 : last[direction]))
-                {
-                  continue;
-                }
-                const std::array<int, 2> d = model::faceDirections(f);
-                const int na = block.nodes[d[0]] - 1;
-                consider(cross[position[d[0]] + static_cast<std::size_t>(na) * position[d[1]]], f);
-              }
-              std::sort(next, next + count);
-            }
-            for (int c = 0; c < count; ++c)
-            {
-              const int* loop = Loops[next[c].second];
-              const int corners[4] = { p[loop[0]], p[loop[1]], p[loop[2]], p[loop[3]] };
-              if (addFace(corners, 4))
-              {
-                mesh.owner.push_back(cell);
-                mesh.neighbour.push_back(next[c].first);
-              }
-            }
-          }
-        }
-      }
-    }
+    add(corners, count);
+    mesh.owner.push_back(owner);
+    mesh.neighbour.push_back(neighbour);
   }
-
-  /// One boundary face: cell (ca, cb) of a block face, with corners through `corners`.
-  void boundaryFace(const model::BlockFace& face, int ca, int cb, const int* corners)
+  void boundaryFace(int owner, const int* corners, int count)
   {
-    if (addFace(corners, 4))
-    {
-      mesh.owner.push_back(static_cast<int>(cellBase[face.block] +
-        faceCell(grid.blocks[face.block], face.face, ca, cb)));
-    }
+    add(corners, count);
+    mesh.owner.push_back(owner);
   }
-
-  void patchFaces(const model::BlockFace& face)
-  {
-    const GridBlock& block = grid.blocks[face.block];
-    const std::array<int, 2> n = faceNodeCounts(block, face.face);
-    for (int cb = 0; cb + 1 < n[1]; ++cb)
-    {
-      for (int ca = 0; ca + 1 < n[0]; ++ca)
-      {
-        int corners[4];
-        const auto loop = outwardCorners(face.face, ca, cb);
-        for (int c = 0; c < 4; ++c)
-        {
-          corners[c] = point(face.block, faceNode(block, face.face, loop[c][0], loop[c][1]));
-        }
-        boundaryFace(face, ca, cb, corners);
-      }
-    }
-  }
-
-  /// The image faces of a periodic patch, in the order of its partner's faces: the first
-  /// corner is the image of the partner face's first corner, the loop runs the other way
-  /// (the image's outward normal is opposite), as OpenFOAM's cyclic patches expect.
-  void imageFaces(const FaceMatch& match)
-  {
-    const GridBlock& source = grid.blocks[match.from.block];
-    const GridBlock& image = grid.blocks[match.to.block];
-    const std::array<int, 2> n = faceNodeCounts(source, match.from.face);
-    const std::array<int, 2> m = faceNodeCounts(image, match.to.face);
-    for (int cb = 0; cb + 1 < n[1]; ++cb)
-    {
-      for (int ca = 0; ca + 1 < n[0]; ++ca)
-      {
-        const auto loop = outwardCorners(match.from.face, ca, cb);
-        int corners[4];
-        std::array<int, 2> low{ std::numeric_limits<int>::max(), std::numeric_limits<int>::max() };
-        for (int c = 0; c < 4; ++c)
-        {
-          const std::array<int, 2> at = mapFaceNode(match.transform, loop[(4 - c) % 4][0],
-            loop[(4 - c) % 4][1], m[0], m[1]);
-          corners[c] = point(match.to.block, faceNode(image, match.to.face, at[0], at[1]));
-          low = { std::min(low[0], at[0]), std::min(low[1], at[1]) };
-        }
-        boundaryFace(match.to, low[0], low[1], corners);
-      }
-    }
-  }
-
-  void boundaryFaces()
-  {
-    const int patchCount = static_cast<int>(grid.patches.size());
-    std::vector<std::array<bool, 6>> inPatch(grid.blocks.size(), std::array<bool, 6>{});
-    for (const GridPatch& patch : grid.patches)
-    {
-      for (const model::BlockFace& face : patch.faces)
-      {
-        inPatch[face.block][face.face] = true;
-      }
-    }
-    for (const FaceMatch& match : grid.interfaces)
-    {
-      inPatch[match.from.block][match.from.face] = true;
-      inPatch[match.to.block][match.to.face] = true;
-    }
-    auto add = [&](FoamPatch patch, int start) {
-      patch.startFace = start;
-      patch.faceCount = mesh.faceCount() - start;
-      mesh.patches.push_back(std::move(patch));
-    };
-    for (int p = 0; p < patchCount; ++p)
-    {
-      const GridPatch& patch = grid.patches[p];
-      FoamPatch entry;
-      entry.name = patch.name;
-      entry.type = foamPatchType(patch.type);
-      const int start = mesh.faceCount();
-      const bool cyclic = patch.partner >= 0 && patch.partner < patchCount;
-      if (!cyclic)
-      {
-        entry.type = entry.type == "cyclic" ? "patch" : entry.type;
-        for (const model::BlockFace& face : patch.faces)
-        {
-          if (!grid.collapsedFaces[face.block][face.face])
-          {
-            patchFaces(face);
-          }
-        }
-        add(entry, start);
-        continue;
-      }
-      const GridPatch& partner = grid.patches[patch.partner];
-      entry.type = "cyclic";
-      entry.neighbourPatch = partner.name;
-      entry.rotationAxis = patch.axis.normalized();
-      entry.rotationCentre = patch.axisPoint;
-      entry.rotationAngle = patch.angle * 180.0 / Pi;
-      if (p < patch.partner)
-      {
-        // In the order of the pairs, which the later patch follows.
-        for (const FaceMatch& match : patch.images)
-        {
-          patchFaces(match.from);
-        }
-      }
-      else
-      {
-        // The faces of the earlier patch of the pair, mapped onto this one in its order.
-        for (const FaceMatch& match : partner.images)
-        {
-          imageFaces(match);
-        }
-      }
-      add(entry, start);
-    }
-    // Boundary faces in no patch.
-    FoamPatch rest;
-    rest.name = "defaultFaces";
-    rest.type = "patch";
-    const int start = mesh.faceCount();
-    for (std::size_t b = 0; b < grid.blocks.size(); ++b)
-    {
-      for (int f = 0; f < 6; ++f)
-      {
-        if (!inPatch[b][f] && !grid.collapsedFaces[b][f])
-        {
-          patchFaces(model::BlockFace{ static_cast<int>(b), f });
-        }
-      }
-    }
-    if (mesh.faceCount() > start)
-    {
-      add(rest, start);
-    }
-  }
+  void patch(const FoamPatch& entry) { mesh.patches.push_back(entry); }
 };
 } // namespace
 
@@ -500,12 +170,19 @@ std::string foamPatchType(const std::string& templateType)
 
 PolyMesh buildPolyMesh(const ExportGrid& grid)
 {
+  polymesh::FaceWalker walker(grid);
   PolyMesh mesh;
-  Builder builder(grid, mesh);
-  builder.numberPoints();
-  builder.linkInterfaces();
-  builder.internalFaces();
-  builder.boundaryFaces();
+  const std::size_t cells = static_cast<std::size_t>(walker.cells());
+  mesh.cellCount = static_cast<int>(cells);
+  mesh.faceNodes.reserve(cells * 12 + 64);
+  mesh.faceOffsets.reserve(cells * 3 + 16);
+  mesh.owner.reserve(cells * 3 + 16);
+  mesh.neighbour.reserve(cells * 3 + 16);
+  MemorySink sink{ mesh };
+  walker.walk(sink);
+  mesh.triangleFaces = walker.triangleCount;
+  mesh.points.reserve(static_cast<std::size_t>(walker.points()) * 3);
+  walker.forEachPoint([&](const double* xyz) { mesh.points.insert(mesh.points.end(), xyz, xyz + 3); });
   return mesh;
 }
 } // namespace exporting

@@ -16,6 +16,7 @@
 #pragma once
 
 #include "ExportGrid.h"
+#include "LargeAllocator.h"
 
 #include <functional>
 #include <string>
@@ -40,11 +41,11 @@ struct FoamPatch
 
 struct PolyMesh
 {
-  std::vector<double> points; ///< x y z interleaved
-  std::vector<int> faceOffsets{ 0 }; ///< faces + 1 entries into faceNodes
-  std::vector<int> faceNodes;
-  std::vector<int> owner;     ///< one per face
-  std::vector<int> neighbour; ///< one per internal face
+  LargeVector<double> points;           ///< x y z interleaved
+  LargeVector<int> faceOffsets{ 0 };    ///< faces + 1 entries into faceNodes
+  LargeVector<int> faceNodes;
+  LargeVector<int> owner;               ///< one per face
+  LargeVector<int> neighbour;           ///< one per internal face
   int cellCount = 0;
   std::vector<FoamPatch> patches;
   int triangleFaces = 0; ///< faces that lost a corner to a collapsed edge (prism cells)
@@ -76,6 +77,25 @@ struct FoamWriteOptions
  * std::runtime_error naming the file and the reason (unwritable folder, disk full).
  */
 void writeFoamCase(const PolyMesh& mesh, const std::string& foamFile,
+  const FoamWriteOptions& options = {});
+
+/// What writeFoamCase wrote.
+struct FoamSummary
+{
+  int points = 0;
+  int cells = 0;
+  int faces = 0;
+  int internalFaces = 0;
+  int triangleFaces = 0;
+  std::vector<FoamPatch> patches;
+};
+
+/**
+ * The same case straight from the grid: binary files are streamed as the faces are
+ * walked (no polyMesh held in memory: a million cells need about a quarter of the memory
+ * and time), ASCII goes through buildPolyMesh. Same files, same guarantees as above.
+ */
+FoamSummary writeFoamCase(const ExportGrid& grid, const std::string& foamFile,
   const FoamWriteOptions& options = {});
 } // namespace exporting
 } // namespace blockforge

@@ -1,6 +1,8 @@
 #include "StagedOutput.h"
 
 #include <cerrno>
+#include <csignal>
+#include <random>
 #include <cstring>
 #include <stdexcept>
 #include <vector>
@@ -87,31 +89,167 @@ void CheckedFile::close()
   }
 }
 
+PositionalFile::PositionalFile(const std::string& path)
+  : Path(path)
+{
+  Descriptor = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (Descriptor < 0)
+  {
+    fail(errno);
+  }
+}
+
+PositionalFile::~PositionalFile()
+{
+  if (Descriptor >= 0)
+  {
+    ::close(Descriptor);
+  }
+}
+
+void PositionalFile::fail(int error) const
+{
+  throw std::runtime_error("could not write " + Path + ": " + reason(error ? error : EIO));
+}
+
+void PositionalFile::writeAt(unsigned long long offset, const void* data, std::size_t bytes)
+{
+  const char* next = static_cast<const char*>(data);
+  while (bytes > 0)
+  {
+    const ssize_t written = ::pwrite(Descriptor, next, bytes, static_cast<off_t>(offset));
+    if (written < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (written <= 0)
+    {
+      fail(written < 0 ? errno : ENOSPC);
+    }
+    next += written;
+    offset += static_cast<unsigned long long>(written);
+    bytes -= static_cast<std::size_t>(written);
+  }
+}
+
+void PositionalFile::close()
+{
+  const int descriptor = Descriptor;
+  Descriptor = -1;
+  if (::close(descriptor) != 0)
+  {
+    fail(errno);
+  }
+}
+
+PositionalFile::Region::Region(PositionalFile& file, unsigned long long offset)
+  : File(file)
+  , Offset(offset)
+  , Buffer(Capacity, '\0')
+{
+}
+
+void PositionalFile::Region::put(const void* data, std::size_t bytes)
+{
+  if (Used + bytes > Capacity)
+  {
+    flush();
+  }
+  if (bytes > Capacity)
+  {
+    File.writeAt(Offset, data, bytes);
+    Offset += bytes;
+    return;
+  }
+  std::memcpy(&Buffer[Used], data, bytes);
+  Used += bytes;
+}
+
+void PositionalFile::Region::flush()
+{
+  File.writeAt(Offset, Buffer.data(), Used);
+  Offset += Used;
+  Used = 0;
+}
+
+namespace
+{
+const char* const StagingSuffix = ".staging";
+
+bool processAlive(long pid)
+{
+  if (pid == static_cast<long>(::getpid()))
+  {
+    return false; // one process writes one target at a time: our own leftovers are stale
+  }
+  return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM;
+}
+} // namespace
+
+void removeStaleStaging(const std::string& target)
+{
+  const std::string folder = folderOf(target);
+  const std::string prefix = "." + nameOf(target) + ".";
+  DIR* directory = ::opendir(folder.c_str());
+  if (!directory)
+  {
+    return;
+  }
+  std::vector<std::string> stale;
+  while (dirent* entry = ::readdir(directory))
+  {
+    // .NAME.<pid>-<hex token>.staging, as blockforge.output names them too.
+    const std::string name = entry->d_name;
+    const std::size_t suffix = std::strlen(StagingSuffix);
+    if (name.size() <= prefix.size() + suffix || name.compare(0, prefix.size(), prefix) != 0 ||
+      name.compare(name.size() - suffix, suffix, StagingSuffix) != 0)
+    {
+      continue;
+    }
+    const std::string middle = name.substr(prefix.size(), name.size() - prefix.size() - suffix);
+    const std::size_t dash = middle.find('-');
+    if (dash == std::string::npos || dash == 0 ||
+      middle.find_first_not_of("0123456789") != dash ||
+      middle.find_first_not_of("0123456789abcdef", dash + 1) != std::string::npos)
+    {
+      continue;
+    }
+    if (!processAlive(std::stol(middle.substr(0, dash))))
+    {
+      stale.push_back(folder + "/" + name);
+    }
+  }
+  ::closedir(directory);
+  for (const std::string& path : stale)
+  {
+    removeTree(path);
+  }
+}
+
 StagedOutput::StagedOutput(const std::string& target, Kind kind)
   : Target(target)
   , What(kind)
 {
   makeDirectories(folderOf(target));
-  std::string pattern = folderOf(target) + "/." + nameOf(target) + ".XXXXXX";
-  std::vector<char> buffer(pattern.begin(), pattern.end());
-  buffer.push_back('\0');
-  if (kind == Kind::Directory)
+  removeStaleStaging(target);
+  // The naming of blockforge.output (issue 12): .NAME.<pid>-<token>.staging beside the
+  // target, so either side removes what a killed run of the other left.
+  static std::mt19937_64 generator(std::random_device{}());
+  char token[32];
+  std::snprintf(token, sizeof(token), "%ld-%08llx", static_cast<long>(::getpid()),
+    static_cast<unsigned long long>(generator() & 0xffffffffULL));
+  Staging = folderOf(target) + "/." + nameOf(target) + "." + token + StagingSuffix;
+  const int made = kind == Kind::Directory
+    ? ::mkdir(Staging.c_str(), 0777)
+    : ::open(Staging.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (made < 0)
   {
-    if (!mkdtemp(buffer.data()))
-    {
-      throw std::runtime_error("could not write " + target + ": " + reason(errno));
-    }
+    throw std::runtime_error("could not write " + target + ": " + reason(errno));
   }
-  else
+  if (kind == Kind::File)
   {
-    const int descriptor = mkstemp(buffer.data());
-    if (descriptor < 0)
-    {
-      throw std::runtime_error("could not write " + target + ": " + reason(errno));
-    }
-    ::close(descriptor);
+    ::close(made);
   }
-  Staging = buffer.data();
 }
 
 StagedOutput::~StagedOutput()
@@ -155,14 +293,6 @@ void StagedOutput::publish()
     removeTree(old);
     Published = true;
     return;
-  }
-  if (What == Kind::File)
-  {
-    ::chmod(Staging.c_str(), 0644 & ~[] {
-      const mode_t mask = ::umask(0);
-      ::umask(mask);
-      return mask;
-    }());
   }
   if (::rename(Staging.c_str(), Target.c_str()) != 0)
   {

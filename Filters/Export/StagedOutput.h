@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 namespace blockforge
@@ -42,10 +43,63 @@ private:
 };
 
 /**
+ * @class PositionalFile
+ * @brief A file written at known offsets, region by region (pwrite), with every write
+ * and the close checked like CheckedFile: for binary files whose sections can be filled
+ * in one pass once their sizes are known.
+ */
+class PositionalFile
+{
+public:
+  explicit PositionalFile(const std::string& path);
+  ~PositionalFile();
+  PositionalFile(const PositionalFile&) = delete;
+  PositionalFile& operator=(const PositionalFile&) = delete;
+
+  void writeAt(unsigned long long offset, const void* data, std::size_t bytes);
+  void close();
+
+  /// Sequential writes into the file from `offset` on, gathered in a buffer.
+  class Region
+  {
+  public:
+    Region(PositionalFile& file, unsigned long long offset);
+    template <typename T>
+    void put(const T& value)
+    {
+      if (Used + sizeof(T) > Capacity)
+      {
+        flush();
+      }
+      std::memcpy(Buffer.data() + Used, &value, sizeof(T));
+      Used += sizeof(T);
+    }
+    void put(const void* data, std::size_t bytes);
+    void flush();
+    unsigned long long offset() const { return Offset + Used; }
+
+  private:
+    static constexpr std::size_t Capacity = std::size_t(1) << 20;
+    PositionalFile& File;
+    unsigned long long Offset;
+    std::string Buffer;
+    std::size_t Used = 0;
+  };
+
+private:
+  [[noreturn]] void fail(int error) const;
+  std::string Path;
+  int Descriptor = -1;
+};
+
+/**
  * @class StagedOutput
- * @brief A temporary file or directory beside `target` ("DIR/.NAME.XXXXXX"); publish()
- * renames it onto `target` (a directory is exchanged atomically with an older one, which
- * is then removed). Destroyed without publish() (an exception), it removes what it staged.
+ * @brief A temporary file or directory beside `target`, named as blockforge.output (the
+ * Python command line's verified writing) names its staging folders,
+ * "DIR/.NAME.<pid>-<token>.staging"; publish() renames it onto `target` (a directory is
+ * exchanged atomically with an older one, which is then removed). Destroyed without
+ * publish() (an exception), it removes what it staged; what a killed process left is
+ * removed by the next run for the same target (removeStaleStaging).
  */
 class StagedOutput
 {
@@ -70,6 +124,9 @@ private:
   Kind What;
   bool Published = false;
 };
+
+/// Removes the staging entries of `target` left by processes that no longer run.
+void removeStaleStaging(const std::string& target);
 
 /// mkdir -p; throws std::runtime_error naming the folder that could not be made.
 void makeDirectories(const std::string& path);

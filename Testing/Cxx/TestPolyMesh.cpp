@@ -13,6 +13,7 @@
 
 #include <dirent.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 using namespace blockforge;
 using namespace blockforge::exporting;
@@ -343,4 +344,84 @@ TEST(FoamCase, WritesBinaryAndAsciiAndReplacesAtomically)
   EXPECT_EQ(entries, 1);
   // A case folder that cannot be made: an error naming it, nothing written.
   EXPECT_THROW(writeFoamCase(mesh, dir + "/box.foam/inside/x.foam"), std::runtime_error);
+}
+
+TEST(FoamCase, StreamedBinaryEqualsTheMeshInMemory)
+{
+  // A wedge (prisms, triangles) whose two sides are a periodic pair: every kind of face.
+  const double phi = Pi / 4.0;
+  const int nr = 4, na = 5, nh = 3;
+  std::vector<OwnedBlock> blocks;
+  blocks.push_back(makeBlock("core", { nr, na, nh }, [&](int i, int j, int k) {
+    const double r = double(i) / (nr - 1), t = phi * j / (na - 1);
+    return Vec3(r * std::cos(t), r * std::sin(t), 0.4 * k / (nh - 1));
+  }));
+  ExportGrid grid = gridOf(blocks);
+  grid.collapsedEdges[0][3] = grid.collapsedEdges[0][7] = true;
+  grid.collapsedFaces[0][0] = true;
+  GridPatch low, high, wall;
+  low.name = "low";
+  low.type = "periodic";
+  low.faces = { { 0, 2 } };
+  low.partner = 1;
+  low.angle = phi;
+  low.images = { FaceMatch{ { 0, 2 }, { 0, 3 }, FaceTransform{ 0 } } };
+  high.name = "high";
+  high.type = "periodic";
+  high.faces = { { 0, 3 } };
+  high.partner = 0;
+  high.angle = -phi;
+  high.images = { FaceMatch{ { 0, 3 }, { 0, 2 }, FaceTransform{ 0 } } };
+  wall.name = "wall";
+  wall.type = "wall";
+  wall.faces = { { 0, 1 } };
+  grid.patches = { low, high, wall };
+  const std::string dir = std::string(BLOCKFORGE_TEST_OUTPUT) + "/foam_stream";
+  removeTree(dir);
+  const FoamSummary summary = writeFoamCase(grid, dir + "/streamed/s.foam");
+  const PolyMesh mesh = buildPolyMesh(grid);
+  writeFoamCase(mesh, dir + "/memory/m.foam");
+  EXPECT_EQ(summary.faces, mesh.faceCount());
+  EXPECT_EQ(summary.internalFaces, mesh.internalFaceCount());
+  EXPECT_EQ(summary.points, mesh.pointCount());
+  EXPECT_EQ(summary.triangleFaces, mesh.triangleFaces);
+  EXPECT_GT(summary.triangleFaces, 0);
+  ASSERT_EQ(summary.patches.size(), mesh.patches.size());
+  for (const char* name : { "points", "faces", "owner", "neighbour", "boundary" })
+  {
+    auto read = [&](const std::string& folder) {
+      std::ifstream stream(dir + "/" + folder + "/constant/polyMesh/" + name, std::ios::binary);
+      std::stringstream text;
+      text << stream.rdbuf();
+      return text.str();
+    };
+    const std::string streamed = read("streamed");
+    EXPECT_FALSE(streamed.empty()) << name;
+    EXPECT_EQ(streamed, read("memory")) << name;
+  }
+}
+
+TEST(FoamCase, LeftoversOfKilledRunsAreRemovedOthersKept)
+{
+  std::vector<OwnedBlock> blocks;
+  blocks.push_back(makeBlock("box", { 2, 2, 2 }, [](int i, int j, int k) {
+    return Vec3(i, j, k);
+  }));
+  const ExportGrid grid = gridOf(blocks);
+  const std::string dir = std::string(BLOCKFORGE_TEST_OUTPUT) + "/foam_leftovers";
+  removeTree(dir);
+  makeDirectories(dir + "/constant");
+  // Named as blockforge.output names staging folders: .NAME.<pid>-<token>.staging. This
+  // process's own are stale (one process writes one target at a time); pid 1 runs.
+  const std::string stale = dir + "/constant/.polyMesh." + std::to_string(::getpid()) + "-0badc0de.staging";
+  const std::string running = dir + "/constant/.polyMesh.1-0badc0de.staging";
+  const std::string unrelated = dir + "/constant/.polyMesh.notes";
+  for (const std::string& path : { stale, running, unrelated })
+    makeDirectories(path);
+  writeFoamCase(grid, dir + "/box.foam");
+  struct stat status;
+  EXPECT_NE(::stat(stale.c_str(), &status), 0);
+  EXPECT_EQ(::stat(running.c_str(), &status), 0);
+  EXPECT_EQ(::stat(unrelated.c_str(), &status), 0);
+  EXPECT_EQ(::stat((dir + "/constant/polyMesh/faces").c_str(), &status), 0);
 }

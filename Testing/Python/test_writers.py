@@ -94,8 +94,6 @@ class Plot3DTest(unittest.TestCase):
 
 class CgnsTest(unittest.TestCase):
     def test_cgnscheck_and_paraview_reader(self):
-        from vtkmodules.vtkIOCGNSReader import vtkCGNSReader
-
         for name, template, inf in (("cylinder", CYLINDER, None),
                                     ("wedge", os.path.join(SOURCE, "Templates", "wedge_sector.yaml"), None),
                                     ("distributor_oh", AXIAL_OH, DISTRIBUTOR_INF)):
@@ -107,14 +105,7 @@ class CgnsTest(unittest.TestCase):
                 self.assertEqual(check.returncode, 0, check.stdout + check.stderr)
                 self.assertNotIn("ERROR", check.stdout + check.stderr)
                 self.assertNotIn("WARNING", check.stdout + check.stderr)
-                reader = vtkCGNSReader()
-                reader.SetFileName(path)
-                reader.UpdateInformation()
-                reader.EnableAllBases()
-                reader.Update()
-                base = reader.GetOutput().GetBlock(0)
-                zones = {base.GetMetaData(z).Get(base.NAME()): base.GetBlock(z)
-                         for z in range(base.GetNumberOfBlocks())}
+                zones = bftest.read_cgns_zones(path)
                 ours = dict(bftest.named_leaves(grid))
                 self.assertEqual(sorted(zones), sorted(ours))
                 for zone, block in ours.items():
