@@ -3,7 +3,7 @@
  * @brief The native command line: applies a template, meshes it and writes the grid in a
  * solver format, without Python or VTK (start-up in milliseconds):
  *
- *   blockforge TEMPLATE [-i POINTS] [-p NAME=EXPR ...] [-d DENSITY] -o OUTPUT [--ascii]
+ *   blockforge TEMPLATE [-i POINTS] [-p NAME=EXPR ...] [-d DENSITY] [-m GB] -o OUTPUT [--ascii]
  *
  * OUTPUT's extension picks the writer: DIR/NAME.foam (OpenFOAM case: DIR/constant/polyMesh
  * and an empty NAME.foam), NAME.xyz (Plot3D multiblock), NAME.cgns (CGNS). `python3 -m
@@ -11,13 +11,17 @@
  */
 #include "Cgns.h"
 #include "ExportModel.h"
+#include "GridCheck.h"
+#include "MemoryBudget.h"
 #include "Mesher.h"
 #include "Plot3D.h"
 #include "PolyMesh.h"
+#include "PrintableText.h"
 #include "Template.h"
 #include "TurboTemplateInputs.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -32,7 +36,8 @@ using namespace blockforge;
 namespace
 {
 const char* const Usage =
-  "usage: blockforge TEMPLATE [-i POINTS] [-p NAME=EXPR ...] [-d DENSITY] -o OUTPUT [--ascii]\n"
+  "usage: blockforge TEMPLATE [-i POINTS] [-p NAME=EXPR ...] [-d DENSITY] [-m GB] -o OUTPUT\n"
+  "                  [--ascii]\n"
   "\n"
   "Applies a BlockForge template (to the point data of -i: a BladeGen .inf, an Info.txt or a\n"
   "point file), meshes it and writes the grid. The extension of OUTPUT picks the format:\n"
@@ -42,7 +47,10 @@ const char* const Usage =
   "Options:\n"
   "  -i, --input FILE        point data for a template with inputs\n"
   "  -p, --parameter N=EXPR  override a template parameter (repeatable)\n"
-  "  -d, --density D         grid density multiplier (scales every cell count)\n"
+  "  -d, --density D         grid density multiplier (scales every cell count; above 0,\n"
+  "                          at most 1000, at most 1,000,000 cells per block direction)\n"
+  "  -m, --max-memory GB     refuse grids that would need more memory (default 0: what\n"
+  "                          the machine has available)\n"
   "  -o, --output FILE       grid to write\n"
   "  --ascii                 ASCII instead of binary where the format has both\n"
   "The grid is written under a temporary name and moved into place: a failure leaves no\n"
@@ -53,6 +61,7 @@ struct Arguments
   std::string templateFile, input, output;
   model::ParameterOverrides parameters;
   double density = 1.0;
+  double maximumMemory = 0.0; ///< GB, 0: what the machine has available
   bool ascii = false;
 };
 
@@ -92,6 +101,17 @@ Arguments parse(int argc, char** argv)
       if (end == text.c_str() || *end != '\0' || !(args.density > 0.0))
       {
         throw std::invalid_argument("-d needs a positive number, got '" + text + "'");
+      }
+    }
+    else if (arg == "-m" || arg == "--max-memory")
+    {
+      const std::string text = value();
+      char* end = nullptr;
+      args.maximumMemory = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || !(args.maximumMemory >= 0.0) ||
+        !std::isfinite(args.maximumMemory))
+      {
+        throw std::invalid_argument("-m needs a number of GB >= 0, got '" + text + "'");
       }
     }
     else if (arg == "-p" || arg == "--parameter")
@@ -138,7 +158,7 @@ model::TemplateInputs readInputs(const std::string& file)
   const io::TurboPointSets sets = io::readTurboPointSets(file);
   for (const std::string& warning : sets.warnings)
   {
-    std::fprintf(stderr, "warning: %s\n", warning.c_str());
+    std::fprintf(stderr, "warning: %s\n", printableText(warning).c_str());
   }
   return io::templateInputs(sets, file);
 }
@@ -194,7 +214,7 @@ int main(int argc, char** argv)
   }
   catch (const std::exception& error)
   {
-    std::fprintf(stderr, "error: %s\n\n%s", error.what(), Usage);
+    std::fprintf(stderr, "error: %s\n\n%s", printableText(error.what()).c_str(), Usage);
     return 2;
   }
   try
@@ -212,6 +232,13 @@ int main(int argc, char** argv)
 
     const auto meshStart = std::chrono::steady_clock::now();
     model::MultiBlockMesher mesher(model, carriers, args.density);
+    model::BlockNodeCounts counts;
+    for (int b = 0; b < mesher.blockCount(); ++b)
+    {
+      counts.push_back(mesher.nodeCounts(b));
+    }
+    model::checkGridMemory(
+      counts, args.maximumMemory, "lower the density multiplier or the cell counts");
     mesher.computeBoundaries();
     std::vector<exporting::LargeVector<double>> nodes(mesher.blockCount());
     std::vector<exporting::GridBlock> blocks(mesher.blockCount());
@@ -221,27 +248,28 @@ int main(int argc, char** argv)
       blocks[b].nodes = mesher.nodeCounts(b);
       nodes[b].resize(static_cast<std::size_t>(blocks[b].nodeCount()) * 3);
       mesher.meshBlock(b, nodes[b].data());
+      model::checkBlockCells(model, b, blocks[b].nodes, nodes[b].data());
       blocks[b].xyz = nodes[b].data();
     }
     const exporting::ExportGrid grid = exporting::exportGrid(model, std::move(blocks));
     const double meshTime = seconds(meshStart);
 
-    std::printf("template: %s\n", args.templateFile.c_str());
+    std::printf("template: %s\n", printableText(args.templateFile).c_str());
     if (!args.input.empty())
     {
-      std::printf("input: %s\n", args.input.c_str());
+      std::printf("input: %s\n", printableText(args.input).c_str());
     }
     const auto writeStart = std::chrono::steady_clock::now();
     writeGrid(grid, args);
     const double writeTime = seconds(writeStart);
     std::printf("time [s]: template %.3f, mesh %.3f, write %.3f, total %.3f\n", templateTime,
       meshTime, writeTime, seconds(start));
-    std::printf("grid written to %s%s\n", args.output.c_str(),
+    std::printf("grid written to %s%s\n", printableText(args.output).c_str(),
       endsWith(args.output, ".cgns") ? "" : args.ascii ? " (ASCII)" : " (binary)");
   }
   catch (const std::exception& error)
   {
-    std::fprintf(stderr, "error: %s\n", error.what());
+    std::fprintf(stderr, "error: %s\n", printableText(error.what()).c_str());
     return 1;
   }
   return 0;

@@ -16,6 +16,8 @@
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkStringArray.h>
+#include <vtkFieldData.h>
 #include <vtkStructuredGrid.h>
 
 #include <iterator>
@@ -184,6 +186,16 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
     {
       fillCarriers(blockModel, geometry, carriers);
     }
+    // What the template chose (its notes): a warning each, and the field data
+    // TemplateNotes, so that the choice is seen in the GUI, in scripts and on the command line.
+    vtkNew<vtkStringArray> notes;
+    notes->SetName("TemplateNotes");
+    for (const std::string& note : blockModel.notes)
+    {
+      vtkWarningMacro(<< this->TemplateFile << ": " << note);
+      notes->InsertNextValue(note);
+    }
+    output->GetFieldData()->AddArray(notes);
     this->ModelDocument = document;
   }
   catch (const std::exception& error)

@@ -236,9 +236,15 @@ using SurfaceParameterFunction = std::function<Eigen::Vector2d(const Vec3& p)>;
  * the surface, in the order of u, to be interpolated (SurfaceCurve).
  *
  * `closed` curves (P(0) == P(1)) are offset outwards for distance > 0, whatever their
- * orientation (the side n points to at the curve point farthest from the centroid of the
- * samples decides), and the returned loop closes exactly (the seam normal is the mean of
- * the normals at u = 0 and 1). Open curves are offset towards +n.
+ * orientation (the sign of the flux of p - centroid through the loop along n decides, which
+ * a sharp edge cannot fool), and the returned loop closes exactly (the seam normal is the
+ * mean of the normals at u = 0 and 1). Open curves are offset towards +n.
+ *
+ * Where the curve bends with a radius of curvature below |distance| on the side it is
+ * offset to (a sharp leading edge, the wiggles of a spline through a capped trailing
+ * edge), the raw offset folds back in a swallowtail; the loop is cut out at the offset's
+ * crossing, as the boundary of the region within the distance has it. Everywhere else
+ * the offset points stay on the curve's normals.
  *
  * Sampling starts with 512 equal steps of u and halves every step across which the normal
  * turns by more than 3 degrees, so a leading edge whose radius is 1e-3 of the curve's
@@ -246,11 +252,11 @@ using SurfaceParameterFunction = std::function<Eigen::Vector2d(const Vec3& p)>;
  * past that the remaining steps are not refined). Deterministic.
  *
  * Throws GeometryError when |distance| is zero or not finite, when a `closed` curve's ends
- * do not meet, when the offset folds back between two samples (|distance| above the
- * radius of curvature on the side it is offset to: consecutive offset points run against
- * the curve), naming the parameter u where it folds, and when the tangent or the surface
- * normal vanish, and when the projections of the samples (`toParameters`, charged to the
- * current WorkBudget) need more than OffsetWorkLimit curve evaluations in all.
+ * do not meet, when the offset folds back without crossing itself nearby (the distance
+ * is larger than the curve is wide: an inward offset past the middle), naming the
+ * parameter u where it folds, when the tangent or the surface normal vanish, and when
+ * the projections of the samples (`toParameters`, charged to the current WorkBudget)
+ * need more than OffsetWorkLimit curve evaluations in all.
  */
 std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
   const Surface& surface, const SurfaceParameterFunction& toParameters, double distance);

@@ -1,5 +1,8 @@
 #include "MemoryBudget.h"
 
+#include "Errors.h"
+#include "ModelSyntax.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -62,6 +65,35 @@ double processVirtualBytes()
   return 0.0;
 }
 } // namespace
+
+void checkDensityMultiplier(const BlockModel& model, double multiplier)
+{
+  using syntax::formatNumber;
+  if (!std::isfinite(multiplier) || !(multiplier > 0.0) || multiplier > MaxDensityMultiplier)
+  {
+    throw TemplateError(model.sourceFile, 0, syntax::entity("model", model.name),
+      "the density multiplier must be a number above 0 and at most " +
+        formatNumber(MaxDensityMultiplier) + ", got " + formatNumber(multiplier));
+  }
+  static const char* const directionNames[3] = { "i", "j", "k" };
+  for (const Block& block : model.blocks)
+  {
+    for (int d = 0; d < 3; ++d)
+    {
+      const double scaled = std::round(block.cells[d] * multiplier);
+      if (scaled > MaxScaledCellsPerDirection)
+      {
+        throw TemplateError(block.where.file, block.where.line,
+          syntax::entity("block", block.name),
+          std::string(directionNames[d]) + ": " + std::to_string(block.cells[d]) +
+            " cells x density multiplier " + formatNumber(multiplier) + " = " +
+            formatNumber(scaled) + " cells, more than " +
+            formatNumber(MaxScaledCellsPerDirection) +
+            " per direction; lower the density multiplier or the cell counts");
+      }
+    }
+  }
+}
 
 std::uint64_t availableMemoryBytes()
 {

@@ -1,10 +1,14 @@
 /**
  * @file MemoryBudget.h
- * @brief Estimates of what a stage will allocate, checked before it allocates: a grid too
- * large for the machine is refused with a clear error instead of VTK's "Unable to
- * allocate" abort, std::bad_alloc, or a machine swapping for minutes.
+ * @brief The size of grid a user may ask for: the density multiplier and scaled cell
+ * counts are validated (errors, not clamps), and what a stage will allocate is estimated
+ * and checked before it allocates: a grid too large for the machine is refused with a
+ * clear error instead of VTK's "Unable to allocate" abort, std::bad_alloc, or a machine
+ * swapping for minutes.
  */
 #pragma once
+
+#include "BlockModel.h"
 
 #include <array>
 #include <cstdint>
@@ -16,6 +20,16 @@ namespace blockforge
 {
 namespace model
 {
+/// Largest density multiplier the mesher accepts (a stated bound, not a clamp).
+constexpr double MaxDensityMultiplier = 1000.0;
+/// Largest cell count per block direction after the density multiplier.
+constexpr double MaxScaledCellsPerDirection = 1.0e6;
+
+/// Throws TemplateError unless `multiplier` is finite, above 0 and at most
+/// MaxDensityMultiplier and every block direction of `model` has at most
+/// MaxScaledCellsPerDirection cells after it (the message names the block and direction).
+void checkDensityMultiplier(const BlockModel& model, double multiplier);
+
 /**
  * @class ResourceError
  * @brief A stage would need more memory than the machine has available or than the

@@ -5,6 +5,7 @@
 #include "../Core/Projection.h"
 #include "../Core/Transfinite.h"
 #include "CarrierGeometry.h"
+#include "MemoryBudget.h"
 #include "ModelSyntax.h"
 #include "Topology.h"
 
@@ -168,7 +169,18 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
           "' is a curve; on_surface needs a surface");
       }
       const Eigen::Vector2d a = edgeEndParameters(model, geometry, edge, 0, size);
-      const Eigen::Vector2d b = edgeEndParameters(model, geometry, edge, 1, size);
+      Eigen::Vector2d b = edgeEndParameters(model, geometry, edge, 1, size);
+      // Straight in (s, t) the short way across the seam of a closed direction: a blade
+      // edge from s = 0.99 at the hub to s = 0.01 at the shroud (an export that starts
+      // its sections at the trailing edge) must not run round the whole blade.
+      if (geometry.closedS(edge.carrier))
+      {
+        b[0] -= std::round(b[0] - a[0]);
+      }
+      if (geometry.closedT(edge.carrier))
+      {
+        b[1] -= std::round(b[1] - a[1]);
+      }
       named.curve = std::make_shared<ParameterLineCurve>(geometry.surface(edge.carrier), a, b,
         geometry.closedS(edge.carrier), geometry.closedT(edge.carrier),
         geometry.extendsT(edge.carrier));
@@ -339,6 +351,54 @@ std::vector<double> lawParameters(
   return distributeNodes(DistributionLaw(), nodeCount, length);
 }
 
+/**
+ * `law` as it applies to `cells` cells when the template gives `templateCells`: a density
+ * multiplier or a preview cap refines or coarsens the grid without changing its shape, so
+ * graded laws keep their overall expansion (geometric: last over first cell; two-sided:
+ * middle over end cell; first cell: its share of the edge). Without this a geometric
+ * ratio of 1.15 over 4 times the cells would make the first cell 1.15^18 times thinner
+ * (besides 4 times), and thin cells at a curved wall fold.
+ */
+DistributionLaw refinedLaw(const DistributionLaw& law, int templateCells, int cells)
+{
+  DistributionLaw refined = law;
+  if (cells == templateCells || templateCells < 1 || cells < 1)
+  {
+    return refined;
+  }
+  switch (law.kind)
+  {
+    case DistributionLaw::Kind::Geometric:
+      if (templateCells > 1 && cells > 1 && law.expansionRatio > 0.0)
+      {
+        refined.expansionRatio = std::pow(law.expansionRatio,
+          static_cast<double>(templateCells - 1) / static_cast<double>(cells - 1));
+      }
+      break;
+    case DistributionLaw::Kind::TwoSided:
+    {
+      const int from = (templateCells - 1) / 2, to = (cells - 1) / 2;
+      if (from > 0 && to > 0 && law.expansionRatio > 0.0)
+      {
+        refined.expansionRatio =
+          std::pow(law.expansionRatio, static_cast<double>(from) / static_cast<double>(to));
+      }
+      break;
+    }
+    case DistributionLaw::Kind::FirstCell:
+      refined.firstCellSize = law.firstCellSize * templateCells / cells;
+      if (law.expansionRatio > 1.0 && cells > 1 && templateCells > 1)
+      {
+        refined.expansionRatio = std::pow(law.expansionRatio,
+          static_cast<double>(templateCells - 1) / static_cast<double>(cells - 1));
+      }
+      break;
+    default:
+      break;
+  }
+  return refined;
+}
+
 std::vector<double> reversedParameters(const std::vector<double>& params)
 {
   const std::size_t n = params.size();
@@ -424,7 +484,9 @@ MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedC
       std::vector<double> params;
       try
       {
-        params = lawParameters(block.laws[use.localEdge], edge.nodeCount, edge.length, allowFallback);
+        params = lawParameters(refinedLaw(block.laws[use.localEdge],
+                                 block.cells[edgeDirection(use.localEdge)], edge.nodeCount - 1),
+          edge.nodeCount, edge.length, allowFallback);
       }
       catch (const GeometryError& error)
       {
@@ -483,7 +545,9 @@ MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedC
           length = std::max(length, topology.edges[links.edge[other]].length);
         }
       }
-      links.collapsedParams[e] = lawParameters(model.blocks[b].laws[e],
+      links.collapsedParams[e] = lawParameters(
+        refinedLaw(model.blocks[b].laws[e], model.blocks[b].cells[edgeDirection(e)],
+          links.nodes[edgeDirection(e)] - 1),
         links.nodes[edgeDirection(e)], length > 0.0 ? length : 1.0, true);
     }
   }
@@ -979,8 +1043,54 @@ void computePeriodicPatchEdges(const BlockModel& model, MeshTopology& topology)
 void copyFaceBoundary(const BlockModel& model, const MeshTopology& topology, int block, int face,
   int na, int nb, std::vector<double>& grid);
 
-/// Grid of a face that lies on a surface: TFI in the surface's (s, t) space, boundary
-/// nodes kept from the edges, interior nodes evaluated on the surface.
+/**
+ * The surface point closest to `target` near (s, t): Gauss-Newton from there on the
+ * surface's own parameters (derivatives by central differences through geometry.point,
+ * which wraps closed and extends Gordon carriers), steps limited so the node stays on
+ * the part of the surface it started on (a thin trailing edge has another side close by).
+ */
+void closestNear(const CarrierGeometry& geometry, int carrier, const Vec3& target, double& s,
+  double& t)
+{
+  const double h = 1e-6, largest = 0.02;
+  for (int iteration = 0; iteration < 8; ++iteration)
+  {
+    const Vec3 p = geometry.point(carrier, s, t);
+    const Vec3 ps = (geometry.point(carrier, s + h, t) - geometry.point(carrier, s - h, t)) / (2 * h);
+    const Vec3 pt = (geometry.point(carrier, s, t + h) - geometry.point(carrier, s, t - h)) / (2 * h);
+    const Vec3 r = target - p;
+    const double a = ps.dot(ps), b = ps.dot(pt), c = pt.dot(pt);
+    const double det = a * c - b * b;
+    if (!(det > 0.0) || !std::isfinite(det))
+    {
+      return;
+    }
+    double ds = (c * ps.dot(r) - b * pt.dot(r)) / det;
+    double dt = (a * pt.dot(r) - b * ps.dot(r)) / det;
+    const double step = std::max(std::abs(ds), std::abs(dt));
+    if (!std::isfinite(step))
+    {
+      return;
+    }
+    if (step > largest)
+    {
+      ds *= largest / step;
+      dt *= largest / step;
+    }
+    s += ds;
+    t = std::clamp(t + dt, geometry.tMin(carrier), geometry.tMax(carrier));
+    if (step < 1e-13)
+    {
+      return;
+    }
+  }
+}
+
+/// Grid of a face that lies on a surface: boundary nodes kept from the edges; each
+/// interior node is the surface point closest to the face's 3-D TFI node, searched from
+/// the TFI node in the surface's (s, t) space. TFI in (s, t) alone follows the
+/// parametrisation, which is far from even on a blade (aligned sections crowd the round
+/// edges into small s ranges): at high densities it put nodes behind their neighbours.
 void surfaceFace(const BlockModel& model, const MeshTopology& topology, const CarrierGeometry& geometry,
   int carrier, int block, int face, std::vector<double>& out)
 {
@@ -1046,13 +1156,18 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
   transfiniteFace(EdgeNodes{ pb.data(), bottom.params(), na }, EdgeNodes{ pt.data(), top.params(), na },
     EdgeNodes{ pl.data(), left.params(), nb }, EdgeNodes{ pr.data(), right.params(), nb },
     parameters.data());
+  std::vector<double> targets(parameters.size());
+  transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), targets.data());
   out.resize(parameters.size());
   for (int b = 1; b + 1 < nb; ++b)
   {
     for (int a = 1; a + 1 < na; ++a)
     {
       const std::size_t i = static_cast<std::size_t>(b) * na + a;
-      const Vec3 p = geometry.point(carrier, parameters[3 * i], parameters[3 * i + 1]);
+      double s = parameters[3 * i], t = parameters[3 * i + 1];
+      closestNear(geometry, carrier, Vec3(targets[3 * i], targets[3 * i + 1], targets[3 * i + 2]),
+        s, t);
+      const Vec3 p = geometry.point(carrier, s, t);
       std::copy_n(p.data(), 3, &out[3 * i]);
     }
   }
@@ -1318,31 +1433,8 @@ MultiBlockMesher::MultiBlockMesher(
   const BlockModel& model, const CarrierGeometry* carriers, double densityMultiplier)
   : P(new Impl)
 {
-  if (!std::isfinite(densityMultiplier) || !(densityMultiplier > 0.0) ||
-    densityMultiplier > MaxDensityMultiplier)
-  {
-    throw TemplateError(model.sourceFile, 0, entity("model", model.name),
-      "the density multiplier must be a number above 0 and at most " +
-        formatNumber(MaxDensityMultiplier) + ", got " + formatNumber(densityMultiplier));
-  }
+  checkDensityMultiplier(model, densityMultiplier);
   checkBasics(model);
-  static const char* const directionNames[3] = { "i", "j", "k" };
-  for (const Block& block : model.blocks)
-  {
-    for (int d = 0; d < 3; ++d)
-    {
-      const double scaled = std::round(block.cells[d] * densityMultiplier);
-      if (scaled > MaxScaledCellsPerDirection)
-      {
-        fail(block.where, entity("block", block.name),
-          std::string(directionNames[d]) + ": " + std::to_string(block.cells[d]) +
-            " cells x density multiplier " + formatNumber(densityMultiplier) + " = " +
-            formatNumber(scaled) + " cells, more than " +
-            formatNumber(MaxScaledCellsPerDirection) +
-            " per direction; lower the density multiplier or the cell counts");
-      }
-    }
-  }
   P->Model = model;
   P->Multiplier = densityMultiplier;
   P->Geometry = carriers ? *carriers : CarrierGeometry(P->Model);

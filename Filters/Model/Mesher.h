@@ -43,11 +43,6 @@ void checkModel(const BlockModel& model);
 /// again (the blade intersections are most of the time to apply a template).
 void checkModel(const BlockModel& model, const CarrierGeometry& geometry);
 
-/// Largest density multiplier the mesher accepts (a stated bound, not a clamp).
-constexpr double MaxDensityMultiplier = 1000.0;
-/// Largest cell count per block direction after the density multiplier.
-constexpr double MaxScaledCellsPerDirection = 1.0e6;
-
 /**
  * @class MultiBlockMesher
  * @brief Generates the grid of every block of a checked model.
@@ -58,7 +53,8 @@ public:
   /// `densityMultiplier` scales every cell count: cells = max(1, round(cells * m)).
   /// Calls checkModel(); throws TemplateError on any problem, also when the multiplier is
   /// not in (0, MaxDensityMultiplier] or a scaled count exceeds MaxScaledCellsPerDirection
-  /// (errors, not clamps: the user asked for something else than what would be meshed).
+  /// (checkDensityMultiplier; errors, not clamps: the user asked for something else than
+  /// what would be meshed).
   MultiBlockMesher(const BlockModel& model, double densityMultiplier = 1.0);
   /// Same with the model's carriers already built (loadTemplate's `carriers`).
   MultiBlockMesher(const BlockModel& model, const CarrierGeometry& carriers,

@@ -443,6 +443,7 @@ public:
     readBlocks();
     readFaces();
     readPatches();
+    readNotes();
     return std::move(Model);
   }
 
@@ -610,7 +611,7 @@ private:
     Sections = syntax::mapEntries(root, 1, "", "the template", Report);
     syntax::checkKeys(Sections,
       { "blockforge", "name", "description", "inputs", "machine", "parameters", "definitions",
-        "carriers", "vertices", "edges", "blocks", "faces", "patches" },
+        "carriers", "vertices", "edges", "blocks", "faces", "patches", "notes" },
       "", Report);
     const MapEntry* version = syntax::findEntry(Sections, "blockforge");
     if (!version)
@@ -636,7 +637,7 @@ private:
     Version = static_cast<int>(versionNumber);
     if (Version < 2)
     {
-      for (const char* key : { "inputs", "machine", "definitions", "carriers", "faces" })
+      for (const char* key : { "inputs", "machine", "definitions", "carriers", "faces", "notes" })
       {
         if (const MapEntry* entry = syntax::findEntry(Sections, key))
         {
@@ -1092,6 +1093,57 @@ private:
         block.laws[e] = syntax::parseLaw(law.value, law.line, entityText,
           "grading " + law.key, numberReader(entityText), Report);
       }
+    }
+  }
+
+  /// Format 2 `notes`: `name: {when: <expression>, say: "text with {expression}s"}`; the
+  /// text of every note whose `when` is not 0 goes to Model.notes, each {expression}
+  /// replaced by its value (how a template says which of its choices it made).
+  void readNotes()
+  {
+    const MapEntry* notes = section("notes");
+    if (!notes || notes->value.IsNull())
+    {
+      return;
+    }
+    for (const MapEntry& entry :
+      syntax::mapEntries(notes->value, notes->line, "", "the notes section", Report, "note"))
+    {
+      const std::string entityText = entity("note", entry.key);
+      const auto keys =
+        syntax::mapEntries(entry.value, entry.line, entityText, "a note", Report);
+      syntax::checkKeys(keys, { "when", "say" }, entityText, Report);
+      const MapEntry* when = syntax::findEntry(keys, "when");
+      const MapEntry* say = syntax::findEntry(keys, "say");
+      if (!say || !say->value.IsScalar())
+      {
+        fail(entry.line, entityText, "a note needs 'say: <text>' (and 'when: <expression>')");
+      }
+      if (when && number(when->value, when->line, entityText, "when") == 0.0)
+      {
+        continue;
+      }
+      const std::string text = say->value.Scalar();
+      std::string said;
+      for (std::size_t at = 0; at < text.size();)
+      {
+        const std::size_t open = text.find('{', at);
+        if (open == std::string::npos)
+        {
+          said += text.substr(at);
+          break;
+        }
+        const std::size_t close = text.find('}', open);
+        if (close == std::string::npos)
+        {
+          fail(say->line, entityText, "'{' without '}' in the text");
+        }
+        said += text.substr(at, open - at);
+        YAML::Node expression(text.substr(open + 1, close - open - 1));
+        said += shortNumber(number(expression, say->line, entityText, "say"));
+        at = close + 1;
+      }
+      Model.notes.push_back(said);
     }
   }
 
@@ -1644,6 +1696,10 @@ private:
       {
         ensureVertex(index);
       }
+      else if (Model.findCarrier(referenced) >= 0)
+      {
+        ensureCarrier(Model.findCarrier(referenced)); // contour.axial_min, ...
+      }
     };
     for (std::size_t d = 0; d < DefinitionEntries.size(); ++d)
     {
@@ -1776,6 +1832,54 @@ private:
       Evaluator.Unavailable[n + ".s"] = why;
       Evaluator.Unavailable[n + ".t"] = why;
     }
+  }
+
+  /// `revolve: ..., extend: f`: the contour continues straight along its end tangents by
+  /// f times its length at both ends (short exports: inlet and outlet further out).
+  void extendContour(std::vector<Vec3>& points, double fraction, int line,
+    const std::string& entityText)
+  {
+    if (!(fraction >= 0.0) || fraction > 10.0)
+    {
+      fail(line, entityText, "extend: expected a fraction of the contour's length from 0 to "
+                             "10, got " + shortNumber(fraction));
+    }
+    if (fraction == 0.0 || points.size() < 2)
+    {
+      return;
+    }
+    double length = 0.0;
+    for (std::size_t k = 1; k < points.size(); ++k)
+    {
+      length += (points[k] - points[k - 1]).norm();
+    }
+    const Vec3 back = (points[0] - points[1]).normalized();
+    const Vec3 ahead = (points.back() - points[points.size() - 2]).normalized();
+    const Vec3 first = points.front(), last = points.back();
+    for (int step = 1; step <= 4; ++step)
+    {
+      points.insert(points.begin(), first + fraction * length * step / 4.0 * back);
+      points.push_back(last + fraction * length * step / 4.0 * ahead);
+    }
+  }
+
+  /// `<revolve carrier>.axial_min` and `.axial_max`: where its contour starts and ends
+  /// along the axis (an inlet or outlet plane must stay within them).
+  void defineContourQueries(const Carrier& carrier, const std::vector<Vec3>& points)
+  {
+    if (!syntax::isIdentifier(carrier.name) || points.empty())
+    {
+      return;
+    }
+    double low = std::numeric_limits<double>::infinity(), high = -low;
+    for (const Vec3& p : points)
+    {
+      const double axial = (p - carrier.axisPoint).dot(carrier.axis);
+      low = std::min(low, axial);
+      high = std::max(high, axial);
+    }
+    Evaluator.defineQuery(carrier.name + ".axial_min", low);
+    Evaluator.defineQuery(carrier.name + ".axial_max", high);
   }
 
   void ensureCarrier(int index)
@@ -2079,7 +2183,8 @@ private:
     if (kind->key == "revolve")
     {
       syntax::checkKeys(keys,
-        { "revolve", "axis", "origin", "angle", "meridional", "degree", "parameters" },
+        { "revolve", "axis", "origin", "angle", "meridional", "degree", "parameters",
+          "extend" },
         entityText, Report);
       carrier.kind = Carrier::Kind::Revolve;
       carrier.axis = Model.machine.axis;
@@ -2159,6 +2264,12 @@ private:
           point = meridional(point, carrier.axisPoint, carrier.axis);
         }
       }
+      if (const MapEntry* extend = syntax::findEntry(keys, "extend"))
+      {
+        extendContour(contour.points,
+          number(extend->value, extend->line, entityText, "extend"), extend->line, entityText);
+      }
+      defineContourQueries(carrier, contour.points);
       carrier.refs = { addHiddenCarrier(contour) };
       return;
     }

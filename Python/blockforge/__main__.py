@@ -123,7 +123,7 @@ def main(argv=None):
                                           binary=not args.ascii)
             else:
                 write_grid(quality.GetOutputDataObject(0), args.output)
-        except (RuntimeError, OSError) as error:
+        except (RuntimeError, OSError, ValueError) as error:
             print(f"error: {printable(error)}", file=sys.stderr)
             return 1
         print(f"grid written to {printable(args.output)} ({time.perf_counter() - start:.3f} s)")

@@ -27,8 +27,17 @@ import secrets
 import shutil
 import xml.etree.ElementTree as ElementTree
 
+from . import printable
+
 STAGING_SUFFIX = ".staging"
 PIECES_MARK = ".pieces-"
+
+
+def _companion_stem(name):
+    """The target's stem for companion names, with bytes that are not UTF-8 made '_': the
+    main file names its companions, and a .vtm must be valid UTF-8 XML to be read."""
+    stem = os.path.splitext(name)[0]
+    return "".join("_" if "\udc80" <= c <= "\udcff" else c for c in stem)
 
 
 def _process_alive(pid):
@@ -66,13 +75,17 @@ class StagedOutput:
     def __init__(self, target):
         self.target = os.path.abspath(target)
         self.directory, self.name = os.path.split(self.target)
-        self.stem = os.path.splitext(self.name)[0]
-        os.makedirs(self.directory, exist_ok=True)
+        self.stem = _companion_stem(self.name)
         self.token = f"{os.getpid()}-{secrets.token_hex(4)}"
-        clean_leftovers(self.target)
         self.staging = os.path.join(self.directory,
                                     f".{self.name}.{self.token}{STAGING_SUFFIX}")
-        os.mkdir(self.staging)
+        try:
+            os.makedirs(self.directory, exist_ok=True)
+            clean_leftovers(self.target)
+            os.mkdir(self.staging)
+        except OSError as error:
+            raise RuntimeError(f"cannot write {printable(self.target)}: "
+                               f"{error.strerror or error}") from None
         self._published = []  # fresh companions moved beside the target, for rollback
 
     def __enter__(self):
@@ -139,7 +152,7 @@ def clean_leftovers(target):
     paths."""
     target = os.path.abspath(target)
     directory, name = os.path.split(target)
-    stem = os.path.splitext(name)[0]
+    stem = _companion_stem(name)
     staging = re.compile(re.escape(f".{name}.") + r"(\d+)-[0-9a-f]+" + re.escape(STAGING_SUFFIX))
     pieces = re.compile(re.escape(stem + PIECES_MARK) + r"(\d+)-[0-9a-f]+")
     try:
@@ -159,6 +172,12 @@ def clean_leftovers(target):
     return removed
 
 
+def _path_argument(path):
+    from . import _path_argument as convert
+
+    return convert(path)
+
+
 def _check_piece(path, block):
     """Reads a written piece back: raises RuntimeError unless it is complete and has the
     block's dimensions."""
@@ -167,7 +186,7 @@ def _check_piece(path, block):
     messages = _Messages()
     reader = vtkXMLStructuredGridReader()
     messages.watch(reader)
-    reader.SetFileName(path)
+    reader.SetFileName(_path_argument(path))
     reader.Update()
     grid = reader.GetOutput()
     if (messages.texts or grid is None
@@ -175,7 +194,7 @@ def _check_piece(path, block):
             or grid.GetNumberOfCells() != block.GetNumberOfCells()
             or grid.GetCellData().GetNumberOfArrays() != block.GetCellData().GetNumberOfArrays()):
         detail = f": {messages.first()}" if messages.texts else ""
-        raise RuntimeError(f"{path} is incomplete after writing{detail}")
+        raise RuntimeError(f"{printable(path)} is incomplete after writing{detail}")
 
 
 class _Messages:
@@ -254,15 +273,15 @@ def write_vtm(data_object, path):
         writer = vtkXMLMultiBlockDataWriter()
         messages.watch(writer)
         writer.SetInputData(data_object)
-        writer.SetFileName(staged_main)
+        writer.SetFileName(_path_argument(staged_main))
         writer.SetDataModeToAppended()
         writer.EncodeAppendedDataOff()
         with _quiet_vtk() as noise:
             written = writer.Write()
         if not written or messages.texts or writer.GetErrorCode() or noise.GetOutput():
             detail = messages.first() if messages.texts else "the VTK writer failed"
-            raise RuntimeError(f"could not write {path}: {detail} (check the free space, "
-                               "the file size limit and the permissions there)")
+            raise RuntimeError(f"could not write {printable(path)}: {detail} (check the free "
+                               "space, the file size limit and the permissions there)")
         # What was written: the .vtm must be complete XML naming one piece per non-empty
         # block, each piece complete and the size of its block.
         staged_pieces = output.staged(pieces)
@@ -273,15 +292,16 @@ def write_vtm(data_object, path):
                 if element.get("file"):
                     references.append(element.get("file"))
         except ElementTree.ParseError as error:
-            raise RuntimeError(f"could not write {path}: the written .vtm is incomplete "
-                               f"({error})") from None
+            raise RuntimeError(f"could not write {printable(path)}: the written .vtm is "
+                               f"incomplete ({error})") from None
         if len(references) != len(blocks):
-            raise RuntimeError(f"could not write {path}: {len(references)} of {len(blocks)} "
-                               "pieces written")
+            raise RuntimeError(f"could not write {printable(path)}: {len(references)} of "
+                               f"{len(blocks)} pieces written")
         for reference, block in zip(references, blocks):
             piece = os.path.join(output.staging, reference)
             if os.path.dirname(os.path.normpath(piece)) != staged_pieces:
-                raise RuntimeError(f"could not write {path}: unexpected piece {reference}")
+                raise RuntimeError(f"could not write {printable(path)}: unexpected piece "
+                                   f"{printable(reference)}")
             _check_piece(piece, block)
             sync_file(piece)
         sync_file(staged_main)

@@ -44,7 +44,7 @@ def fresh_directory(name):
 
 def read_grid(path):
     reader = vtkXMLMultiBlockDataReader()
-    reader.SetFileName(path)
+    reader.SetFileName(os.fsencode(path))
     reader.Update()
     return named_leaves(reader.GetOutput())
 
@@ -85,6 +85,18 @@ class MessagesTest(unittest.TestCase):
         status, _, err = run_main(AXIAL_OH, "-i", os.path.join(self.data, "BladeGen.inf"))
         self.assertEqual(status, 1)
         self.assertRegex(err, r"^error: .*hub\.curve:5: .*\\xff")
+
+    def test_output_path(self):
+        """A stray byte in the output name: the grid is written and readable (its pieces
+        folder is named without the byte, so the .vtm stays valid UTF-8 XML)."""
+        path = os.fsdecode(os.path.join(os.fsencode(self.directory), b"grid\xff.vtm"))
+        status, out, err = run_main(CYLINDER, "-o", path)
+        self.assertEqual(status, 0, err)
+        self.assertIn("grid written to", out)
+        self.assertIn("grid\\xff.vtm", out)
+        self.assertEqual(len(read_grid(path)), 4)
+        folder = blockforge.output.referenced_folders(path).pop()
+        self.assertTrue(os.path.basename(folder).startswith("grid_.pieces-"), folder)
 
     def test_output_window_gets_the_escaped_text(self):
         """ParaView's Output Messages show what VTK's output window receives."""
@@ -161,6 +173,37 @@ class MemoryTest(unittest.TestCase):
         source.Update()
         self.assertIn("lower PreviewCells or the cell counts",
                       blockforge._message(errors.messages[0]))
+
+
+@unittest.skipUnless(os.environ.get("BLOCKFORGE_CLI"), "BLOCKFORGE_CLI not set")
+class NativeCommandLineTest(unittest.TestCase):
+    """The native command line refuses and escapes like the Python one."""
+
+    def run_native(self, *arguments):
+        output = os.path.join(fresh_directory("native"), "case", "grid.foam")
+        return subprocess.run([os.environ["BLOCKFORGE_CLI"]] + list(arguments) +
+                              ["-o", output], capture_output=True, timeout=60)
+
+    def test_refusals(self):
+        for arguments, needle in (
+                (["-d", "1000"], b"the grid would need 209 TB for 8.2e+12 nodes"),
+                (["-d", "inf"], b"the density multiplier must be a number above 0"),
+                (["-m", "0.00001"], b"more than MaximumMemory (10.5 kB)")):
+            result = self.run_native(CYLINDER, *arguments)
+            self.assertEqual(result.returncode, 1, result.stderr)
+            self.assertIn(needle, result.stderr)
+
+    def test_stray_bytes(self):
+        template = os.path.join(fresh_directory("native_stray").encode(), b"bad\xfe.yaml")
+        with open(CYLINDER, "rb") as stream:
+            text = stream.read()
+        with open(template, "wb") as stream:
+            stream.write(text.replace(b"blocks:", b"blocks:\n  b\xff: {}", 1))
+        result = self.run_native(os.fsdecode(template))
+        self.assertEqual(result.returncode, 1)
+        self.assertIn(b"bad\\xfe.yaml:", result.stderr)
+        self.assertIn(b"block 'b\\xff'", result.stderr)
+        result.stderr.decode("utf-8")  # valid UTF-8
 
 
 class TemplateFileTest(unittest.TestCase):
