@@ -48,16 +48,20 @@ private:
   double Sum = 0.0, Compensation = 0.0;
 };
 
+/// Smallest cell, as a fraction of its edge: below it the nodes of a cell coincide once
+/// they are placed on the edge's coordinates (rounding), and the cell has no volume.
+constexpr double MinCellFraction = 1e-12;
+
 void requireStrictlyIncreasing(const std::vector<double>& s, const char* lawName)
 {
   for (std::size_t i = 1; i < s.size(); ++i)
   {
-    if (!(s[i] > s[i - 1]))
+    if (!(s[i] - s[i - 1] >= MinCellFraction))
     {
       throw GeometryError(std::string(lawName) + " distribution: with " +
-        std::to_string(s.size()) +
-        " nodes the smallest cells become too small to represent; reduce the expansion "
-        "ratio or the number of nodes");
+        std::to_string(s.size()) + " nodes the smallest cells become too small to " +
+        "represent (below 1e-12 of the edge); reduce the expansion ratio or the number of " +
+        "nodes");
     }
   }
 }

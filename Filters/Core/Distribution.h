@@ -49,7 +49,8 @@ struct DistributionLaw
  * Relative node positions s_0 = 0 < s_1 < ... < s_(n-1) = 1 for `nodeCount` nodes
  * (>= 2) on an edge of length `edgeLength` (used only by FirstCell). Throws
  * GeometryError when the law cannot be met (non-positive ratio, first cell too large
- * or too small for the edge with the given ratio), the message says why in user terms.
+ * or too small for the edge with the given ratio, a cell below 1e-12 of the edge, whose
+ * nodes would coincide once placed), the message says why in user terms.
  */
 std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
   double edgeLength = 1.0);

@@ -2,6 +2,7 @@
 
 #include "../Core/BSpline.h"
 #include "../Core/Curve.h"
+#include "../Core/Parallel.h"
 #include "../Core/Projection.h"
 #include "../Core/Transfinite.h"
 #include "CarrierGeometry.h"
@@ -1489,13 +1490,15 @@ void MultiBlockMesher::computeBoundaries()
     imageOf[entry.image] = &entry;
   }
   const std::map<int, int> onSurface = surfaceFaceCarriers(model, topology);
-  for (std::size_t f = 0; f < topology.faces.size(); ++f)
-  {
+  // Faces are computed from their edges alone, each into its own grid: on threads when a
+  // runner is installed (Core/Parallel.h), with the same bits, and the error of the first
+  // failing face in face order.
+  forEachChunk(static_cast<long>(topology.faces.size()), [&](long f) {
     UniqueFace& face = topology.faces[f];
     const FaceUse& owner = face.uses.front();
     if (imageOf.count(static_cast<int>(f)))
     {
-      continue;
+      return;
     }
     try
     {
@@ -1514,7 +1517,7 @@ void MultiBlockMesher::computeBoundaries()
       fail(model.blocks[owner.block].where, blockEntity(model, owner.block),
         "face " + blockFaceText(model, owner.block, owner.face) + ": " + error.what());
     }
-  }
+  });
   for (const PeriodicPair& entry : images)
   {
     periodicFace(model, topology, entry, topology.faces[entry.image].xyz);
