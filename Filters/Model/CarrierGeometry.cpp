@@ -98,13 +98,15 @@ Vec3 ParameterLineCurve::point(double u) const
 Vec3 ParameterLineCurve::derivative(double u, int order) const
 {
   const Eigen::Vector2d st = parameters(u);
-  SurfaceDerivatives d;
-  TheSurface->derivatives(st[0], st[1], d);
   const Eigen::Vector2d delta = To - From;
   if (order == 1)
   {
-    return d.Ps * delta[0] + d.Pt * delta[1];
+    Vec3 P, Ps, Pt;
+    TheSurface->firstDerivatives(st[0], st[1], P, Ps, Pt);
+    return Ps * delta[0] + Pt * delta[1];
   }
+  SurfaceDerivatives d;
+  TheSurface->derivatives(st[0], st[1], d);
   return d.Pss * delta[0] * delta[0] + 2.0 * d.Pst * delta[0] * delta[1] +
     d.Ptt * delta[1] * delta[1];
 }
