@@ -390,53 +390,51 @@ Vec3 SurfaceOfRevolution::point(double s, double t) const
     rotateVector(Contour->point(s) - AxisPoint, AxisDirection, std::cos(angle), std::sin(angle));
 }
 
-void SurfaceOfRevolution::derivatives(double s, double t, SurfaceDerivatives& out) const
+void SurfaceOfRevolution::contourJet(double s, int order, Vec3 (&c)[3]) const
 {
-  Vec3 c[3];
   if (const auto* spline = dynamic_cast<const BSplineCurve*>(Contour.get()))
   {
-    spline->derivatives(s, 2, c);
+    spline->derivatives(s, order, c);
+    return;
   }
-  else
-  {
-    c[0] = Contour->point(s);
-    c[1] = Contour->derivative(s, 1);
-    c[2] = Contour->derivative(s, 2);
-  }
+  c[0] = Contour->point(s);
+  c[1] = Contour->derivative(s, 1);
+  c[2] = order >= 2 ? Contour->derivative(s, 2) : Vec3::Zero();
+}
+
+void SurfaceOfRevolution::derivatives(double s, double t, SurfaceDerivatives& out) const
+{
+  Vec3 c[3], arm;
+  contourJet(s, 2, c);
+  double cs = 0.0, sn = 0.0;
+  firstOrder(c, t, out.P, out.Ps, out.Pt, cs, sn, arm);
   const double sweep = AngleEnd - AngleStart;
-  const double angle = AngleStart + t * sweep;
-  const double cs = std::cos(angle), sn = std::sin(angle);
   const Vec3& k = AxisDirection;
-  const Vec3 arm = angle == 0.0 ? Vec3(c[0] - AxisPoint) : rotateVector(c[0] - AxisPoint, k, cs, sn);
-  out.P = angle == 0.0 ? c[0] : Vec3(AxisPoint + arm);
-  out.Ps = rotateVector(c[1], k, cs, sn);
   out.Pss = rotateVector(c[2], k, cs, sn);
-  // d/dangle of a rotation is k x (rotated vector).
-  out.Pt = sweep * k.cross(arm);
   out.Ptt = sweep * sweep * k.cross(k.cross(arm));
   out.Pst = sweep * k.cross(out.Ps);
 }
 
-// The same as derivatives() without the second-order terms.
 void SurfaceOfRevolution::firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const
 {
-  Vec3 c[3];
-  if (const auto* spline = dynamic_cast<const BSplineCurve*>(Contour.get()))
-  {
-    spline->derivatives(s, 1, c);
-  }
-  else
-  {
-    c[0] = Contour->point(s);
-    c[1] = Contour->derivative(s, 1);
-  }
+  Vec3 c[3], arm;
+  contourJet(s, 1, c);
+  double cs = 0.0, sn = 0.0;
+  firstOrder(c, t, P, Ps, Pt, cs, sn, arm);
+}
+
+void SurfaceOfRevolution::firstOrder(const Vec3 (&c)[3], double t, Vec3& P, Vec3& Ps, Vec3& Pt,
+  double& cs, double& sn, Vec3& arm) const
+{
   const double sweep = AngleEnd - AngleStart;
   const double angle = AngleStart + t * sweep;
-  const double cs = std::cos(angle), sn = std::sin(angle);
+  cs = std::cos(angle);
+  sn = std::sin(angle);
   const Vec3& k = AxisDirection;
-  const Vec3 arm = angle == 0.0 ? Vec3(c[0] - AxisPoint) : rotateVector(c[0] - AxisPoint, k, cs, sn);
+  arm = angle == 0.0 ? Vec3(c[0] - AxisPoint) : rotateVector(c[0] - AxisPoint, k, cs, sn);
   P = angle == 0.0 ? c[0] : Vec3(AxisPoint + arm);
   Ps = rotateVector(c[1], k, cs, sn);
+  // d/dangle of a rotation is k x (rotated vector).
   Pt = sweep * k.cross(arm);
 }
 

@@ -65,6 +65,11 @@ public:
   double contourParameter(const Vec3& p) const;
 
 private:
+  /// Point and derivatives of the contour at s up to `order` (1 or 2).
+  void contourJet(double s, int order, Vec3 (&c)[3]) const;
+  /// Point and first derivatives from the contour's jet, with the rotation at t.
+  void firstOrder(const Vec3 (&c)[3], double t, Vec3& P, Vec3& Ps, Vec3& Pt, double& cs,
+    double& sn, Vec3& arm) const;
   CurvePtr Contour;
   Vec3 AxisPoint, AxisDirection;
   double AngleStart, AngleEnd;

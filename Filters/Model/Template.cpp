@@ -2580,18 +2580,7 @@ private:
 
   double vertexSpan() const
   {
-    Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
-    bool any = false;
-    for (const Vertex& vertex : Model.vertices)
-    {
-      if (vertex.position.allFinite())
-      {
-        low = low.cwiseMin(vertex.position);
-        high = high.cwiseMax(vertex.position);
-        any = true;
-      }
-    }
-    return any ? (high - low).norm() : 0.0;
+    return placedVertexSpan(Model);
   }
 
   void checkOnCarrier(int vertex, int carrier, double distance, int line, const std::string& entityText)
