@@ -8,6 +8,8 @@
  *                       + meshBlock() of every block into preallocated buffers [nodes/s];
  * - MeshBlocks/<size>:  meshBlock() of every block only (boundaries computed once);
  * - Quality/<size>:     computeGridQuality() of the grid (all six measures) [cells/s];
+ * - CheckCells/<size>:  findInvertedCells() of every block, the mesher's check of every
+ *                       grid it hands out, to compare with MeshBlocks [cells/s];
  * and, as the limit to approach, on a unit cube with the same node count:
  * - PlainTFI/<size>:    a plain trilinear TFI loop (paper eq. 6 evaluated node by node
  *                       from the 6 faces, 12 edges, 8 vertices) [nodes/s];
@@ -20,6 +22,7 @@
  */
 #include <benchmark/benchmark.h>
 
+#include "InvertedCells.h"
 #include "Mesher.h"
 #include "Quality.h"
 #include "Template.h"
@@ -194,6 +197,24 @@ void BM_Quality(benchmark::State& state, double multiplier)
     std::vector<CellQualityArrays> quality = computeGridQuality(blocks);
     benchmark::DoNotOptimize(quality.data());
     benchmark::ClobberMemory();
+  }
+  setRates(state, "cells/s", grid.counts.cells);
+  state.counters["cells"] = static_cast<double>(grid.counts.cells);
+}
+
+void BM_CheckCells(benchmark::State& state, double multiplier)
+{
+  Grid& grid = meshedGrid(multiplier);
+  for (auto _ : state)
+  {
+    std::int64_t inverted = 0;
+    for (size_t b = 0; b < grid.xyz.size(); ++b)
+    {
+      inverted += findInvertedCells(
+        grid.xyz[b].data(), grid.dims[b][0], grid.dims[b][1], grid.dims[b][2])
+                    .count;
+    }
+    benchmark::DoNotOptimize(inverted);
   }
   setRates(state, "cells/s", grid.counts.cells);
   state.counters["cells"] = static_cast<double>(grid.counts.cells);
@@ -381,6 +402,9 @@ int main(int argc, char** argv)
         ->UseRealTime()
         ->Unit(benchmark::kMillisecond);
       benchmark::RegisterBenchmark(("Quality" + suffix).c_str(), BM_Quality, multiplier)
+        ->UseRealTime()
+        ->Unit(benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(("CheckCells" + suffix).c_str(), BM_CheckCells, multiplier)
         ->UseRealTime()
         ->Unit(benchmark::kMillisecond);
       benchmark::RegisterBenchmark(("PlainTFI" + suffix).c_str(), BM_PlainTFI, counts.nodes)

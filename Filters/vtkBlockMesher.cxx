@@ -5,6 +5,8 @@
 #include "../Model/ModelDocument.h"
 
 #include <vtkDataObject.h>
+#include <vtkFieldData.h>
+#include <vtkIdTypeArray.h>
 #include <vtkInformation.h>
 #include <vtkInformationVector.h>
 #include <vtkMultiBlockDataSet.h>
@@ -51,12 +53,31 @@ int vtkBlockMesher::RequestData(
     this->UpdateProgress(0.0);
     const blockforge::model::BlockModel blockModel =
       blockforge::model::readModelDocument(document);
+    std::vector<blockforge::model::InvertedCellReport> folds;
     blockforge::vtkglue::meshModel(blockModel, document, this->DensityMultiplier, 0, piece,
-      pieceCount, output, [this](double fraction) { this->UpdateProgress(fraction); });
+      pieceCount, output, [this](double fraction) { this->UpdateProgress(fraction); },
+      nullptr,
+      this->AllowInvertedCells ? blockforge::vtkglue::InvertedCellPolicy::Report
+                               : blockforge::vtkglue::InvertedCellPolicy::Refuse,
+      &folds, this->MaximumMemory);
+    if (this->AllowInvertedCells)
+    {
+      vtkIdType inverted = 0;
+      for (const auto& fold : folds)
+      {
+        vtkWarningMacro(<< "AllowInvertedCells is on, the grid is output anyway: "
+                        << blockforge::vtkglue::printable(fold.message.c_str()));
+        inverted += fold.cells;
+      }
+      vtkNew<vtkIdTypeArray> count;
+      count->SetName("InvertedCellCount");
+      count->InsertNextValue(inverted);
+      output->GetFieldData()->AddArray(count);
+    }
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro(<< error.what());
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
     output->Initialize();
     return 0;
   }
@@ -68,4 +89,6 @@ void vtkBlockMesher::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "DensityMultiplier: " << this->DensityMultiplier << "\n";
+  os << indent << "MaximumMemory: " << this->MaximumMemory << " GB\n";
+  os << indent << "AllowInvertedCells: " << this->AllowInvertedCells << "\n";
 }

@@ -14,6 +14,8 @@
 #include "Quality.h"
 #include "QualityKernels.h"
 
+#include "Parallel.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -87,6 +89,8 @@ struct BlockView
   int ni, nj, nk; // nodes
   int ci, cj, ck; // cells
   long cellCount;
+  /// A neighbour layer (another rank's cells) takes part with this side only; -1: all.
+  int onlySide = -1;
 
   explicit BlockView(const StructuredBlock& b)
     : xyz(b.xyz)
@@ -299,7 +303,7 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     for (int side = 0; side < 6; ++side)
     {
       table.sideOffset[6 * blockIndex + side] = count;
-      if (view.cellCount > 0)
+      if (view.cellCount > 0 && (view.onlySide < 0 || view.onlySide == side))
       {
         count += static_cast<long>(view.sideWidth(side)) * view.sideHeight(side);
       }
@@ -319,6 +323,10 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     }
     for (int side = 0; side < 6; ++side)
     {
+      if (view.onlySide >= 0 && view.onlySide != side)
+      {
+        continue;
+      }
       for (int b = 0; b < view.sideHeight(side); ++b)
       {
         for (int a = 0; a < view.sideWidth(side); ++a)
@@ -407,7 +415,9 @@ bool linkMatches(const std::vector<BlockView>& views, const PeriodicSideLink& li
   }
   const BlockView& source = views[link.sourceBlock];
   const BlockView& image = views[link.imageBlock];
-  if (source.cellCount == 0 || image.cellCount == 0)
+  if (source.cellCount == 0 || image.cellCount == 0 ||
+    (source.onlySide >= 0 && source.onlySide != link.sourceSide) ||
+    (image.onlySide >= 0 && image.onlySide != link.imageSide))
   {
     return false;
   }
@@ -662,18 +672,6 @@ struct FaceArrays
   }
 };
 
-/// The centres of the cells along the six sides of a block, indexed like the side's faces
-/// (BlockView::sideFace), kept by the grid pass for the boundary faces.
-struct SideCentres
-{
-  CoordinateArrays side[6];
-  P3 at(int s, int a, int b, const BlockView& view) const
-  {
-    const long n = a + static_cast<long>(view.sideWidth(s)) * b;
-    return { side[s].x[n], side[s].y[n], side[s].z[n] };
-  }
-};
-
 /// Rolling per-block buffers of the grid pass.
 class BlockPass
 {
@@ -688,8 +686,7 @@ public:
     // between them, 2 layers of cell centres (x, y, z).
     // Upper faces: of a row (i), of the previous row (j), of the previous layer (k).
     const long size = 2 * 3 * plane_ + 2 * 2 * 2 * plane_ + 2 * plane_ + 2 * 3 * layerCells_ +
-      9 * (2 * static_cast<long>(view.ci) + layerCells_) +
-      3 * 2 * (static_cast<long>(view.cj) * view.ck + static_cast<long>(view.ci) * view.ck + layerCells_);
+      9 * (2 * static_cast<long>(view.ci) + layerCells_);
     if (scratch.capacity() < static_cast<std::size_t>(size))
     {
       scratch = std::vector<double>();
@@ -724,25 +721,19 @@ public:
     iFaces_ = faceArrays(view.ci);
     jFaces_ = faceArrays(view.ci);
     kFaces_ = faceArrays(layerCells_);
-    for (int s = 0; s < 6; ++s)
-    {
-      const long count = static_cast<long>(view.sideWidth(s)) * view.sideHeight(s);
-      sides_.side[s] = { take(count), take(count), take(count) };
-    }
     minCosine2_ = quality.nonOrthogonality;
     maxSkewness_ = quality.skewness;
   }
 
-  /// Centres of the cells along the block's sides, complete after the last layer.
-  const SideCentres& sideCentres() const { return sides_; }
-
-  /// Shape measures of every cell of layer k and the faces below and beside them.
+  /// Shape measures of every cell of layer k and the faces below and beside them. The
+  /// first layer passed starts the pass: its faces below are left to the layer under it.
   void layer(int k)
   {
-    if (k == 0)
+    if (first_ < 0)
     {
-      loadPlane(view_, 0, planes_[0]);
-      planeEdges(0);
+      first_ = k;
+      loadPlane(view_, k, planes_[k % 2]);
+      planeEdges(k % 2);
     }
     lower_ = k % 2;
     upper_ = 1 - lower_;
@@ -823,51 +814,34 @@ private:
       quality_.aspectRatio[cell + l] = shape.aspectRatio;
     }
 
-    // Each face once: the upper faces here, the lower ones from the cells below (the
-    // upper face of lane l is the lower face of lane l + 1: stored before loaded).
+    // Each face once, in its canonical corner order (hexFaceGeometry): the upper faces
+    // here, the lower ones from the cells below (the upper face of lane l is the lower
+    // face of lane l + 1: stored before loaded), or computed where there is none below in
+    // this pass (the same bits as the cell below would give: chunks and neighbour layers
+    // agree with one whole pass).
     const long inLayer = i + static_cast<long>(view_.ci) * j_;
     FaceGeometry<T> faces[6];
     for (const int f : { 1, 3, 5 })
     {
-      const V3<T> p[4] = { c[hexFaces[f][0]], c[hexFaces[f][1]], c[hexFaces[f][2]],
-        c[hexFaces[f][3]] };
-      faces[f] = quadFace(p);
+      faces[f] = hexFace(c, f);
     }
     iFaces_.store(i, faces[1]);
     FaceGeometry<T> below[3]; // lower i, j, k faces with area vectors into these cells
-    const bool hasBelow[3] = { i > 0, j_ > 0, k_ > 0 };
-    if (hasBelow[0])
-    {
-      below[0] = iFaces_.load<T>(i - 1);
-    }
-    if (hasBelow[1])
-    {
-      below[1] = jFaces_.load<T>(i);
-    }
-    if (hasBelow[2])
-    {
-      below[2] = kFaces_.load<T>(inLayer);
-    }
+    const bool hasBelow[3] = { i > 0, j_ > 0, k_ > first_ };
+    below[0] = hasBelow[0] ? iFaces_.load<T>(i - 1) : lowerHexFace(c, 0);
+    below[1] = hasBelow[1] ? jFaces_.load<T>(i) : lowerHexFace(c, 1);
+    below[2] = hasBelow[2] ? kFaces_.load<T>(inLayer) : lowerHexFace(c, 2);
     jFaces_.store(i, faces[3]);
     kFaces_.store(inLayer, faces[5]);
     for (int d = 0; d < 3; ++d)
     {
-      const int f = 2 * d;
-      if (hasBelow[d])
-      {
-        faces[f] = reversed(below[d]);
-        continue;
-      }
-      const V3<T> p[4] = { c[hexFaces[f][0]], c[hexFaces[f][1]], c[hexFaces[f][2]],
-        c[hexFaces[f][3]] };
-      faces[f] = quadFace(p);
+      faces[2 * d] = reversed(below[d]);
     }
     const V3<T> centre = cellCentroidFromFaces(c, faces);
     const CoordinateArrays& centres = centres_[k_ % 2];
     storeLanes(centres.x + inLayer, centre.x);
     storeLanes(centres.y + inLayer, centre.y);
     storeLanes(centres.z + inLayer, centre.z);
-    keepSideCentres<T>(i, centre);
 
     // Lower faces, corners ordered so that the area vector points into these cells.
     if (i > 0)
@@ -880,51 +854,10 @@ private:
       const V3<T> q[4] = { c[0], c[4], c[5], c[1] };
       lowerFace<T>(q, below[1], centres, inLayer - view_.ci, cell - view_.ci, centre, cell);
     }
-    if (k_ > 0)
+    if (k_ > first_)
     {
       const V3<T> q[4] = { c[0], c[1], c[2], c[3] };
       lowerFace<T>(q, below[2], centres_[1 - k_ % 2], inLayer, cell - layerCells_, centre, cell);
-    }
-  }
-
-  /// Cells (i.., j_, k_) on a side of the block keep their centres for boundaryFaces.
-  template <typename T>
-  void keepSideCentres(int i, const V3<T>& centre)
-  {
-    auto keep = [&centre](const CoordinateArrays& side, long n) {
-      storeLanes(side.x + n, centre.x);
-      storeLanes(side.y + n, centre.y);
-      storeLanes(side.z + n, centre.z);
-    };
-    if (j_ == 0)
-    {
-      keep(sides_.side[2], i + static_cast<long>(view_.ci) * k_);
-    }
-    if (j_ == view_.cj - 1)
-    {
-      keep(sides_.side[3], i + static_cast<long>(view_.ci) * k_);
-    }
-    if (k_ == 0)
-    {
-      keep(sides_.side[4], i + static_cast<long>(view_.ci) * j_);
-    }
-    if (k_ == view_.ck - 1)
-    {
-      keep(sides_.side[5], i + static_cast<long>(view_.ci) * j_);
-    }
-    for (int l = 0; l < laneCount<T>; ++l)
-    {
-      const long n = j_ + static_cast<long>(view_.cj) * k_;
-      for (const int s : { 0, 1 })
-      {
-        if (i + l == (s == 0 ? 0 : view_.ci - 1))
-        {
-          const P3 p = laneOf(centre, l);
-          sides_.side[s].x[n] = p.x;
-          sides_.side[s].y[n] = p.y;
-          sides_.side[s].z[n] = p.z;
-        }
-      }
     }
   }
 
@@ -968,16 +901,16 @@ private:
   EdgeLengths iEdges_[2], jEdges_[2], kEdges_;
   CoordinateArrays centres_[2];
   FaceArrays iFaces_, jFaces_, kFaces_;
-  SideCentres sides_;
   double* minCosine2_;
   double* maxSkewness_;
   int lower_ = 0, upper_ = 1, j_ = 0, k_ = 0;
+  int first_ = -1;
 };
 
 /// Block-boundary faces: interfaces are measured with the other cell's centre, true
 /// boundaries with OpenFOAM's boundary skewness only.
 void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
-  const InterfaceTable& interfaces, const SideCentres& centres, const CellQualityPointers& quality)
+  const InterfaceTable& interfaces, const CellQualityPointers& quality)
 {
   const BlockView& view = views[blockIndex];
   for (int side = 0; side < 6; ++side)
@@ -1000,7 +933,7 @@ void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
         }
         const P3 outward = lowerSide ? -1.0 * face.area : face.area;
         const long owner = view.cell(ijk[0], ijk[1], ijk[2]);
-        const P3 ownerCentre = centres.at(side, a, b, view);
+        const P3 ownerCentre = view.cellCentre(ijk[0], ijk[1], ijk[2]);
         double& minCosine2 = quality.nonOrthogonality[owner];
         double& maxSkewness = quality.skewness[owner];
         const BlockView* otherView = nullptr;
@@ -1051,13 +984,45 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
   std::fill_n(quality.skewness, cellCount, 0.0);
   std::fill_n(quality.aspectRatio, cellCount, 0.0);
   std::fill_n(quality.scaledJacobian, cellCount, 0.0);
-  BlockPass pass(view, quality, scratch);
-  for (int k = 0; k < view.ck; ++k)
+  // Layers in chunks of at least two, on threads when a runner is installed. A chunk
+  // [k0, k1) first re-evaluates layer k0 - 1 (the same values again: idempotent writes and
+  // min/max updates), whose centres its lowest faces need, and updates cells of layers
+  // k0 - 1 .. k1 - 1 only. Even chunks run first, then odd ones, so no two chunks that
+  // touch the same layer run at once; min and max do not depend on the order, so every
+  // chunking gives the same bits.
+  const long layerCells = static_cast<long>(view.ci) * view.cj;
+  const int chunks =
+    static_cast<int>(chunkCount(cellCount, 1L << 16, std::max(1, view.ck / 2)));
+  if (chunks == 1)
   {
-    pass.layer(k);
-    progress.advance(static_cast<double>(view.ci) * view.cj);
+    BlockPass pass(view, quality, scratch);
+    for (int k = 0; k < view.ck; ++k)
+    {
+      pass.layer(k);
+      progress.advance(static_cast<double>(layerCells));
+    }
   }
-  boundaryFaces(views, blockIndex, interfaces, pass.sideCentres(), quality);
+  else
+  {
+    auto runChunk = [&](long chunk)
+    {
+      const int k0 = static_cast<int>(view.ck * chunk / chunks);
+      const int k1 = static_cast<int>(view.ck * (chunk + 1) / chunks);
+      std::vector<double> chunkScratch;
+      BlockPass pass(view, quality, chunkScratch);
+      for (int k = std::max(k0 - 1, 0); k < k1; ++k)
+      {
+        pass.layer(k);
+      }
+    };
+    for (int parity = 0; parity < 2; ++parity)
+    {
+      const long count = (chunks - parity + 1) / 2;
+      forEachChunk(count, [&](long n) { runChunk(2 * n + parity); });
+      progress.advance(static_cast<double>(layerCells) * view.ck * 0.5);
+    }
+  }
+  boundaryFaces(views, blockIndex, interfaces, quality);
   for (long cell = 0; cell < cellCount; ++cell)
   {
     double& value = quality.nonOrthogonality[cell];
@@ -1188,7 +1153,27 @@ std::vector<BlockView> blockViews(const std::vector<StructuredBlock>& blocks, do
   return views;
 }
 
-void evaluateBlocks(const std::vector<BlockView>& views, double totalCells,
+/// Appends the views of neighbour layers (one side each) after the measured blocks'.
+void addNeighbourViews(std::vector<BlockView>& views, const std::vector<NeighbourLayer>& neighbours)
+{
+  for (std::size_t n = 0; n < neighbours.size(); ++n)
+  {
+    const NeighbourLayer& neighbour = neighbours[n];
+    const StructuredBlock& cells = neighbour.cells;
+    const int across[3] = { cells.ni, cells.nj, cells.nk };
+    if (neighbour.side < 0 || neighbour.side > 5 || across[neighbour.side / 2] != 2 ||
+      cells.ni < 2 || cells.nj < 2 || cells.nk < 2 || !cells.xyz)
+    {
+      throw GeometryError("grid quality: neighbour layer " + std::to_string(n) +
+        " is not two node layers at a block side");
+    }
+    views.emplace_back(cells);
+    views.back().onlySide = neighbour.side;
+  }
+}
+
+/// Measures the first `measured` views; the views after them are neighbour layers.
+void evaluateBlocks(const std::vector<BlockView>& views, std::size_t measured, double totalCells,
   const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
   const std::function<void(double)>& progress)
 {
@@ -1197,7 +1182,7 @@ void evaluateBlocks(const std::vector<BlockView>& views, double totalCells,
   InterfaceTable interfaces = matchBlockInterfaces(views);
   addPeriodicLinks(interfaces, views, periodic);
   std::vector<double> scratch;
-  for (std::size_t n = 0; n < views.size(); ++n)
+  for (std::size_t n = 0; n < measured; ++n)
   {
     evaluateBlock(views, static_cast<int>(n), interfaces, outputs[n], scratch, reporter);
   }
@@ -1225,7 +1210,7 @@ std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBl
     outputs[n] = { q.minAngle.data(), q.maxAngle.data(), q.nonOrthogonality.data(),
       q.skewness.data(), q.aspectRatio.data(), q.scaledJacobian.data() };
   }
-  evaluateBlocks(views, totalCells, periodic, outputs, progress);
+  evaluateBlocks(views, views.size(), totalCells, periodic, outputs, progress);
   return quality;
 }
 
@@ -1245,14 +1230,53 @@ void computeGridQuality(const std::vector<StructuredBlock>& blocks,
   const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
   const std::function<void(double)>& progress)
 {
+  computeGridQuality(blocks, periodic, std::vector<NeighbourLayer>(), outputs, progress);
+}
+
+void computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::vector<NeighbourLayer>& neighbours,
+  const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress)
+{
   if (outputs.size() != blocks.size())
   {
     throw GeometryError("grid quality: " + std::to_string(outputs.size()) +
       " output buffers for " + std::to_string(blocks.size()) + " blocks");
   }
   double totalCells = 0.0;
-  const std::vector<BlockView> views = blockViews(blocks, totalCells);
-  evaluateBlocks(views, totalCells, periodic, outputs, progress);
+  std::vector<BlockView> views = blockViews(blocks, totalCells);
+  addNeighbourViews(views, neighbours);
+  evaluateBlocks(views, blocks.size(), totalCells, periodic, outputs, progress);
+}
+
+StructuredBlock sideLayer(const StructuredBlock& block, int side, std::vector<double>& nodes)
+{
+  if (side < 0 || side > 5 || block.ni < 2 || block.nj < 2 || block.nk < 2 || !block.xyz)
+  {
+    throw GeometryError("grid quality: no side " + std::to_string(side) + " to take a layer of");
+  }
+  int begin[3] = { 0, 0, 0 };
+  int count[3] = { block.ni, block.nj, block.nk };
+  const int axis = side / 2;
+  begin[axis] = side % 2 == 0 ? 0 : count[axis] - 2;
+  count[axis] = 2;
+  nodes.resize(3 * static_cast<std::size_t>(count[0]) * count[1] * count[2]);
+  double* out = nodes.data();
+  for (int k = 0; k < count[2]; ++k)
+  {
+    for (int j = 0; j < count[1]; ++j)
+    {
+      const double* row = block.xyz +
+        3 * (begin[0] + static_cast<long>(block.ni) * (begin[1] + j + static_cast<long>(block.nj) * (begin[2] + k)));
+      std::copy_n(row, 3 * static_cast<std::size_t>(count[0]), out);
+      out += 3 * count[0];
+    }
+  }
+  StructuredBlock layer;
+  layer.xyz = nodes.data();
+  layer.ni = count[0];
+  layer.nj = count[1];
+  layer.nk = count[2];
+  return layer;
 }
 
 void prepareOutputMemory(void* begin, std::size_t bytes)

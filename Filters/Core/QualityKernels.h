@@ -681,15 +681,44 @@ inline int usableLanes(const FaceGeometry<T>& face, const FaceMeasures<T>& m)
 // ---------------------------------------------------------------------------------------
 // Cell centres
 
-/// The six faces of a hexahedron (outward area vectors for a right-handed cell).
+/// Upper face f (1, 3, 5: i1, j1, k1) of a hexahedron, outward, in the corner order of
+/// hexFaces.
+template <typename T>
+inline FaceGeometry<T> hexFace(const V3<T> (&c)[8], int f)
+{
+  const V3<T> p[4] = { c[hexFaces[f][0]], c[hexFaces[f][1]], c[hexFaces[f][2]], c[hexFaces[f][3]] };
+  return quadFace(p);
+}
+
+/// Lower face along direction d (0, 1, 2: i0, j0, k0) with its area vector into the cell,
+/// in the corner order in which the neighbour below computes it as its upper face
+/// (hexFace), so both cells get the same bits.
+template <typename T>
+inline FaceGeometry<T> lowerHexFace(const V3<T> (&c)[8], int d)
+{
+  static constexpr int lower[3][4] = { { 0, 3, 7, 4 }, { 0, 4, 5, 1 }, { 0, 1, 2, 3 } };
+  const V3<T> p[4] = { c[lower[d][0]], c[lower[d][1]], c[lower[d][2]], c[lower[d][3]] };
+  return quadFace(p);
+}
+
+/// The same face seen from its other side: the area vector reversed.
+template <typename T>
+inline FaceGeometry<T> reversed(FaceGeometry<T> face)
+{
+  face.area = { splat<T>(0.0) - face.area.x, splat<T>(0.0) - face.area.y,
+    splat<T>(0.0) - face.area.z };
+  return face;
+}
+
+/// The six faces of a hexahedron, outward area vectors (hexFaces order), each computed in
+/// its canonical corner order (a face shared by two cells gets the same bits in both).
 template <typename T>
 inline void hexFaceGeometry(const V3<T> (&c)[8], FaceGeometry<T> (&faces)[6])
 {
-  for (int f = 0; f < 6; ++f)
+  for (int d = 0; d < 3; ++d)
   {
-    const V3<T> p[4] = { c[hexFaces[f][0]], c[hexFaces[f][1]], c[hexFaces[f][2]],
-      c[hexFaces[f][3]] };
-    faces[f] = quadFace(p);
+    faces[2 * d] = reversed(lowerHexFace(c, d));
+    faces[2 * d + 1] = hexFace(c, 2 * d + 1);
   }
 }
 
@@ -819,13 +848,6 @@ inline V3<T> cellCentroid(const V3<T> (&c)[8])
   return cellCentroidFromFaces(c, faces);
 }
 
-/// The same face seen from its other side: the area vector reversed.
-template <typename T>
-inline FaceGeometry<T> reversed(FaceGeometry<T> face)
-{
-  face.area = { splat<T>(0.0) - face.area.x, splat<T>(0.0) - face.area.y,
-    splat<T>(0.0) - face.area.z };
-  return face;
-}
+
 } // namespace quality
 } // namespace blockforge

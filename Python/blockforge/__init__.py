@@ -9,10 +9,16 @@ and :func:`mesh_template` runs the whole pipeline in one call.
 """
 # The wrapped classes derive from these VTK modules; import them first so their
 # Python types are registered.
+import os
+
 from vtkmodules import vtkCommonCore, vtkCommonDataModel, vtkCommonExecutionModel  # noqa: F401
 
 from .BlockForgeFilters import (  # noqa: F401
+    vtkBlockCGNSWriter,
+    vtkBlockFoamWriter,
+    vtkBlockGridWriter,
     vtkBlockMesher,
+    vtkBlockPlot3DWriter,
     vtkBlockTemplate,
     vtkBlockTemplateAlgorithm,
     vtkBlockTemplateSource,
@@ -21,7 +27,11 @@ from .BlockForgeFilters import (  # noqa: F401
 )
 
 __all__ = [
+    "vtkBlockCGNSWriter",
+    "vtkBlockFoamWriter",
+    "vtkBlockGridWriter",
     "vtkBlockMesher",
+    "vtkBlockPlot3DWriter",
     "vtkBlockTemplate",
     "vtkBlockTemplateAlgorithm",
     "vtkBlockTemplateSource",
@@ -35,11 +45,28 @@ __all__ = [
 MIN_ANGLE_CLASSES = ("0-20", "20-40", "40-60", "60-80", "80-90")
 
 
+def printable(text):
+    """*text* (str or bytes) as a str that can be printed anywhere: bytes that are not
+    UTF-8 (and the surrogate escapes Python uses for them in file names and argv) are
+    shown as \\xNN, like the C++ side does in its messages."""
+    if isinstance(text, bytes):
+        return text.decode("utf-8", "backslashreplace")
+    text = str(text)
+    try:
+        text.encode("utf-8")
+        return text
+    except UnicodeEncodeError:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+
+
 def _message(text):
-    """The text of a VTK error message without VTK's "ERROR: In file, line N" and
-    "Class (0x...): " header."""
-    text = text.strip()
-    if text.startswith("ERROR: In "):
+    """The text of a VTK error or warning without VTK's "ERROR: In file, line N" and
+    "Class (0x...): " header. VTK hands Python None for a message that is not valid
+    UTF-8 (BlockForge's own messages never are: they escape such bytes)."""
+    if text is None:
+        return "a message that is not valid UTF-8 text"
+    text = printable(text).strip()
+    if text.startswith(("ERROR: In ", "Warning: In ")):
         text = text.partition("\n")[2]
     head, sep, rest = text.partition("): ")
     if sep and " (0x" in head and "\n" not in head:
@@ -47,10 +74,26 @@ def _message(text):
     return text.strip()
 
 
+def _path_argument(path):
+    """A file name for a VTK method: str, or bytes when it holds bytes that are not UTF-8
+    (surrogate escapes), which VTK passes on unchanged."""
+    path = os.fspath(path)
+    if isinstance(path, bytes):
+        return path
+    try:
+        path.encode("utf-8")
+        return path
+    except UnicodeEncodeError:
+        return os.fsencode(path)
+
+
 def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_file=None,
-                  timings=None):
+                  timings=None, allow_inverted_cells=False, warnings=None,
+                  maximum_memory=0.0):
     """:func:`mesh_template`; with a dict *timings*, also records the seconds of each
-    stage under "read" (only with an input file), "template" and "mesh + quality"."""
+    stage under "read" (only with an input file), "template" and "mesh + quality"; with a
+    list *warnings*, collects the stages' warnings (reader repairs, inverted cells let
+    through) without VTK's header."""
     import time
 
     from vtkmodules.util.misc import calldata_type
@@ -60,21 +103,25 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     stages = []  # (timing key, the algorithm whose update runs that stage)
     if input_file is not None:
         reader = vtkTurboPointSetsReader()
-        reader.SetFileName(str(input_file))
+        reader.SetFileName(_path_argument(input_file))
         template = vtkBlockTemplate()
         template.SetInputConnection(reader.GetOutputPort())
         stages.append(("read", reader))
     else:
         template = vtkBlockTemplateSource()
-    template.SetTemplateFile(str(template_file))
+    template.SetTemplateFile(_path_argument(template_file))
+    template.SetMaximumMemory(float(maximum_memory))
     for name, value in (parameters or {}).items():
-        template.SetParameter(str(name), str(value))
+        template.SetParameter(_path_argument(str(name)), _path_argument(str(value)))
     stages.append(("template", template))
     mesher = vtkBlockMesher()
     mesher.SetDensityMultiplier(float(density_multiplier))
+    mesher.SetMaximumMemory(float(maximum_memory))
+    mesher.SetAllowInvertedCells(bool(allow_inverted_cells))
     mesher.SetInputConnection(template.GetOutputPort())
     quality = vtkGridQuality()
     quality.SetInputConnection(mesher.GetOutputPort())
+    quality.SetMaximumMemory(float(maximum_memory))
     stages.append(("mesh + quality", quality))
 
     errors = []
@@ -88,8 +135,14 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     def collect_failure(_caller, _event, message):
         failures.append(message)
 
+    @calldata_type(VTK_STRING)
+    def collect_warning(_caller, _event, message):
+        if warnings is not None:
+            warnings.append(_message(message))
+
     for algorithm in [stage for _, stage in stages] + [mesher]:
         algorithm.AddObserver(vtkCommand.ErrorEvent, collect)
+        algorithm.AddObserver(vtkCommand.WarningEvent, collect_warning)
         algorithm.GetExecutive().AddObserver(vtkCommand.ErrorEvent, collect_failure)
     # Stage by stage, so that a failing stage stops the pipeline with its own message.
     for key, algorithm in stages:
@@ -102,7 +155,8 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     return quality
 
 
-def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None):
+def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None,
+                  allow_inverted_cells=False, maximum_memory=0.0):
     """Applies a template, meshes it and measures the grid.
 
     Without *input_file* the pipeline is vtkBlockTemplateSource -> vtkBlockMesher ->
@@ -116,6 +170,13 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
     :param input_file: point data for a template with inputs: a file the
         vtkTurboPointSetsReader reads (a BladeGen .inf, an Info.txt or a point file);
         None for a template without inputs
+    :param allow_inverted_cells: False (default): a grid with an inverted cell is an error
+        naming the block and the cell range; True: the grid is returned anyway for
+        inspection (field data ``InvertedCellCount``, a VTK warning per folded block)
+    :param maximum_memory: largest memory in GB (2^30 bytes) a stage may allocate; 0:
+        what the machine has available. A larger grid is refused before it is allocated
+        ("the grid would need 48 GB for 2e+09 nodes; this machine has 23 GB available;
+        lower the density multiplier or the cell counts").
     :returns: the vtkGridQuality algorithm after its update (port 0: the grid with the
         quality arrays; port 1: MinAngle class table; port 2: statistics table)
     :raises RuntimeError: when a stage (reader, template, mesher or quality) reports an
@@ -123,4 +184,6 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
         "ERROR: In file, line" header (e.g. "<file>: no such file", or the template's
         "<template>:<line>: ..." message). No later stage runs after a failing one.
     """
-    return _run_pipeline(template_file, parameters, density_multiplier, input_file)
+    return _run_pipeline(template_file, parameters, density_multiplier, input_file,
+                         allow_inverted_cells=allow_inverted_cells,
+                         maximum_memory=maximum_memory)

@@ -78,6 +78,20 @@ class ProxyTest(unittest.TestCase):
         for proxy in (mesher, reloaded, source):
             Delete(proxy)
 
+    def test_mesher_refuses_inverted_cells_unless_allowed(self):
+        source = BlockTemplateSource(TemplateFile=os.path.join(DATA, "folded_spline.yaml"))
+        mesher = BlockMesher(Input=source)
+        self.assertEqual(mesher.AllowInvertedCells, 0)
+        mesher.UpdatePipeline()
+        self.assertEqual(servermanager.Fetch(mesher).GetNumberOfBlocks(), 0)
+        mesher.AllowInvertedCells = 1
+        mesher.UpdatePipeline()
+        grid = servermanager.Fetch(mesher)
+        self.assertEqual(grid.GetNumberOfBlocks(), 1)
+        self.assertGreater(grid.GetFieldData().GetArray("InvertedCellCount").GetValue(0), 0)
+        Delete(mesher)
+        Delete(source)
+
     def test_bad_template_gives_empty_output(self):
         source = BlockTemplateSource(TemplateFile=os.path.join(DATA, "bad_inside_out.yaml"))
         mesher = BlockMesher(Input=source)
