@@ -232,7 +232,9 @@ std::shared_ptr<SurfaceCurve> intersectWithRevolution(std::shared_ptr<const Gord
   const SurfaceOfRevolution& revolution, double tMin, double tMax, int samples,
   WorkBudget* budget)
 {
-  WorkBudget ownBudget(IntersectionWorkLimit, "intersection with a surface of revolution");
+  // more initial samples are more work: the budget grows with them past the default 64
+  WorkBudget ownBudget(IntersectionWorkLimit * static_cast<std::size_t>(std::max(1, samples / 64)),
+    "intersection with a surface of revolution");
   WorkBudget& work = budget ? *budget : ownBudget;
   const WorkBudget::Scope scope(work);
   if (!surface)

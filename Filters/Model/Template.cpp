@@ -47,8 +47,16 @@ std::string readFile(const std::string& path)
       "cannot open template file '" + path + "'" +
         (error ? std::string(": ") + std::strerror(error) : std::string()));
   }
-  std::string text(MaxTemplateBytes + 1, '\0');
-  stream.read(&text[0], static_cast<std::streamsize>(text.size()));
+  // Read in pieces up to one byte past the limit: a buffer of the whole limit would be
+  // zero-filled on every read (16 MB, tens of milliseconds on a virtual machine).
+  std::string text;
+  char piece[1 << 16];
+  while (text.size() <= MaxTemplateBytes && stream)
+  {
+    stream.read(piece, static_cast<std::streamsize>(
+      std::min(sizeof(piece), MaxTemplateBytes + 1 - text.size())));
+    text.append(piece, static_cast<std::size_t>(stream.gcount()));
+  }
   if (stream.bad() || (stream.fail() && !stream.eof()))
   {
     const int error = errno;
@@ -56,7 +64,6 @@ std::string readFile(const std::string& path)
       "cannot read template file '" + path + "'" +
         (error ? std::string(": ") + std::strerror(error) : std::string()));
   }
-  text.resize(static_cast<std::size_t>(stream.gcount()));
   if (text.size() > MaxTemplateBytes)
   {
     throw TemplateError(path, 0, "",
