@@ -42,6 +42,7 @@ public:
     double angleStart, double angleEnd);
   Vec3 point(double s, double t) const override;
   void derivatives(double s, double t, SurfaceDerivatives& out) const override;
+  void firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const override;
 
   const Vec3& axisPoint() const { return AxisPoint; }
   const Vec3& axisDirection() const { return AxisDirection; } ///< unit vector
@@ -65,6 +66,11 @@ public:
   double contourParameter(const Vec3& p) const;
 
 private:
+  /// Point and derivatives of the contour at s up to `order` (1 or 2).
+  void contourJet(double s, int order, Vec3 (&c)[3]) const;
+  /// Point and first derivatives from the contour's jet, with the rotation at t.
+  void firstOrder(const Vec3 (&c)[3], double t, Vec3& P, Vec3& Ps, Vec3& Pt, double& cs,
+    double& sn, Vec3& arm) const;
   CurvePtr Contour;
   Vec3 AxisPoint, AxisDirection;
   double AngleStart, AngleEnd;
@@ -135,6 +141,7 @@ public:
 
   Vec3 point(double s, double t) const override;
   void derivatives(double s, double t, SurfaceDerivatives& out) const override;
+  void firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const override;
   /// Same as point() (which extrapolates too); kept as the explicit name for callers.
   Vec3 extendedPoint(double s, double t) const { return point(s, t); }
 

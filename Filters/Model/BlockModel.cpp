@@ -1,5 +1,7 @@
 #include "BlockModel.h"
 
+#include <algorithm>
+
 namespace blockforge
 {
 namespace model
@@ -49,6 +51,14 @@ int BlockModel::findCarrier(const std::string& carrierName) const
 
 int BlockModel::requiredFormat() const
 {
+  for (const Vertex& vertex : vertices)
+  {
+    // Rules the constraint does not imply travel as such from format 3 on.
+    if (vertex.rule.kind != impliedRule(vertex.constraint).kind)
+    {
+      return 3;
+    }
+  }
   if (machine.defined || !carriers.empty() || !surfaceFaces.empty())
   {
     return 2;
@@ -109,6 +119,48 @@ const std::array<int, 4> FaceEdgeTable[6] = { { 3, 7, 8, 11 }, { 1, 5, 9, 10 },
   { 0, 4, 8, 9 }, { 2, 6, 11, 10 }, { 0, 2, 3, 1 }, { 4, 6, 7, 5 } };
 const std::array<int, 2> FaceDirectionTable[6] = { { 1, 2 }, { 1, 2 }, { 0, 2 }, { 0, 2 },
   { 0, 1 }, { 0, 1 } };
+}
+
+const std::vector<std::string>& edgeKindNames()
+{
+  static const std::vector<std::string> names = { "line", "arc", "spline", "on_curve",
+    "on_surface", "project", "periodic", "follow" };
+  return names;
+}
+
+bool edgeKindFromName(const std::string& name, Edge::Kind& kind)
+{
+  const std::vector<std::string>& names = edgeKindNames();
+  const auto found = std::find(names.begin(), names.end(), name);
+  if (found == names.end())
+  {
+    return false;
+  }
+  kind = static_cast<Edge::Kind>(found - names.begin());
+  return true;
+}
+
+const std::vector<std::string>& carrierEdgeKindNames()
+{
+  static const std::vector<std::string> names(
+    edgeKindNames().begin() + static_cast<int>(Edge::Kind::OnCurve), edgeKindNames().end());
+  return names;
+}
+
+VertexRule impliedRule(const VertexConstraint& constraint)
+{
+  VertexRule rule;
+  rule.kind = constraint.periodicSource >= 0 ? VertexRule::Kind::Periodic
+    : constraint.carrier >= 0                ? VertexRule::Kind::OnCarrier
+                                             : VertexRule::Kind::Fixed;
+  return rule;
+}
+
+const std::vector<std::string>& vertexRuleNames()
+{
+  static const std::vector<std::string> names = { "fixed", "on_carrier", "intersection",
+    "projected", "periodic", "rotated" };
+  return names;
 }
 
 const char* faceName(int face)

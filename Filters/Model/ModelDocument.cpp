@@ -1,6 +1,7 @@
 #include "ModelDocument.h"
 
 #include "ModelSyntax.h"
+#include "Placement.h"
 #include "Errors.h"
 
 #include <algorithm>
@@ -142,6 +143,7 @@ public:
     for (Vertex& vertex : Model.vertices)
     {
       resolvePeriodicSource(vertex);
+      resolveRuleSource(vertex);
     }
     for (const YAML::Node& node : list(sections, "edges"))
     {
@@ -293,7 +295,8 @@ private:
   {
     Vertex vertex;
     const auto keys = entries(
-      node, "vertex", { "position", "on", "at", "periodic", "pitches" }, vertex.name, vertex.where);
+      node, "vertex", { "position", "on", "at", "periodic", "pitches", "rule", "source", "origin",
+        "axis", "angle" }, vertex.name, vertex.where);
     const std::string entityText = entity("vertex", vertex.name);
     if (Model.findVertex(vertex.name) >= 0)
     {
@@ -319,7 +322,77 @@ private:
       vertex.constraint.pitches = integer(pitches.value, pitches.line, entityText, "pitches");
       vertex.constraint.periodicSource = -2; // resolved once every vertex is known
     }
+    readRule(keys, node, entityText, vertex);
     Model.vertices.push_back(vertex);
+  }
+
+  /// Format 3: the placement rule when the constraint does not imply it (older documents
+  /// have none: their rules are the implied ones).
+  void readRule(const std::vector<MapEntry>& keys, const YAML::Node& node,
+    const std::string& entityText, Vertex& vertex)
+  {
+    VertexConstraint constraint = vertex.constraint;
+    if (constraint.periodicSource == -2)
+    {
+      constraint.periodicSource = 0; // periodic, its source not resolved yet
+    }
+    vertex.rule = impliedRule(constraint);
+    const MapEntry* rule = syntax::findEntry(keys, "rule");
+    if (!rule)
+    {
+      return;
+    }
+    const std::string name = text(rule->value, rule->line, entityText, "rule");
+    const std::vector<std::string>& names = vertexRuleNames();
+    const auto found = std::find(names.begin(), names.end(), name);
+    if (found == names.end())
+    {
+      fail(rule->line, entityText,
+        "unknown placement rule '" + name + "' (" + syntax::joinNames(names) + ")");
+    }
+    vertex.rule.kind = static_cast<VertexRule::Kind>(found - names.begin());
+    const bool needsCarrier = vertex.rule.kind == VertexRule::Kind::OnCarrier ||
+      vertex.rule.kind == VertexRule::Kind::Intersection ||
+      vertex.rule.kind == VertexRule::Kind::Projected;
+    if (needsCarrier && vertex.constraint.carrier < 0)
+    {
+      fail(rule->line, entityText, "rule '" + name + "' needs 'on' and 'at'");
+    }
+    if (vertex.rule.kind == VertexRule::Kind::Periodic && vertex.constraint.periodicSource == -1)
+    {
+      fail(rule->line, entityText, "rule 'periodic' needs 'periodic' and 'pitches'");
+    }
+    if (vertex.rule.kind == VertexRule::Kind::Projected ||
+      vertex.rule.kind == VertexRule::Kind::Rotated)
+    {
+      const MapEntry& source = required(keys, "source", node, entityText);
+      RuleSources.push_back(text(source.value, source.line, entityText, "source"));
+      vertex.rule.source = -2; // resolved once every vertex is known
+    }
+    if (vertex.rule.kind == VertexRule::Kind::Rotated)
+    {
+      const MapEntry& origin = required(keys, "origin", node, entityText);
+      const MapEntry& axis = required(keys, "axis", node, entityText);
+      const MapEntry& angle = required(keys, "angle", node, entityText);
+      vertex.rule.origin = vector3(origin.value, origin.line, entityText, "origin");
+      vertex.rule.axis = vector3(axis.value, axis.line, entityText, "axis");
+      vertex.rule.angle = number(angle.value, angle.line, entityText, "angle");
+    }
+  }
+
+  void resolveRuleSource(Vertex& vertex)
+  {
+    if (vertex.rule.source != -2)
+    {
+      return;
+    }
+    const std::string& sourceName = RuleSources[NextRuleSource++];
+    vertex.rule.source = Model.findVertex(sourceName);
+    if (vertex.rule.source < 0 || vertex.rule.source == &vertex - Model.vertices.data())
+    {
+      fail(vertex.where.line, entity("vertex", vertex.name),
+        "unknown source vertex '" + sourceName + "' of its placement rule");
+    }
   }
 
   void readEdge(const YAML::Node& node)
@@ -373,9 +446,7 @@ private:
     }
     else if (kindName == "on_curve" || kindName == "on_surface" || kindName == "project")
     {
-      edge.kind = kindName == "on_curve" ? Edge::Kind::OnCurve
-        : kindName == "on_surface"       ? Edge::Kind::OnSurface
-                                         : Edge::Kind::Project;
+      edgeKindFromName(kindName, edge.kind);
       const MapEntry& carrier = required(keys, "carrier", node, entityText);
       edge.carrier = carrierRef(carrier.value, carrier.line, entityText);
       if (const MapEntry* at = syntax::findEntry(keys, "at"))
@@ -392,7 +463,7 @@ private:
     }
     else if (kindName == "periodic" || kindName == "follow")
     {
-      edge.kind = kindName == "periodic" ? Edge::Kind::Periodic : Edge::Kind::Follow;
+      edgeKindFromName(kindName, edge.kind);
       const MapEntry& source = required(keys, "source", node, entityText);
       const std::string sourceName = text(source.value, source.line, entityText, "source");
       for (std::size_t e = 0; e < Model.edges.size(); ++e)
@@ -415,8 +486,7 @@ private:
     else
     {
       fail(kind.line, entityText,
-        "unknown edge kind '" + kindName +
-          "' (line, arc, spline, on_curve, on_surface, project, periodic, follow)");
+        "unknown edge kind '" + kindName + "' (" + syntax::joinNames(edgeKindNames()) + ")");
     }
     Model.edges.push_back(edge);
   }
@@ -742,6 +812,8 @@ private:
     "range", "samples", "distance" };
   std::vector<std::string> PeriodicSources;
   std::size_t NextPeriodic = 0;
+  std::vector<std::string> RuleSources;
+  std::size_t NextRuleSource = 0;
 
   const std::string& Text;
   syntax::Reporter Report;
@@ -903,6 +975,24 @@ std::string writeModelDocument(const BlockModel& model)
           << vertexName(model, vertex.constraint.periodicSource, user);
       out << YAML::Key << "pitches" << YAML::Value << vertex.constraint.pitches;
     }
+    if (vertex.rule.kind != impliedRule(vertex.constraint).kind)
+    {
+      out << YAML::Key << "rule" << YAML::Value
+          << vertexRuleNames()[static_cast<int>(vertex.rule.kind)];
+      if (vertex.rule.kind == VertexRule::Kind::Projected ||
+        vertex.rule.kind == VertexRule::Kind::Rotated)
+      {
+        out << YAML::Key << "source" << YAML::Value << vertexName(model, vertex.rule.source, user);
+      }
+      if (vertex.rule.kind == VertexRule::Kind::Rotated)
+      {
+        out << YAML::Key << "origin" << YAML::Value;
+        emitVector(out, vertex.rule.origin);
+        out << YAML::Key << "axis" << YAML::Value;
+        emitVector(out, vertex.rule.axis);
+        out << YAML::Key << "angle" << YAML::Value << formatNumber(vertex.rule.angle);
+      }
+    }
     emitWhere(out, vertex.where, model);
     out << YAML::EndMap;
   }
@@ -914,9 +1004,7 @@ std::string writeModelDocument(const BlockModel& model)
     const std::string user = entity("edge", edge.name);
     out << YAML::Flow << YAML::BeginMap;
     out << YAML::Key << "name" << YAML::Value << edge.name;
-    static const char* const edgeKinds[] = { "line", "arc", "spline", "on_curve", "on_surface",
-      "project", "periodic", "follow" };
-    out << YAML::Key << "kind" << YAML::Value << edgeKinds[static_cast<int>(edge.kind)];
+    out << YAML::Key << "kind" << YAML::Value << edgeKindNames()[static_cast<int>(edge.kind)];
     out << YAML::Key << "from" << YAML::Value << vertexName(model, edge.from, user);
     out << YAML::Key << "to" << YAML::Value << vertexName(model, edge.to, user);
     if (edge.kind == Edge::Kind::Arc)

@@ -1,0 +1,228 @@
+/**
+ * @file MeshInternals.h
+ * @brief Private to the mesher, the mesh plan and the model check (not installed): the
+ * geometry of named edges, the model's topology with the node data the mesher adds, and
+ * the steps that turn them into edge, face and block grids.
+ */
+#pragma once
+
+#include "BlockModel.h"
+#include "CarrierGeometry.h"
+#include "Errors.h"
+#include "ModelSyntax.h"
+#include "Topology.h"
+
+#include "../Core/Curve.h"
+#include "../Core/Transfinite.h"
+
+#include <array>
+#include <cstdint>
+#include <unordered_map>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace blockforge
+{
+namespace model
+{
+constexpr double Pi = 3.14159265358979323846;
+
+[[noreturn]] inline void fail(
+  const SourceLocation& where, const std::string& entityText, const std::string& what)
+{
+  throw TemplateError(where.file, where.line, entityText, what);
+}
+
+inline std::string blockEntity(const BlockModel& model, int block)
+{
+  return syntax::entity("block", model.blocks[block].name);
+}
+
+// -------------------------------------------------------------------- edge geometry
+/// The curve of a named edge in its own direction (from -> to), with what it takes to
+/// place nodes at arc-length fractions.
+struct NamedCurve
+{
+  CurvePtr curve;
+  std::shared_ptr<const ArcLength> arcLength; ///< splines only: arcs are arc-length already
+  std::shared_ptr<const ArcLengthTable> lengthTable; ///< curves on carriers
+  double length = 0.0;
+  int projectOnto = -1; ///< Project: the nodes of the straight line are projected onto it
+};
+
+/// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.
+double carrierTolerance(const CarrierGeometry& geometry, int carrier, double size);
+
+/// The curve of named edge `edge` (`previous`: the curves of the edges before it, which a
+/// periodic or follow edge takes its shape from). Throws GeometryError.
+NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::vector<NamedCurve>& previous, const Edge& edge, double size);
+/// Curves of all named edges; GeometryError becomes a TemplateError naming the edge.
+std::vector<NamedCurve> buildNamedCurves(const BlockModel& model, const CarrierGeometry& geometry);
+
+/**
+ * Keeps the explicit end parameters (`at`) of an on_curve or on_surface edge on its end
+ * vertices after they moved: each moved end takes its vertex's parameters on the edge's
+ * carrier; on closed carriers the change is taken the short way round, so an edge that
+ * ran across the seam (ends outside [0, 1]) still does.
+ */
+void followEdgeEnds(
+  BlockModel& model, const CarrierGeometry& geometry, int edge, const std::vector<char>& movedVertex);
+
+/// Node parameters of `law` for `nodeCount` nodes on an edge of `length` (with the
+/// fallbacks of previews and density multipliers when `allowFallback`).
+std::vector<double> lawParameters(
+  const DistributionLaw& law, int nodeCount, double length, bool allowFallback);
+std::vector<double> reversedParameters(const std::vector<double>& params);
+/**
+ * `law` as it applies to `cells` cells when the template gives `templateCells`: a density
+ * multiplier or a preview cap refines or coarsens the grid without changing its shape, so
+ * graded laws keep their overall expansion (geometric: last over first cell; two-sided:
+ * middle over end cell; first cell: its share of the edge). Without this a geometric
+ * ratio of 1.15 over 4 times the cells would make the first cell 1.15^18 times thinner
+ * (besides 4 times), and thin cells at a curved wall fold.
+ */
+DistributionLaw refinedLaw(const DistributionLaw& law, int templateCells, int cells);
+
+// -------------------------------------------------------------------- mesh topology
+/// A shared edge with its nodes: parameters in the canonical direction (from the first
+/// block that uses it) and coordinates.
+struct UniqueEdge : TopologyEdge
+{
+  double length = 0.0;
+  std::vector<double> params;
+  std::vector<double> xyz;
+};
+
+/// A shared face with its grid, stored in the orientation of its owner.
+struct UniqueFace : TopologyFace
+{
+  std::vector<double> xyz;
+};
+
+struct MeshLinks : BlockLinks
+{
+  std::array<std::vector<double>, 12> collapsedParams; ///< for collapsed edges only
+};
+
+/// The model's public topology with what the mesher adds to its edges, faces and blocks.
+struct MeshTopology
+{
+  Topology connectivity;
+  std::vector<UniqueEdge> edges;
+  std::vector<UniqueFace> faces;
+  std::vector<MeshLinks> blocks;
+};
+
+/// Node counts of a block at a density multiplier (max(1, round(cells * m)) cells per
+/// direction, at most `cap` when cap > 0), plus one.
+std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int cap);
+
+MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const std::vector<std::array<int, 3>>& nodes, bool allowFallback);
+/// Node parameters of unique edge `e` from the laws of the blocks that use it (checked to
+/// agree), with its current length.
+void computeEdgeParameters(const BlockModel& model, MeshTopology& topology, int e, bool allowFallback);
+/// Parameters of the collapsed edges of block `b`.
+void computeCollapsedParameters(const BlockModel& model, MeshTopology& topology, int b);
+
+// -------------------------------------------------------------------- grids
+/// Nodes of one edge as a block sees it (its local direction), possibly borrowed.
+struct LocalEdge
+{
+  std::vector<double> xyzStorage, paramStorage;
+  const double* borrowedXyz = nullptr;
+  const double* borrowedParams = nullptr;
+  int count = 0;
+  const double* xyz() const { return xyzStorage.empty() ? borrowedXyz : xyzStorage.data(); }
+  const double* params() const
+  {
+    return paramStorage.empty() ? borrowedParams : paramStorage.data();
+  }
+  EdgeNodes nodes() const { return EdgeNodes{ xyz(), params(), count }; }
+};
+
+LocalEdge localEdge(
+  const BlockModel& model, const MeshTopology& topology, int block, int localEdgeIndex);
+/// Throws TemplateError when the first cells at a corner of block `b` are inverted.
+void checkCornerCells(const BlockModel& model, const MeshTopology& topology, int block, double size);
+void checkCornerCells(const BlockModel& model, const MeshTopology& topology, double size);
+void faceFromEdges(const BlockModel& model, const MeshTopology& topology, int block, int face,
+  std::vector<double>& out);
+void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const CarrierGeometry& geometry, UniqueEdge& edge);
+std::map<std::pair<int, int>, int> edgeLookup(const MeshTopology& topology);
+int findUniqueEdge(const std::map<std::pair<int, int>, int>& lookup, int a, int b);
+/// A unique edge whose nodes are the rotated nodes of another.
+struct EdgeCopy
+{
+  int source = -1, sourceFrom = -1; ///< unique edge, and the vertex it is read from
+  int image = -1, imageFrom = -1;
+  Vec3 axisPoint, axis;
+  double angle = 0.0;
+  SourceLocation where;
+  std::string entity;
+};
+/// The periodic copies, in the order they must be made: named periodic edges, then the
+/// edges of every periodic image face (topology.connectivity.periodic must be current).
+std::vector<EdgeCopy> periodicEdgeCopies(const BlockModel& model, const MeshTopology& topology);
+void copyPeriodicEdge(const BlockModel& model, MeshTopology& topology, const EdgeCopy& copy);
+/**
+ * Projections of points onto carriers already made, by carrier and exact coordinates:
+ * CarrierGeometry::project is a function of these alone, so a remembered result is the
+ * same bits as a new projection. The mesh plan keeps one, so that a surface face whose
+ * boundary changed in one edge projects only that edge's nodes again.
+ */
+class ProjectionCache
+{
+public:
+  void project(const CarrierGeometry& geometry, int carrier, const Vec3& p, double& s, double& t);
+
+private:
+  struct Key
+  {
+    int carrier;
+    std::array<std::uint64_t, 3> bits;
+    bool operator==(const Key& o) const { return carrier == o.carrier && bits == o.bits; }
+  };
+  struct KeyHash
+  {
+    std::size_t operator()(const Key& key) const;
+  };
+  std::unordered_map<Key, std::pair<double, double>, KeyHash> Known;
+};
+
+void surfaceFace(const BlockModel& model, const MeshTopology& topology, const CarrierGeometry& geometry,
+  int carrier, int block, int face, std::vector<double>& out, ProjectionCache* cache = nullptr);
+void periodicFace(const BlockModel& model, const MeshTopology& topology, const PeriodicPair& entry,
+  std::vector<double>& out);
+/// Unique face -> surface carrier of the model's surface face sets.
+std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopology& topology);
+/// The grid of unique face f (not a periodic image), on its surface carrier if it has one.
+void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::map<int, int>& onSurface, MeshTopology& topology, int f,
+  ProjectionCache* cache = nullptr);
+/// Every edge and face grid of the model (computeBoundaries), after buildMeshTopology.
+void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::vector<NamedCurve>& curves, MeshTopology& topology);
+/// The nodes of block b by transfinite interpolation from its face and edge grids.
+void meshBlockNodes(const BlockModel& model, const MeshTopology& topology, int block, double* out);
+
+// -------------------------------------------------------------------- model check
+void checkBasics(const BlockModel& model);
+/// Inside-out and folded blocks; only `blocks` when given.
+void checkOrientation(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  double size, const std::vector<int>* blocks = nullptr);
+/// Control points on their carriers, periodic vertices rotations of their sources; only
+/// `vertices` when given (the carriers' own checks then are skipped).
+void checkCarriers(const BlockModel& model, const CarrierGeometry& geometry, double size,
+  const std::vector<int>* vertices = nullptr);
+void checkSurfaceFaces(const BlockModel& model, const CarrierGeometry& geometry,
+  const MeshTopology& topology, double size);
+void checkNamedEdgesUsed(const BlockModel& model, const MeshTopology& topology);
+/// Everything checkModel checks after the basics.
+void checkModelWith(const BlockModel& model, const CarrierGeometry& geometry);
+} // namespace model
+} // namespace blockforge

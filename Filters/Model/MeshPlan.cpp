@@ -1,0 +1,420 @@
+#include "MeshPlan.h"
+
+#include "MemoryBudget.h"
+#include "MeshInternals.h"
+#include "Mesher.h"
+
+#include "../Core/InvertedCells.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+namespace blockforge
+{
+namespace model
+{
+struct MeshPlan::Impl
+{
+  BlockModel Model;
+  CarrierGeometry Geometry;
+  double Multiplier = 1.0;
+  bool AllowFallback = false;
+  std::vector<NamedCurve> Curves;
+  MeshTopology Topo;
+  std::vector<EdgeCopy> Copies;
+  std::map<int, int> OnSurface;
+  std::vector<bool> IsImage;
+  std::vector<std::vector<double>> Nodes;
+  std::vector<int> Updated;
+  std::vector<int> Pending; ///< vertices of failed updates, recomputed with the next one
+  ProjectionCache Projections;
+
+  // What depends on what, built once.
+  std::vector<std::vector<int>> VertexNamedEdges;  ///< vertex -> named edges ending at it
+  std::vector<std::vector<int>> NamedFollowers;    ///< named edge -> periodic/follow edges
+  std::vector<std::vector<int>> VertexUniqueEdges; ///< vertex -> unique edges ending at it
+  std::vector<int> NamedUnique;                    ///< named edge -> unique edge, -1
+  std::vector<std::vector<int>> EdgeFaces;         ///< unique edge -> unique faces
+  std::vector<std::vector<int>> EdgeBlocks;        ///< unique edge -> blocks
+  std::vector<std::vector<int>> FaceBlocks;        ///< unique face -> blocks
+  std::vector<std::vector<int>> VertexBlocks;      ///< vertex -> blocks
+
+  void buildDependencies();
+  void run(const std::vector<int>& moved);
+};
+
+namespace
+{
+template <typename T>
+void addUnique(std::vector<T>& list, const T& value)
+{
+  if (std::find(list.begin(), list.end(), value) == list.end())
+  {
+    list.push_back(value);
+  }
+}
+
+Feasibility infeasible(Feasibility::Problem problem, int block, const std::string& message)
+{
+  Feasibility result;
+  result.problem = problem;
+  result.block = block;
+  result.message = message;
+  return result;
+}
+} // namespace
+
+void MeshPlan::Impl::buildDependencies()
+{
+  const std::size_t vertexCount = Model.vertices.size();
+  VertexNamedEdges.assign(vertexCount, {});
+  VertexUniqueEdges.assign(vertexCount, {});
+  VertexBlocks.assign(vertexCount, {});
+  NamedFollowers.assign(Model.edges.size(), {});
+  NamedUnique.assign(Model.edges.size(), -1);
+  for (std::size_t e = 0; e < Model.edges.size(); ++e)
+  {
+    const Edge& edge = Model.edges[e];
+    VertexNamedEdges[edge.from].push_back(static_cast<int>(e));
+    VertexNamedEdges[edge.to].push_back(static_cast<int>(e));
+    if ((edge.kind == Edge::Kind::Periodic || edge.kind == Edge::Kind::Follow) && edge.source >= 0)
+    {
+      NamedFollowers[edge.source].push_back(static_cast<int>(e));
+    }
+  }
+  EdgeFaces.assign(Topo.edges.size(), {});
+  EdgeBlocks.assign(Topo.edges.size(), {});
+  FaceBlocks.assign(Topo.faces.size(), {});
+  for (std::size_t u = 0; u < Topo.edges.size(); ++u)
+  {
+    const UniqueEdge& edge = Topo.edges[u];
+    VertexUniqueEdges[edge.a].push_back(static_cast<int>(u));
+    VertexUniqueEdges[edge.b].push_back(static_cast<int>(u));
+    if (edge.named >= 0)
+    {
+      NamedUnique[edge.named] = static_cast<int>(u);
+    }
+    for (const EdgeUse& use : edge.uses)
+    {
+      addUnique(EdgeBlocks[u], use.block);
+    }
+  }
+  for (std::size_t b = 0; b < Topo.blocks.size(); ++b)
+  {
+    const MeshLinks& links = Topo.blocks[b];
+    for (int v : Model.blocks[b].vertices)
+    {
+      addUnique(VertexBlocks[v], static_cast<int>(b));
+    }
+    for (int f = 0; f < 6; ++f)
+    {
+      const int face = links.face[f];
+      if (face < 0)
+      {
+        continue;
+      }
+      addUnique(FaceBlocks[face], static_cast<int>(b));
+      for (const int local : faceEdges(f))
+      {
+        if (links.edge[local] >= 0)
+        {
+          addUnique(EdgeFaces[links.edge[local]], face);
+        }
+      }
+    }
+  }
+}
+
+MeshPlan::MeshPlan(const BlockModel& model, const CarrierGeometry& carriers, double densityMultiplier)
+  : P(new Impl)
+{
+  checkDensityMultiplier(model, densityMultiplier);
+  checkBasics(model);
+  P->Model = model;
+  P->Geometry = carriers;
+  P->Multiplier = densityMultiplier;
+  checkModelWith(P->Model, P->Geometry);
+  P->Curves = buildNamedCurves(P->Model, P->Geometry);
+  std::vector<std::array<int, 3>> nodes;
+  for (const Block& block : P->Model.blocks)
+  {
+    nodes.push_back(scaledNodeCounts(block, densityMultiplier, 0));
+  }
+  P->AllowFallback = nodes != baseNodeCounts(P->Model);
+  P->Topo = buildMeshTopology(P->Model, P->Curves, nodes, P->AllowFallback);
+  computeAllBoundaries(P->Model, P->Geometry, P->Curves, P->Topo);
+  P->Copies = periodicEdgeCopies(P->Model, P->Topo);
+  P->OnSurface = surfaceFaceCarriers(P->Model, P->Topo);
+  P->IsImage.assign(P->Topo.faces.size(), false);
+  for (const PeriodicPair& pair : P->Topo.connectivity.periodic)
+  {
+    P->IsImage[pair.image] = true;
+  }
+  P->buildDependencies();
+  P->Nodes.resize(P->Model.blocks.size());
+  for (int b = 0; b < blockCount(); ++b)
+  {
+    const std::array<int, 3>& n = P->Topo.blocks[b].nodes;
+    P->Nodes[b].resize(3 * static_cast<std::size_t>(n[0]) * n[1] * n[2]);
+    meshBlockNodes(P->Model, P->Topo, b, P->Nodes[b].data());
+    P->Updated.push_back(b);
+  }
+}
+
+MeshPlan::~MeshPlan() = default;
+
+BlockModel& MeshPlan::model()
+{
+  return P->Model;
+}
+
+const BlockModel& MeshPlan::model() const
+{
+  return P->Model;
+}
+
+const CarrierGeometry& MeshPlan::carriers() const
+{
+  return P->Geometry;
+}
+
+const Topology& MeshPlan::topology() const
+{
+  return P->Topo.connectivity;
+}
+
+const std::vector<int>& MeshPlan::updatedBlocks() const
+{
+  return P->Updated;
+}
+
+int MeshPlan::blockCount() const
+{
+  return static_cast<int>(P->Model.blocks.size());
+}
+
+std::array<int, 3> MeshPlan::nodeCounts(int block) const
+{
+  return P->Topo.blocks.at(block).nodes;
+}
+
+const std::vector<double>& MeshPlan::blockNodes(int block) const
+{
+  return P->Nodes.at(block);
+}
+
+/// The update itself; throws TemplateError or GeometryError like the mesher would.
+void MeshPlan::Impl::run(const std::vector<int>& moved)
+{
+  BlockModel& model = Model;
+  const double size = modelSize(model);
+  std::vector<char> movedVertex(model.vertices.size(), 0);
+  for (const int v : moved)
+  {
+    movedVertex.at(v) = 1;
+  }
+  checkCarriers(model, Geometry, size, &moved);
+
+  // Named edge curves: those ending at a moved vertex, and those following a rebuilt one
+  // (a follow or periodic edge always comes after its source).
+  std::vector<char> rebuilt(model.edges.size(), 0);
+  for (const int v : moved)
+  {
+    for (const int e : VertexNamedEdges[v])
+    {
+      rebuilt[e] = 1;
+    }
+  }
+  for (std::size_t e = 0; e < model.edges.size(); ++e)
+  {
+    if (!rebuilt[e])
+    {
+      continue;
+    }
+    for (const int follower : NamedFollowers[e])
+    {
+      rebuilt[follower] = 1;
+    }
+    try
+    {
+      followEdgeEnds(model, Geometry, static_cast<int>(e), movedVertex);
+      Curves[e] = buildNamedCurve(model, Geometry, Curves, model.edges[e], size);
+    }
+    catch (const GeometryError& error)
+    {
+      fail(model.edges[e].where, syntax::entity("edge", model.edges[e].name), error.what());
+    }
+  }
+
+  // Shared edges: node parameters (the length may change them) and nodes.
+  std::vector<char> changedEdge(Topo.edges.size(), 0);
+  for (const int v : moved)
+  {
+    for (const int u : VertexUniqueEdges[v])
+    {
+      changedEdge[u] = 1;
+    }
+  }
+  for (std::size_t e = 0; e < model.edges.size(); ++e)
+  {
+    if (rebuilt[e] && NamedUnique[e] >= 0)
+    {
+      changedEdge[NamedUnique[e]] = 1;
+    }
+  }
+  std::vector<int> blocks;
+  for (std::size_t u = 0; u < Topo.edges.size(); ++u)
+  {
+    if (!changedEdge[u])
+    {
+      continue;
+    }
+    UniqueEdge& edge = Topo.edges[u];
+    edge.length = edge.named >= 0
+      ? Curves[edge.named].length
+      : (model.vertices[edge.b].position - model.vertices[edge.a].position).norm();
+    computeEdgeParameters(model, Topo, static_cast<int>(u), AllowFallback);
+    computeEdgeNodes(model, Curves, Geometry, edge);
+    for (const int b : EdgeBlocks[u])
+    {
+      addUnique(blocks, b);
+    }
+  }
+  for (const int b : blocks)
+  {
+    computeCollapsedParameters(model, Topo, b);
+  }
+
+  // Periodic copies of changed edges (their pairing checked again: vertices moved).
+  findPeriodicPairs(model, Topo.connectivity);
+  for (const EdgeCopy& copy : Copies)
+  {
+    if (changedEdge[copy.source] || changedEdge[copy.image])
+    {
+      copyPeriodicEdge(model, Topo, copy);
+      changedEdge[copy.image] = 1;
+      for (const int b : EdgeBlocks[copy.image])
+      {
+        addUnique(blocks, b);
+      }
+    }
+  }
+
+  // Faces with a changed edge, then the periodic images of changed faces.
+  std::vector<char> changedFace(Topo.faces.size(), 0);
+  for (std::size_t u = 0; u < Topo.edges.size(); ++u)
+  {
+    if (changedEdge[u])
+    {
+      for (const int f : EdgeFaces[u])
+      {
+        changedFace[f] = 1;
+      }
+    }
+  }
+  for (std::size_t f = 0; f < Topo.faces.size(); ++f)
+  {
+    if (changedFace[f] && !IsImage[f])
+    {
+      computeFaceGrid(model, Geometry, OnSurface, Topo, static_cast<int>(f), &Projections);
+    }
+  }
+  for (const PeriodicPair& pair : Topo.connectivity.periodic)
+  {
+    if (changedFace[pair.source] || changedFace[pair.image])
+    {
+      changedFace[pair.image] = 1;
+      periodicFace(model, Topo, pair, Topo.faces[pair.image].xyz);
+    }
+  }
+  for (std::size_t f = 0; f < Topo.faces.size(); ++f)
+  {
+    if (changedFace[f])
+    {
+      for (const int b : FaceBlocks[f])
+      {
+        addUnique(blocks, b);
+      }
+    }
+  }
+  for (const int v : moved)
+  {
+    for (const int b : VertexBlocks[v])
+    {
+      addUnique(blocks, b);
+    }
+  }
+  std::sort(blocks.begin(), blocks.end());
+  Updated = blocks;
+}
+
+Feasibility MeshPlan::update(const std::vector<int>& moved)
+{
+  std::vector<int> vertices = P->Pending;
+  for (const int v : moved)
+  {
+    if (v < 0 || v >= static_cast<int>(P->Model.vertices.size()))
+    {
+      return infeasible(Feasibility::Problem::ModelError, -1,
+        "MeshPlan::update: no vertex " + std::to_string(v));
+    }
+    addUnique(vertices, v);
+  }
+  P->Pending = vertices;
+  P->Updated.clear();
+  try
+  {
+    P->run(vertices);
+  }
+  catch (const std::exception& error)
+  {
+    return infeasible(Feasibility::Problem::ModelError, -1, error.what());
+  }
+  const double size = modelSize(P->Model);
+  for (const int b : P->Updated)
+  {
+    try
+    {
+      const std::vector<int> one = { b };
+      checkOrientation(P->Model, P->Curves, size, &one);
+      checkCornerCells(P->Model, P->Topo, b, size);
+    }
+    catch (const TemplateError& error)
+    {
+      return infeasible(Feasibility::Problem::FoldedCorner, b, error.what());
+    }
+  }
+  for (const int b : P->Updated)
+  {
+    meshBlockNodes(P->Model, P->Topo, b, P->Nodes[b].data());
+  }
+  P->Pending.clear();
+  for (const int b : P->Updated)
+  {
+    const Feasibility cells = checkCells(P->Nodes[b].data(), P->Topo.blocks[b].nodes, b);
+    if (!cells.feasible())
+    {
+      return cells;
+    }
+  }
+  return Feasibility();
+}
+
+Feasibility checkCells(const double* xyz, const std::array<int, 3>& nodes, int block)
+{
+  const InvertedCells inverted = findInvertedCells(xyz, nodes[0], nodes[1], nodes[2]);
+  if (inverted.count == 0)
+  {
+    return Feasibility();
+  }
+  const std::array<int, 3>& c = inverted.worstCell;
+  return infeasible(Feasibility::Problem::InvertedCell, block,
+    std::to_string(inverted.count) + " inverted cell(s) in block " + std::to_string(block) +
+      ", the worst (" + std::to_string(c[0]) + ", " + std::to_string(c[1]) + ", " +
+      std::to_string(c[2]) + ") with scaled Jacobian " +
+      syntax::shortNumber(inverted.worstScaledJacobian));
+}
+} // namespace model
+} // namespace blockforge
