@@ -49,6 +49,14 @@ int BlockModel::findCarrier(const std::string& carrierName) const
 
 int BlockModel::requiredFormat() const
 {
+  for (const Vertex& vertex : vertices)
+  {
+    // Rules the constraint does not imply travel as such from format 3 on.
+    if (vertex.rule.kind != impliedRule(vertex.constraint).kind)
+    {
+      return 3;
+    }
+  }
   if (machine.defined || !carriers.empty() || !surfaceFaces.empty())
   {
     return 2;
@@ -109,6 +117,22 @@ const std::array<int, 4> FaceEdgeTable[6] = { { 3, 7, 8, 11 }, { 1, 5, 9, 10 },
   { 0, 4, 8, 9 }, { 2, 6, 11, 10 }, { 0, 2, 3, 1 }, { 4, 6, 7, 5 } };
 const std::array<int, 2> FaceDirectionTable[6] = { { 1, 2 }, { 1, 2 }, { 0, 2 }, { 0, 2 },
   { 0, 1 }, { 0, 1 } };
+}
+
+VertexRule impliedRule(const VertexConstraint& constraint)
+{
+  VertexRule rule;
+  rule.kind = constraint.periodicSource >= 0 ? VertexRule::Kind::Periodic
+    : constraint.carrier >= 0                ? VertexRule::Kind::OnCarrier
+                                             : VertexRule::Kind::Fixed;
+  return rule;
+}
+
+const std::vector<std::string>& vertexRuleNames()
+{
+  static const std::vector<std::string> names = { "fixed", "on_carrier", "intersection",
+    "projected", "periodic", "rotated" };
+  return names;
 }
 
 const char* faceName(int face)

@@ -120,11 +120,42 @@ struct VertexConstraint
   int pitches = 0;
 };
 
+/**
+ * How a vertex's position follows from its parameters and from other vertices: its
+ * placement rule (Placement.h applies the rules in dependency order, for the template,
+ * the optimizer and manual moves alike).
+ */
+struct VertexRule
+{
+  enum class Kind
+  {
+    Fixed,        ///< the position itself (a point, cylindrical coordinates or expressions)
+    OnCarrier,    ///< carrier(s, t) of the constraint: a control point, (s, t) free
+    Intersection, ///< curve(s) where a curve meets a surface: on its carrier, s not free
+    Projected,    ///< the position of vertex `source` projected onto the constraint's carrier
+    Periodic,     ///< the constraint's periodic source rotated by whole machine pitches
+    Rotated       ///< vertex `source` rotated by `angle` about `axis` through `origin`
+  };
+  Kind kind = Kind::Fixed;
+  int source = -1; ///< Projected, Rotated: the vertex followed
+  Vec3 origin = Vec3::Zero();
+  Vec3 axis = Vec3::UnitZ(); ///< unit vector
+  double angle = 0.0;        ///< radians, right-hand rule
+};
+
+/// The rule a vertex's constraint implies on its own (documents older than format 3
+/// carry no rules): OnCarrier with a carrier, Periodic with a periodic source, else Fixed.
+VertexRule impliedRule(const VertexConstraint& constraint);
+
+/// The names of the rule kinds in model documents, in VertexRule::Kind order.
+const std::vector<std::string>& vertexRuleNames();
+
 struct Vertex
 {
   std::string name;
   Vec3 position = Vec3::Zero();
   VertexConstraint constraint;
+  VertexRule rule;
   SourceLocation where;
 };
 
@@ -209,9 +240,10 @@ struct SurfaceFaces
 
 struct BlockModel
 {
-  /// Newest model document format; documents of models without format-2 entities are
-  /// still written as format 1.
-  static constexpr int FormatVersion = 2;
+  /// Newest model document format (3: vertices carry their placement rules); documents
+  /// of models without format-2 entities are still written as format 1, and documents of
+  /// formats 1 and 2 still read (their rules follow from the constraints).
+  static constexpr int FormatVersion = 3;
   std::string name;
   std::string sourceFile;
   /// Parameter values after overrides, in definition order.

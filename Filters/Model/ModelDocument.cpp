@@ -1,6 +1,7 @@
 #include "ModelDocument.h"
 
 #include "ModelSyntax.h"
+#include "Placement.h"
 #include "Errors.h"
 
 #include <algorithm>
@@ -142,6 +143,7 @@ public:
     for (Vertex& vertex : Model.vertices)
     {
       resolvePeriodicSource(vertex);
+      resolveRuleSource(vertex);
     }
     for (const YAML::Node& node : list(sections, "edges"))
     {
@@ -293,7 +295,8 @@ private:
   {
     Vertex vertex;
     const auto keys = entries(
-      node, "vertex", { "position", "on", "at", "periodic", "pitches" }, vertex.name, vertex.where);
+      node, "vertex", { "position", "on", "at", "periodic", "pitches", "rule", "source", "origin",
+        "axis", "angle" }, vertex.name, vertex.where);
     const std::string entityText = entity("vertex", vertex.name);
     if (Model.findVertex(vertex.name) >= 0)
     {
@@ -319,7 +322,77 @@ private:
       vertex.constraint.pitches = integer(pitches.value, pitches.line, entityText, "pitches");
       vertex.constraint.periodicSource = -2; // resolved once every vertex is known
     }
+    readRule(keys, node, entityText, vertex);
     Model.vertices.push_back(vertex);
+  }
+
+  /// Format 3: the placement rule when the constraint does not imply it (older documents
+  /// have none: their rules are the implied ones).
+  void readRule(const std::vector<MapEntry>& keys, const YAML::Node& node,
+    const std::string& entityText, Vertex& vertex)
+  {
+    VertexConstraint constraint = vertex.constraint;
+    if (constraint.periodicSource == -2)
+    {
+      constraint.periodicSource = 0; // periodic, its source not resolved yet
+    }
+    vertex.rule = impliedRule(constraint);
+    const MapEntry* rule = syntax::findEntry(keys, "rule");
+    if (!rule)
+    {
+      return;
+    }
+    const std::string name = text(rule->value, rule->line, entityText, "rule");
+    const std::vector<std::string>& names = vertexRuleNames();
+    const auto found = std::find(names.begin(), names.end(), name);
+    if (found == names.end())
+    {
+      fail(rule->line, entityText,
+        "unknown placement rule '" + name + "' (" + syntax::joinNames(names) + ")");
+    }
+    vertex.rule.kind = static_cast<VertexRule::Kind>(found - names.begin());
+    const bool needsCarrier = vertex.rule.kind == VertexRule::Kind::OnCarrier ||
+      vertex.rule.kind == VertexRule::Kind::Intersection ||
+      vertex.rule.kind == VertexRule::Kind::Projected;
+    if (needsCarrier && vertex.constraint.carrier < 0)
+    {
+      fail(rule->line, entityText, "rule '" + name + "' needs 'on' and 'at'");
+    }
+    if (vertex.rule.kind == VertexRule::Kind::Periodic && vertex.constraint.periodicSource == -1)
+    {
+      fail(rule->line, entityText, "rule 'periodic' needs 'periodic' and 'pitches'");
+    }
+    if (vertex.rule.kind == VertexRule::Kind::Projected ||
+      vertex.rule.kind == VertexRule::Kind::Rotated)
+    {
+      const MapEntry& source = required(keys, "source", node, entityText);
+      RuleSources.push_back(text(source.value, source.line, entityText, "source"));
+      vertex.rule.source = -2; // resolved once every vertex is known
+    }
+    if (vertex.rule.kind == VertexRule::Kind::Rotated)
+    {
+      const MapEntry& origin = required(keys, "origin", node, entityText);
+      const MapEntry& axis = required(keys, "axis", node, entityText);
+      const MapEntry& angle = required(keys, "angle", node, entityText);
+      vertex.rule.origin = vector3(origin.value, origin.line, entityText, "origin");
+      vertex.rule.axis = vector3(axis.value, axis.line, entityText, "axis");
+      vertex.rule.angle = number(angle.value, angle.line, entityText, "angle");
+    }
+  }
+
+  void resolveRuleSource(Vertex& vertex)
+  {
+    if (vertex.rule.source != -2)
+    {
+      return;
+    }
+    const std::string& sourceName = RuleSources[NextRuleSource++];
+    vertex.rule.source = Model.findVertex(sourceName);
+    if (vertex.rule.source < 0 || vertex.rule.source == &vertex - Model.vertices.data())
+    {
+      fail(vertex.where.line, entity("vertex", vertex.name),
+        "unknown source vertex '" + sourceName + "' of its placement rule");
+    }
   }
 
   void readEdge(const YAML::Node& node)
@@ -742,6 +815,8 @@ private:
     "range", "samples", "distance" };
   std::vector<std::string> PeriodicSources;
   std::size_t NextPeriodic = 0;
+  std::vector<std::string> RuleSources;
+  std::size_t NextRuleSource = 0;
 
   const std::string& Text;
   syntax::Reporter Report;
@@ -902,6 +977,24 @@ std::string writeModelDocument(const BlockModel& model)
       out << YAML::Key << "periodic" << YAML::Value
           << vertexName(model, vertex.constraint.periodicSource, user);
       out << YAML::Key << "pitches" << YAML::Value << vertex.constraint.pitches;
+    }
+    if (vertex.rule.kind != impliedRule(vertex.constraint).kind)
+    {
+      out << YAML::Key << "rule" << YAML::Value
+          << vertexRuleNames()[static_cast<int>(vertex.rule.kind)];
+      if (vertex.rule.kind == VertexRule::Kind::Projected ||
+        vertex.rule.kind == VertexRule::Kind::Rotated)
+      {
+        out << YAML::Key << "source" << YAML::Value << vertexName(model, vertex.rule.source, user);
+      }
+      if (vertex.rule.kind == VertexRule::Kind::Rotated)
+      {
+        out << YAML::Key << "origin" << YAML::Value;
+        emitVector(out, vertex.rule.origin);
+        out << YAML::Key << "axis" << YAML::Value;
+        emitVector(out, vertex.rule.axis);
+        out << YAML::Key << "angle" << YAML::Value << formatNumber(vertex.rule.angle);
+      }
     }
     emitWhere(out, vertex.where, model);
     out << YAML::EndMap;

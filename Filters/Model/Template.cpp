@@ -3,6 +3,7 @@
 #include "CarrierGeometry.h"
 #include "Mesher.h"
 #include "ModelSyntax.h"
+#include "Placement.h"
 
 #include <muParser.h>
 
@@ -790,7 +791,7 @@ private:
       }
       else if (entry.value.IsMap())
       {
-        vertex.position = readVertexMapping(entry, entityText);
+        readVertexMapping(entry, entityText, vertex);
       }
       else
       {
@@ -803,7 +804,7 @@ private:
 
   /// `{position: [x, y, z]}` or `{rotate: v, angle: a, axis: [..], origin: [..]}`: the
   /// mapping form leaves room for the constraints of later format versions.
-  Vec3 readVertexMapping(const MapEntry& entry, const std::string& entityText)
+  void readVertexMapping(const MapEntry& entry, const std::string& entityText, Vertex& vertex)
   {
     const auto keys =
       syntax::mapEntries(entry.value, entry.line, entityText, "the vertex", Report);
@@ -821,7 +822,8 @@ private:
       {
         fail(entry.line, entityText, "'angle', 'axis' and 'origin' belong to 'rotate'");
       }
-      return vector3(position->value, position->line, entityText, "position");
+      vertex.position = vector3(position->value, position->line, entityText, "position");
+      return;
     }
     const MapEntry* angle = syntax::findEntry(keys, "angle");
     if (!angle)
@@ -839,9 +841,12 @@ private:
     {
       origin = vector3(originEntry->value, originEntry->line, entityText, "origin");
     }
-    const double radians = number(angle->value, angle->line, entityText, "angle");
-    const Eigen::AngleAxisd rotation(radians, axis);
-    return origin + rotation * (Model.vertices[source].position - origin);
+    vertex.rule.kind = VertexRule::Kind::Rotated;
+    vertex.rule.source = source;
+    vertex.rule.axis = axis;
+    vertex.rule.origin = origin;
+    vertex.rule.angle = number(angle->value, angle->line, entityText, "angle");
+    placeVertex(Model, Geometry, vertex);
   }
 
   void readEdges()
@@ -3034,7 +3039,7 @@ private:
     const int here = lineOrFallback(kind->value, kind->line);
     if (kind->key == "position" || kind->key == "rotate")
     {
-      vertex.position = readVertexMapping(entry, entityText);
+      readVertexMapping(entry, entityText, vertex);
       return;
     }
     if (kind->key == "cylindrical")
@@ -3075,7 +3080,8 @@ private:
       }
       constraint.carrier = curve;
       constraint.s = u;
-      vertex.position = Geometry.point(curve, u);
+      vertex.rule.kind = VertexRule::Kind::OnCarrier;
+      placeVertex(Model, Geometry, vertex);
       return;
     }
     if (kind->key == "on_surface" && syntax::findEntry(keys, "axial"))
@@ -3096,7 +3102,8 @@ private:
       constraint.carrier = surface;
       constraint.s = s;
       constraint.t = t;
-      vertex.position = Geometry.point(surface, s, t);
+      vertex.rule.kind = VertexRule::Kind::OnCarrier;
+      placeVertex(Model, Geometry, vertex);
       return;
     }
     if (kind->key == "on_surface")
@@ -3131,7 +3138,8 @@ private:
       constraint.carrier = surface;
       constraint.s = st[0];
       constraint.t = st[1];
-      vertex.position = Geometry.point(surface, st[0], st[1]);
+      vertex.rule.kind = VertexRule::Kind::OnCarrier;
+      placeVertex(Model, Geometry, vertex);
       return;
     }
     if (kind->key == "project")
@@ -3144,12 +3152,23 @@ private:
       }
       const Vec3 point = pointValue(kind->value, kind->line, entityText, "project");
       const int carrier = carrierRef(onto->value, onto->line, entityText, "onto", Want::Any);
-      double s = 0.0, t = 0.0, distance = 0.0;
-      Geometry.project(carrier, point, s, t, distance);
       constraint.carrier = carrier;
-      constraint.s = s;
-      constraint.t = t;
-      vertex.position = Geometry.point(carrier, s, t);
+      if (!kind->value.IsSequence() && !kind->value.IsMap())
+      {
+        // Projected from a vertex: follows it wherever it moves later.
+        vertex.rule.kind = VertexRule::Kind::Projected;
+        vertex.rule.source = vertexRef(kind->value, kind->line, entityText);
+      }
+      else
+      {
+        // Projected from a point: a control point where the point lands.
+        double s = 0.0, t = 0.0, distance = 0.0;
+        Geometry.project(carrier, point, s, t, distance);
+        constraint.s = s;
+        constraint.t = t;
+        vertex.rule.kind = VertexRule::Kind::OnCarrier;
+      }
+      placeVertex(Model, Geometry, vertex);
       return;
     }
     if (kind->key == "intersect")
@@ -3165,7 +3184,8 @@ private:
         curveSurfaceIntersection(curve, surface, syntax::findEntry(keys, "near"), entityText, here);
       constraint.carrier = curve;
       constraint.s = u;
-      vertex.position = Geometry.point(curve, u);
+      vertex.rule.kind = VertexRule::Kind::Intersection;
+      placeVertex(Model, Geometry, vertex);
       return;
     }
     // periodic
@@ -3187,35 +3207,10 @@ private:
       fail(here, entityText,
         "a periodic vertex needs the blade count: " + Evaluator.Unavailable["pitch"]);
     }
-    const double angle = pitches * machine.pitch();
-    const Vertex& original = Model.vertices[source];
-    vertex.position = rotateAboutAxis(original.position, machine.axisPoint, machine.axis, angle);
     constraint.periodicSource = source;
     constraint.pitches = pitches;
-    constraint.carrier = -1;
-    // The paper's parameter offsets: the image of a point on a surface of revolution about
-    // the machine axis is on the same surface at t + angle / (a1 - a0).
-    if (original.constraint.carrier >= 0)
-    {
-      const int carrier = original.constraint.carrier;
-      const Carrier& definition = Model.carriers[carrier];
-      if (definition.kind == Carrier::Kind::Revolve &&
-        (definition.axis - machine.axis).norm() <= 1e-12 &&
-        (definition.axisPoint - machine.axisPoint).norm() <= 1e-12 * std::max(1.0, vertexSpan()))
-      {
-        double t = original.constraint.t + angle / (definition.angleEnd - definition.angleStart);
-        if (Geometry.closedT(carrier))
-        {
-          t = wrapUnit(t);
-        }
-        if (t >= 0.0 && t <= 1.0)
-        {
-          constraint.carrier = carrier;
-          constraint.s = original.constraint.s;
-          constraint.t = t;
-        }
-      }
-    }
+    vertex.rule.kind = VertexRule::Kind::Periodic;
+    placeVertex(Model, Geometry, vertex);
   }
   // --- edges and faces (format 2) --------------------------------------------------
   bool isEdgeV2(const MapEntry& entry) const

@@ -100,7 +100,7 @@ std::string boxOnSurface(const std::string& carriers, const std::string& vertice
 TEST(CarrierTemplates, AnnularPassageFromPointSets)
 {
   const BlockModel model = loadPassage();
-  EXPECT_EQ(model.requiredFormat(), 2);
+  EXPECT_EQ(model.requiredFormat(), 3); // an intersection vertex: a rule of format 3
   EXPECT_EQ(model.machine.bladeCount, 12);
   const double pitch = 2.0 * Pi / 12.0;
   EXPECT_EQ(model.blocks.size(), 2u);
@@ -225,7 +225,7 @@ TEST(CarrierTemplates, DocumentRoundTripAndDeterminism)
 {
   const BlockModel model = loadPassage();
   const std::string document = writeModelDocument(model);
-  EXPECT_NE(document.find("blockforge_model: 2"), std::string::npos);
+  EXPECT_NE(document.find("blockforge_model: 3"), std::string::npos);
   EXPECT_NE(document.find("carriers:"), std::string::npos);
   const BlockModel reread = documentRoundTrip(model);
   const Grid original = meshAll(model);

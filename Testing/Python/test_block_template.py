@@ -101,7 +101,7 @@ class BlockTemplateTest(unittest.TestCase):
         preview = servermanager.Fetch(template)
         self.assertEqual(preview.GetNumberOfBlocks(), 2)
         document = preview.GetFieldData().GetAbstractArray("BlockForgeModel").GetValue(0)
-        self.assertIn("blockforge_model: 2", document)
+        self.assertIn("blockforge_model: 3", document)  # placement rules (projections)
         self.assertIn("kind: revolve", document)
 
         # port 1: the carriers the template declares, by name

@@ -1,0 +1,328 @@
+#include "MeshInternals.h"
+
+#include "../Core/BSpline.h"
+#include "../Core/Carriers.h"
+#include "../Core/Curve.h"
+#include "../Core/Projection.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+namespace blockforge
+{
+namespace model
+{
+using syntax::entity;
+using syntax::formatNumber;
+using syntax::shortNumber;
+
+namespace
+{
+// -------------------------------------------------------------------- edge geometry
+
+/// A curve moved parallel to itself: base(t) + (1 - t) startShift + t endShift, t the base
+/// curve's own parameter (a `follow` edge: the source edge's shape between other ends).
+class FollowCurve : public Curve
+{
+public:
+  /// `reversed`: the follow edge runs from the base's end to its start.
+  FollowCurve(CurvePtr base, const Vec3& startShift, const Vec3& endShift, bool reversed)
+    : Base(std::move(base))
+    , StartShift(startShift)
+    , EndShift(endShift)
+    , Reversed(reversed)
+  {
+  }
+  Vec3 point(double t) const override
+  {
+    return Base->point(Reversed ? 1.0 - t : t) + (1.0 - t) * StartShift + t * EndShift;
+  }
+  Vec3 derivative(double t, int order = 1) const override
+  {
+    const double sign = Reversed && order % 2 == 1 ? -1.0 : 1.0;
+    const Vec3 base = sign * Base->derivative(Reversed ? 1.0 - t : t, order);
+    return order == 1 ? Vec3(base + EndShift - StartShift) : base;
+  }
+
+private:
+  CurvePtr Base;
+  Vec3 StartShift, EndShift;
+  bool Reversed;
+};
+
+/// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.
+} // namespace
+
+double carrierTolerance(const CarrierGeometry& geometry, int carrier, double size)
+{
+  return 1e-9 * std::max(size, geometry.size(carrier));
+}
+
+/// Parameters of `vertex` on `carrier`; GeometryError (ending with `advice`) when the
+/// vertex is not on it.
+Eigen::Vector2d vertexOnCarrier(const BlockModel& model, const CarrierGeometry& geometry,
+  int vertex, int carrier, double size, const std::string& advice)
+{
+  double s = 0.0, t = 0.0, distance = 0.0;
+  geometry.vertexParameters(model, vertex, carrier, s, t, distance);
+  if (distance > carrierTolerance(geometry, carrier, size))
+  {
+    throw GeometryError("vertex '" + model.vertices[vertex].name + "' is not on carrier '" +
+      model.carriers[carrier].name + "' (" + shortNumber(distance) + " away); " + advice);
+  }
+  return Eigen::Vector2d(s, t);
+}
+
+/// Parameter(s) of an edge end on the edge's carrier: from `at`, else from the vertex.
+Eigen::Vector2d edgeEndParameters(const BlockModel& model, const CarrierGeometry& geometry,
+  const Edge& edge, int end, double size)
+{
+  const int vertex = end == 0 ? edge.from : edge.to;
+  const bool surface = edge.kind != Edge::Kind::OnCurve;
+  const std::size_t per = surface ? 2 : 1;
+  if (edge.at.size() == 2 * per)
+  {
+    Eigen::Vector2d st(edge.at[end * per], surface ? edge.at[end * per + 1] : 0.0);
+    const double distance =
+      (geometry.point(edge.carrier, st[0], st[1]) - model.vertices[vertex].position).norm();
+    if (distance > carrierTolerance(geometry, edge.carrier, size))
+    {
+      throw GeometryError("'at' puts its " + std::string(end == 0 ? "first" : "second") +
+        " end " + shortNumber(distance) + " away from vertex '" + model.vertices[vertex].name +
+        "'");
+    }
+    return st;
+  }
+  return vertexOnCarrier(model, geometry, vertex, edge.carrier, size, "attach it to the carrier");
+}
+
+NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::vector<NamedCurve>& previous, const Edge& edge, double size)
+{
+  const Vec3& start = model.vertices[edge.from].position;
+  const Vec3& end = model.vertices[edge.to].position;
+  NamedCurve named;
+  const int carrierCount = static_cast<int>(model.carriers.size());
+  if ((edge.kind == Edge::Kind::OnCurve || edge.kind == Edge::Kind::OnSurface ||
+        edge.kind == Edge::Kind::Project) &&
+    (edge.carrier < 0 || edge.carrier >= carrierCount))
+  {
+    throw GeometryError("refers to a carrier that does not exist");
+  }
+  switch (edge.kind)
+  {
+    case Edge::Kind::OnCurve:
+    {
+      if (geometry.isSurface(edge.carrier))
+      {
+        throw GeometryError("carrier '" + model.carriers[edge.carrier].name +
+          "' is a surface; on_curve needs a curve");
+      }
+      const double u0 = edgeEndParameters(model, geometry, edge, 0, size)[0];
+      const double u1 = edgeEndParameters(model, geometry, edge, 1, size)[0];
+      if (u0 == u1)
+      {
+        throw GeometryError("both ends are at the same curve parameter");
+      }
+      named.curve = std::make_shared<SubCurve>(
+        geometry.curve(edge.carrier), u0, u1, geometry.closedS(edge.carrier));
+      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve);
+      named.length = named.lengthTable->totalLength();
+      break;
+    }
+    case Edge::Kind::OnSurface:
+    {
+      if (!geometry.isSurface(edge.carrier))
+      {
+        throw GeometryError("carrier '" + model.carriers[edge.carrier].name +
+          "' is a curve; on_surface needs a surface");
+      }
+      const Eigen::Vector2d a = edgeEndParameters(model, geometry, edge, 0, size);
+      const Eigen::Vector2d b = edgeEndParameters(model, geometry, edge, 1, size);
+      named.curve = std::make_shared<ParameterLineCurve>(geometry.surface(edge.carrier), a, b,
+        geometry.closedS(edge.carrier), geometry.closedT(edge.carrier),
+        geometry.extendsT(edge.carrier));
+      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve);
+      named.length = named.lengthTable->totalLength();
+      break;
+    }
+    case Edge::Kind::Project:
+    {
+      named.curve = std::make_shared<LineCurve>(start, end);
+      named.length = (end - start).norm();
+      named.projectOnto = edge.carrier;
+      for (const int vertex : { edge.from, edge.to })
+      {
+        vertexOnCarrier(model, geometry, vertex, edge.carrier, size,
+          "the ends of a projected edge must lie on it");
+      }
+      break;
+    }
+    case Edge::Kind::Periodic:
+    {
+      const int self = static_cast<int>(&edge - model.edges.data());
+      if (edge.source < 0 || edge.source >= self)
+      {
+        throw GeometryError("the source of a periodic edge must be an edge defined before it");
+      }
+      if (!model.machine.defined || model.machine.bladeCount <= 0)
+      {
+        throw GeometryError("a periodic edge needs the machine's blade count");
+      }
+      const Edge& source = model.edges[edge.source];
+      const double angle = edge.pitches * model.machine.pitch();
+      const double tolerance = 1e-9 * size;
+      for (int k = 0; k < 2; ++k)
+      {
+        const Vertex& image = model.vertices[k == 0 ? edge.from : edge.to];
+        const Vertex& original = model.vertices[k == 0 ? source.from : source.to];
+        const Vec3 rotated = rotateAboutAxis(
+          original.position, model.machine.axisPoint, model.machine.axis, angle);
+        const double miss = (rotated - image.position).norm();
+        if (miss > tolerance)
+        {
+          throw GeometryError("vertex '" + image.name + "' is not the image of '" +
+            original.name + "' of source edge '" + source.name + "' rotated by " +
+            std::to_string(edge.pitches) + " pitch(es) (off by " + shortNumber(miss) + ")");
+        }
+      }
+      named.length = previous[edge.source].length;
+      break;
+    }
+    case Edge::Kind::Follow:
+    {
+      const int self = static_cast<int>(&edge - model.edges.data());
+      if (edge.source < 0 || edge.source >= self)
+      {
+        throw GeometryError("the source of a follow edge must be an edge defined before it");
+      }
+      const Edge& source = model.edges[edge.source];
+      const NamedCurve& base = previous[edge.source];
+      if (!base.curve || base.projectOnto >= 0 || source.kind == Edge::Kind::Periodic ||
+        source.kind == Edge::Kind::Follow)
+      {
+        throw GeometryError("edge '" + source.name +
+          "' cannot be followed: follow a line, arc, spline, on_curve or on_surface edge");
+      }
+      // The follow edge may run either way along its source: its ends go with the
+      // source's nearer ends.
+      const Vec3& sourceStart = model.vertices[source.from].position;
+      const Vec3& sourceEnd = model.vertices[source.to].position;
+      const bool reversed = (start - sourceEnd).norm() + (end - sourceStart).norm() <
+        (start - sourceStart).norm() + (end - sourceEnd).norm();
+      named.curve = reversed
+        ? std::make_shared<FollowCurve>(base.curve, start - sourceEnd, end - sourceStart, true)
+        : std::make_shared<FollowCurve>(base.curve, start - sourceStart, end - sourceEnd, false);
+      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve);
+      named.length = named.lengthTable->totalLength();
+      break;
+    }
+    default:
+      break;
+  }
+  switch (edge.kind)
+  {
+    case Edge::Kind::Line:
+      named.curve = std::make_shared<LineCurve>(start, end);
+      named.length = (end - start).norm();
+      break;
+    case Edge::Kind::Arc:
+    {
+      auto arc = std::make_shared<ArcCurve>(edge.arcHasCentre
+          ? ArcCurve::fromCentre(start, end, edge.arcCentre)
+          : ArcCurve::throughPoint(start, edge.arcThrough, end));
+      named.length = arc->radius() * arc->sweepAngle();
+      named.curve = arc;
+      break;
+    }
+    case Edge::Kind::Spline:
+    {
+      std::vector<Vec3> points;
+      points.push_back(start);
+      points.insert(points.end(), edge.splinePoints.begin(), edge.splinePoints.end());
+      points.push_back(end);
+      named.curve = std::make_shared<BSplineCurve>(
+        BSplineCurve::interpolate(points, 3, ParameterMethod::ChordLength));
+      named.arcLength = std::make_shared<ArcLength>(named.curve);
+      named.length = named.arcLength->totalLength();
+      break;
+    }
+    default:
+      break;
+  }
+  if (!std::isfinite(named.length) || !(named.length > 0.0))
+  {
+    throw GeometryError("the edge has no length");
+  }
+  return named;
+}
+
+/// Curves of all named edges; GeometryError becomes a TemplateError naming the edge.
+std::vector<NamedCurve> buildNamedCurves(const BlockModel& model, const CarrierGeometry& geometry)
+{
+  std::vector<NamedCurve> curves;
+  const double size = modelSize(model);
+  for (const Edge& edge : model.edges)
+  {
+    try
+    {
+      curves.push_back(buildNamedCurve(model, geometry, curves, edge, size));
+    }
+    catch (const GeometryError& error)
+    {
+      fail(edge.where, entity("edge", edge.name), error.what());
+    }
+  }
+  return curves;
+}
+
+/// Node parameters of `law` for `nodeCount` nodes on an edge of `length`. When the cell
+/// counts were changed for a preview or a density multiplier, a first-cell law that no
+/// longer fits falls back to the solved ratio, then to uniform: previews must not fail
+/// on a template that meshes at its own density.
+std::vector<double> lawParameters(
+  const DistributionLaw& law, int nodeCount, double length, bool allowFallback)
+{
+  if (!allowFallback)
+  {
+    return distributeNodes(law, nodeCount, length);
+  }
+  try
+  {
+    return distributeNodes(law, nodeCount, length);
+  }
+  catch (const GeometryError&)
+  {
+  }
+  if (law.kind == DistributionLaw::Kind::FirstCell && law.expansionRatio != 0.0)
+  {
+    DistributionLaw solved = law;
+    solved.expansionRatio = 0.0;
+    try
+    {
+      return distributeNodes(solved, nodeCount, length);
+    }
+    catch (const GeometryError&)
+    {
+    }
+  }
+  return distributeNodes(DistributionLaw(), nodeCount, length);
+}
+
+std::vector<double> reversedParameters(const std::vector<double>& params)
+{
+  const std::size_t n = params.size();
+  std::vector<double> reversed(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    reversed[i] = 1.0 - params[n - 1 - i];
+  }
+  reversed.front() = 0.0;
+  reversed.back() = 1.0;
+  return reversed;
+}
+
+} // namespace model
+} // namespace blockforge

@@ -1,0 +1,662 @@
+#include "MeshInternals.h"
+
+#include "../Core/Carriers.h"
+#include "../Core/Projection.h"
+#include "../Core/Transfinite.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+namespace blockforge
+{
+namespace model
+{
+using syntax::entity;
+using syntax::formatNumber;
+using syntax::shortNumber;
+
+// -------------------------------------------------------------------- mesh topology
+
+/**
+ * The topology of the model for the given node counts (buildConnectivity's checks) with
+ * the node parameters of every edge, checked on shared edges: the same laws must put the
+ * nodes at the same places.
+ */
+MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const std::vector<std::array<int, 3>>& nodes, bool allowFallback)
+{
+  MeshTopology topology;
+  topology.connectivity = buildConnectivity(model, nodes);
+  for (const TopologyEdge& edge : topology.connectivity.edges)
+  {
+    UniqueEdge unique;
+    static_cast<TopologyEdge&>(unique) = edge;
+    unique.length = edge.named >= 0
+      ? curves[edge.named].length
+      : (model.vertices[edge.b].position - model.vertices[edge.a].position).norm();
+    topology.edges.push_back(std::move(unique));
+  }
+  for (const TopologyFace& face : topology.connectivity.faces)
+  {
+    UniqueFace unique;
+    static_cast<TopologyFace&>(unique) = face;
+    topology.faces.push_back(std::move(unique));
+  }
+  for (const BlockLinks& links : topology.connectivity.blocks)
+  {
+    MeshLinks mesh;
+    static_cast<BlockLinks&>(mesh) = links;
+    topology.blocks.push_back(std::move(mesh));
+  }
+  for (std::size_t e = 0; e < topology.edges.size(); ++e)
+  {
+    computeEdgeParameters(model, topology, static_cast<int>(e), allowFallback);
+  }
+  for (int b = 0; b < static_cast<int>(model.blocks.size()); ++b)
+  {
+    computeCollapsedParameters(model, topology, b);
+  }
+  return topology;
+}
+
+/// Node parameters: the first block's law defines the edge; every other block must give
+/// the same parameters, compared in the edge's canonical direction.
+void computeEdgeParameters(const BlockModel& model, MeshTopology& topology, int e, bool allowFallback)
+{
+  UniqueEdge& edge = topology.edges[e];
+  edge.params.clear();
+  for (const EdgeUse& use : edge.uses)
+  {
+    const Block& block = model.blocks[use.block];
+    std::vector<double> params;
+    try
+    {
+      params = lawParameters(block.laws[use.localEdge], edge.nodeCount, edge.length, allowFallback);
+    }
+    catch (const GeometryError& error)
+    {
+      const std::array<int, 2> ends = edgeVertices(use.localEdge);
+      fail(block.where, blockEntity(model, use.block),
+        "grading of edge " + edgeText(model, block.vertices[ends[0]], block.vertices[ends[1]]) +
+          " (" + syntax::edgeLabel(use.localEdge) + "): " + error.what());
+    }
+    if (use.reversed)
+    {
+      params = reversedParameters(params);
+    }
+    if (edge.params.empty())
+    {
+      edge.params = std::move(params);
+      continue;
+    }
+    double difference = 0.0;
+    for (std::size_t i = 0; i < params.size(); ++i)
+    {
+      difference = std::max(difference, std::abs(params[i] - edge.params[i]));
+    }
+    if (difference > 1e-12)
+    {
+      const EdgeUse& first = edge.uses.front();
+      const std::array<int, 2> ends = edgeVertices(use.localEdge);
+      fail(block.where, blockEntity(model, use.block),
+        "the grading of edge " +
+          edgeText(model, block.vertices[ends[0]], block.vertices[ends[1]]) + " (" +
+          syntax::edgeLabel(use.localEdge) + ") puts its nodes differently from block '" +
+          model.blocks[first.block].name + "' (" + syntax::edgeLabel(first.localEdge) +
+          "), by up to " + shortNumber(difference) +
+          " of the edge length; give both blocks the same law along this edge (a reversed "
+          "direction needs the inverse ratio)");
+    }
+  }
+}
+
+/// Collapsed edges carry no geometry, but their parameters still steer the blending
+/// inside the block: take the block's law over the length of the longest parallel edge.
+void computeCollapsedParameters(const BlockModel& model, MeshTopology& topology, int b)
+{
+  MeshLinks& links = topology.blocks[b];
+  for (int e = 0; e < 12; ++e)
+  {
+    if (links.edge[e] >= 0)
+    {
+      continue;
+    }
+    double length = 0.0;
+    for (int other = 0; other < 12; ++other)
+    {
+      if (edgeDirection(other) == edgeDirection(e) && links.edge[other] >= 0)
+      {
+        length = std::max(length, topology.edges[links.edge[other]].length);
+      }
+    }
+    links.collapsedParams[e] = lawParameters(
+      model.blocks[b].laws[e], links.nodes[edgeDirection(e)], length > 0.0 ? length : 1.0, true);
+  }
+}
+
+// -------------------------------------------------------------------- grids
+
+LocalEdge localEdge(
+  const BlockModel& model, const MeshTopology& topology, int block, int localEdgeIndex)
+{
+  const MeshLinks& links = topology.blocks[block];
+  LocalEdge local;
+  local.count = links.nodes[edgeDirection(localEdgeIndex)];
+  const int unique = links.edge[localEdgeIndex];
+  if (unique < 0)
+  {
+    const Vec3& point =
+      model.vertices[model.blocks[block].vertices[edgeVertices(localEdgeIndex)[0]]].position;
+    local.xyzStorage.resize(3 * local.count);
+    for (int i = 0; i < local.count; ++i)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        local.xyzStorage[3 * i + c] = point[c];
+      }
+    }
+    local.borrowedParams = links.collapsedParams[localEdgeIndex].data();
+    return local;
+  }
+  const UniqueEdge& edge = topology.edges[unique];
+  if (!links.reversed[localEdgeIndex])
+  {
+    local.borrowedXyz = edge.xyz.data();
+    local.borrowedParams = edge.params.data();
+    return local;
+  }
+  local.xyzStorage.resize(3 * local.count);
+  for (int i = 0; i < local.count; ++i)
+  {
+    std::copy_n(&edge.xyz[3 * (local.count - 1 - i)], 3, &local.xyzStorage[3 * i]);
+  }
+  local.paramStorage = reversedParameters(edge.params);
+  return local;
+}
+
+/**
+ * The first cells at every block corner must not be inverted: the first nodes of the three
+ * edges leaving a corner (in +i, +j, +k: towards the corner from the far side) form a
+ * right-handed frame. This is the real shape of the corner cells, whatever the curvature
+ * of the edges; corners where an edge is collapsed (wedges) are skipped.
+ */
+void checkCornerCells(const BlockModel& model, const MeshTopology& topology, double size)
+{
+  for (int b = 0; b < static_cast<int>(model.blocks.size()); ++b)
+  {
+    checkCornerCells(model, topology, b, size);
+  }
+}
+
+void checkCornerCells(const BlockModel& model, const MeshTopology& topology, int b, double size)
+{
+  {
+    std::array<std::array<Vec3, 3>, 8> frame{};
+    for (int e = 0; e < 12; ++e)
+    {
+      const LocalEdge edge = localEdge(model, topology, b, e);
+      const double* xyz = edge.xyz();
+      const int n = edge.count;
+      const std::array<int, 2> ends = edgeVertices(e);
+      auto node = [&](int i) { return Vec3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]); };
+      frame[ends[0]][edgeDirection(e)] = node(1) - node(0);
+      frame[ends[1]][edgeDirection(e)] = node(n - 1) - node(n - 2);
+    }
+    for (int v = 0; v < 8; ++v)
+    {
+      const Vec3 &ds = frame[v][0], &dt = frame[v][1], &du = frame[v][2];
+      const double scale = ds.norm() * dt.norm() * du.norm();
+      if (ds.norm() <= 1e-12 * size || dt.norm() <= 1e-12 * size || du.norm() <= 1e-12 * size)
+      {
+        continue;
+      }
+      if (ds.dot(dt.cross(du)) < -1e-10 * scale)
+      {
+        const Block& block = model.blocks[b];
+        fail(block.where, blockEntity(model, b),
+          "the block folds at V" + std::to_string(v) + " (vertex '" +
+            model.vertices[block.vertices[v]].name +
+            "'): the edges leaving it form a left-handed frame, so its corner cells are "
+            "inverted; move the vertices or change the edges' shapes");
+      }
+    }
+  }
+}
+
+/// Face grid of `face` of `block` in the block's own orientation, from its four edges.
+void faceFromEdges(const BlockModel& model, const MeshTopology& topology, int block, int face,
+  std::vector<double>& out)
+{
+  const std::array<int, 4> edges = faceEdges(face);
+  const LocalEdge bottom = localEdge(model, topology, block, edges[0]);
+  const LocalEdge top = localEdge(model, topology, block, edges[1]);
+  const LocalEdge left = localEdge(model, topology, block, edges[2]);
+  const LocalEdge right = localEdge(model, topology, block, edges[3]);
+  out.resize(3 * static_cast<std::size_t>(bottom.count) * left.count);
+  transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data());
+}
+
+void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const CarrierGeometry& geometry, UniqueEdge& edge)
+{
+  const Vec3& start = model.vertices[edge.a].position;
+  const Vec3& end = model.vertices[edge.b].position;
+  const int n = edge.nodeCount;
+  edge.xyz.resize(3 * n);
+  const NamedCurve* named = edge.named >= 0 ? &curves[edge.named] : nullptr;
+  if (named && model.edges[edge.named].kind == Edge::Kind::Periodic)
+  {
+    return; // rotated from its source edge afterwards
+  }
+  // The named edge may run b -> a; its curve is evaluated at the mirrored fraction.
+  const bool curveReversed = named && model.edges[edge.named].from != edge.a;
+  for (int i = 0; i < n; ++i)
+  {
+    Vec3 point;
+    if (i == 0)
+    {
+      point = start; // end nodes are the vertices themselves, bit for bit
+    }
+    else if (i == n - 1)
+    {
+      point = end;
+    }
+    else if (!named || model.edges[edge.named].kind == Edge::Kind::Line ||
+      model.edges[edge.named].kind == Edge::Kind::Project)
+    {
+      point = (1.0 - edge.params[i]) * start + edge.params[i] * end;
+      if (named && named->projectOnto >= 0)
+      {
+        double s = 0.0, t = 0.0, distance = 0.0;
+        geometry.project(named->projectOnto, point, s, t, distance);
+        point = geometry.point(named->projectOnto, s, t);
+      }
+    }
+    else
+    {
+      const double fraction = curveReversed ? 1.0 - edge.params[i] : edge.params[i];
+      const double t = named->lengthTable ? named->lengthTable->parameterAtFraction(fraction)
+        : named->arcLength                ? named->arcLength->parameterAtFraction(fraction)
+                                          : fraction;
+      point = named->curve->point(t);
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      edge.xyz[3 * i + c] = point[c];
+    }
+  }
+}
+
+std::map<std::pair<int, int>, int> edgeLookup(const MeshTopology& topology)
+{
+  std::map<std::pair<int, int>, int> lookup;
+  for (std::size_t e = 0; e < topology.edges.size(); ++e)
+  {
+    lookup.emplace(std::make_pair(topology.edges[e].a, topology.edges[e].b), static_cast<int>(e));
+  }
+  return lookup;
+}
+
+int findUniqueEdge(const std::map<std::pair<int, int>, int>& lookup, int a, int b)
+{
+  const auto found = lookup.find(std::make_pair(std::min(a, b), std::max(a, b)));
+  return found == lookup.end() ? -1 : found->second;
+}
+
+/**
+ * Makes unique edge `image` (running imageFrom -> imageTo) the rotation of unique edge
+ * `source` (running sourceFrom -> sourceTo): interior nodes rotated, end nodes the vertices
+ * themselves. The node parameters of both must agree (the same grading).
+ */
+void rotateEdgeNodes(const BlockModel& model, MeshTopology& topology, int source, int sourceFrom,
+  int image, int imageFrom, const Vec3& axisPoint, const Vec3& axis, double angle,
+  const SourceLocation& where, const std::string& entityText)
+{
+  const UniqueEdge& from = topology.edges[source];
+  UniqueEdge& to = topology.edges[image];
+  const int n = to.nodeCount;
+  if (from.nodeCount != n)
+  {
+    fail(where, entityText,
+      "edge " + edgeText(model, to.a, to.b) + " has " + std::to_string(n - 1) +
+        " cells but its periodic source " + edgeText(model, from.a, from.b) + " has " +
+        std::to_string(from.nodeCount - 1));
+  }
+  const bool sourceForward = sourceFrom == from.a;
+  const bool imageForward = imageFrom == to.a;
+  double difference = 0.0;
+  for (int i = 0; i < n; ++i)
+  {
+    const int along = imageForward ? i : n - 1 - i; // index along imageFrom -> imageTo
+    const int sourceIndex = sourceForward ? along : n - 1 - along;
+    const double sourceParam =
+      sourceForward ? from.params[sourceIndex] : 1.0 - from.params[sourceIndex];
+    const double imageParam = imageForward ? to.params[i] : 1.0 - to.params[i];
+    difference = std::max(difference, std::abs(sourceParam - imageParam));
+    if (i == 0 || i == n - 1)
+    {
+      const Vec3& vertex = model.vertices[i == 0 ? to.a : to.b].position;
+      std::copy_n(vertex.data(), 3, &to.xyz[3 * i]);
+      continue;
+    }
+    const Vec3 p(from.xyz[3 * sourceIndex], from.xyz[3 * sourceIndex + 1], from.xyz[3 * sourceIndex + 2]);
+    const Vec3 q = rotateAboutAxis(p, axisPoint, axis, angle);
+    std::copy_n(q.data(), 3, &to.xyz[3 * i]);
+  }
+  if (difference > 1e-12)
+  {
+    fail(where, entityText,
+      "edge " + edgeText(model, to.a, to.b) + " places its nodes differently from its periodic "
+      "source " + edgeText(model, from.a, from.b) + " (by up to " + shortNumber(difference) +
+        " of the edge length); give both the same grading");
+  }
+}
+
+/// Named periodic edges: rotated copies of their source edges.
+void computePeriodicEdges(const BlockModel& model, MeshTopology& topology)
+{
+  const auto lookup = edgeLookup(topology);
+  for (std::size_t e = 0; e < topology.edges.size(); ++e)
+  {
+    const UniqueEdge& edge = topology.edges[e];
+    if (edge.named < 0 || model.edges[edge.named].kind != Edge::Kind::Periodic)
+    {
+      continue;
+    }
+    const Edge& named = model.edges[edge.named];
+    const Edge& source = model.edges[named.source];
+    const int sourceEdge = findUniqueEdge(lookup, source.from, source.to);
+    if (sourceEdge < 0)
+    {
+      fail(named.where, entity("edge", named.name),
+        "its source edge '" + source.name + "' is not an edge of any block");
+    }
+    rotateEdgeNodes(model, topology, sourceEdge, source.from, static_cast<int>(e), named.from,
+      model.machine.axisPoint, model.machine.axis, named.pitches * model.machine.pitch(),
+      named.where, entity("edge", named.name));
+  }
+}
+
+/// The edges of every periodic image face: rotations of the source face's edges.
+void computePeriodicPatchEdges(const BlockModel& model, MeshTopology& topology)
+{
+  const auto lookup = edgeLookup(topology);
+  for (const PeriodicPair& entry : topology.connectivity.periodic)
+  {
+    const UniqueFace& from = topology.faces[entry.source];
+    const UniqueFace& to = topology.faces[entry.image];
+    for (int k = 0; k < 4; ++k)
+    {
+      const int g0 = to.ownerIds[k], g1 = to.ownerIds[(k + 1) % 4];
+      const int f0 = from.ownerIds[entry.transform.mapCorner(k)];
+      const int f1 = from.ownerIds[entry.transform.mapCorner((k + 1) % 4)];
+      if (g0 == g1 || f0 == f1)
+      {
+        continue; // collapsed
+      }
+      const int image = findUniqueEdge(lookup, g0, g1);
+      const int source = findUniqueEdge(lookup, f0, f1);
+      if (image < 0 || source < 0 || image == source)
+      {
+        continue;
+      }
+      const Patch& patch = model.patches[entry.patch];
+      rotateEdgeNodes(model, topology, source, f0, image, g0, entry.axisPoint, entry.axis,
+        entry.angle, patch.where, entity("patch", patch.name));
+    }
+  }
+}
+
+/// Copies the boundary nodes of a face grid from its block's edges (bit for bit).
+void copyFaceBoundary(const BlockModel& model, const MeshTopology& topology, int block, int face,
+  int na, int nb, std::vector<double>& grid);
+
+/// Grid of a face that lies on a surface: TFI in the surface's (s, t) space, boundary
+/// nodes kept from the edges, interior nodes evaluated on the surface.
+void surfaceFace(const BlockModel& model, const MeshTopology& topology, const CarrierGeometry& geometry,
+  int carrier, int block, int face, std::vector<double>& out)
+{
+  const std::array<int, 4> edges = faceEdges(face);
+  const LocalEdge bottom = localEdge(model, topology, block, edges[0]);
+  const LocalEdge top = localEdge(model, topology, block, edges[1]);
+  const LocalEdge left = localEdge(model, topology, block, edges[2]);
+  const LocalEdge right = localEdge(model, topology, block, edges[3]);
+  const int na = bottom.count, nb = left.count;
+  // The boundary loop: bottom (a up), right (b up), top (a down), left (b down).
+  std::vector<Vec3> loop;
+  auto node = [](const LocalEdge& edge, int i) {
+    const double* p = edge.xyz() + 3 * i;
+    return Vec3(p[0], p[1], p[2]);
+  };
+  for (int a = 0; a < na; ++a)
+    loop.push_back(node(bottom, a));
+  for (int b = 1; b < nb; ++b)
+    loop.push_back(node(right, b));
+  for (int a = na - 2; a >= 0; --a)
+    loop.push_back(node(top, a));
+  for (int b = nb - 2; b >= 1; --b)
+    loop.push_back(node(left, b));
+  const int loopSize = static_cast<int>(loop.size());
+  std::vector<Eigen::Vector2d> st(loopSize);
+  for (int k = 0; k < loopSize; ++k)
+  {
+    double s = 0.0, t = 0.0, distance = 0.0;
+    geometry.project(carrier, loop[k], s, t, distance);
+    st[k] = Eigen::Vector2d(s, t);
+  }
+  // Unwrap across the seam of closed directions.
+  const bool closed[2] = { geometry.closedS(carrier), geometry.closedT(carrier) };
+  for (int k = 1; k < loopSize; ++k)
+  {
+    for (int d = 0; d < 2; ++d)
+    {
+      if (!closed[d])
+        continue;
+      while (st[k][d] - st[k - 1][d] > 0.5)
+        st[k][d] -= 1.0;
+      while (st[k][d] - st[k - 1][d] < -0.5)
+        st[k][d] += 1.0;
+    }
+  }
+  auto fill = [&](int count, auto index) {
+    std::vector<double> xyz(3 * count);
+    for (int i = 0; i < count; ++i)
+    {
+      const Eigen::Vector2d& p = st[index(i) % loopSize];
+      xyz[3 * i] = p[0];
+      xyz[3 * i + 1] = p[1];
+      xyz[3 * i + 2] = 0.0;
+    }
+    return xyz;
+  };
+  const std::vector<double> pb = fill(na, [&](int a) { return a; });
+  const std::vector<double> pr = fill(nb, [&](int b) { return (na - 1) + b; });
+  const std::vector<double> pt = fill(na, [&](int a) { return (na - 1) + (nb - 1) + (na - 1 - a); });
+  const std::vector<double> pl =
+    fill(nb, [&](int b) { return 2 * (na - 1) + (nb - 1) + (nb - 1 - b); });
+  std::vector<double> parameters(3 * static_cast<std::size_t>(na) * nb);
+  transfiniteFace(EdgeNodes{ pb.data(), bottom.params(), na }, EdgeNodes{ pt.data(), top.params(), na },
+    EdgeNodes{ pl.data(), left.params(), nb }, EdgeNodes{ pr.data(), right.params(), nb },
+    parameters.data());
+  out.resize(parameters.size());
+  for (int b = 1; b + 1 < nb; ++b)
+  {
+    for (int a = 1; a + 1 < na; ++a)
+    {
+      const std::size_t i = static_cast<std::size_t>(b) * na + a;
+      const Vec3 p = geometry.point(carrier, parameters[3 * i], parameters[3 * i + 1]);
+      std::copy_n(p.data(), 3, &out[3 * i]);
+    }
+  }
+  copyFaceBoundary(model, topology, block, face, na, nb, out);
+}
+
+void copyFaceBoundary(const BlockModel& model, const MeshTopology& topology, int block, int face,
+  int na, int nb, std::vector<double>& grid)
+{
+  const std::array<int, 4> edges = faceEdges(face);
+  const LocalEdge bottom = localEdge(model, topology, block, edges[0]);
+  const LocalEdge top = localEdge(model, topology, block, edges[1]);
+  const LocalEdge left = localEdge(model, topology, block, edges[2]);
+  const LocalEdge right = localEdge(model, topology, block, edges[3]);
+  for (int a = 0; a < na; ++a)
+  {
+    std::copy_n(bottom.xyz() + 3 * a, 3, &grid[3 * static_cast<std::size_t>(a)]);
+    std::copy_n(top.xyz() + 3 * a, 3, &grid[3 * (static_cast<std::size_t>(nb - 1) * na + a)]);
+  }
+  for (int b = 0; b < nb; ++b)
+  {
+    std::copy_n(left.xyz() + 3 * b, 3, &grid[3 * (static_cast<std::size_t>(b) * na)]);
+    std::copy_n(right.xyz() + 3 * b, 3, &grid[3 * (static_cast<std::size_t>(b) * na + na - 1)]);
+  }
+}
+
+/// Grid of a periodic image face: the source face's nodes rotated; boundary from its edges.
+void periodicFace(const BlockModel& model, const MeshTopology& topology, const PeriodicPair& entry,
+  std::vector<double>& out)
+{
+  const UniqueFace& from = topology.faces[entry.source];
+  const UniqueFace& to = topology.faces[entry.image];
+  out.resize(3 * static_cast<std::size_t>(to.na) * to.nb);
+  for (int b = 0; b < to.nb; ++b)
+  {
+    for (int a = 0; a < to.na; ++a)
+    {
+      int sa = 0, sb = 0;
+      entry.transform.map(a, b, from.na, from.nb, sa, sb);
+      const double* p = &from.xyz[3 * (static_cast<std::size_t>(sb) * from.na + sa)];
+      const Vec3 q = rotateAboutAxis(Vec3(p[0], p[1], p[2]), entry.axisPoint, entry.axis, entry.angle);
+      std::copy_n(q.data(), 3, &out[3 * (static_cast<std::size_t>(b) * to.na + a)]);
+    }
+  }
+  const FaceUse& owner = to.uses.front();
+  copyFaceBoundary(model, topology, owner.block, owner.face, to.na, to.nb, out);
+}
+
+/// Unique face -> surface carrier of the model's surface face sets.
+std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopology& topology)
+{
+  std::map<int, int> carriers;
+  for (const SurfaceFaces& set : model.surfaceFaces)
+  {
+    for (const BlockFace& face : set.faces)
+    {
+      const int unique = topology.blocks[face.block].face[face.face];
+      if (unique >= 0)
+      {
+        carriers[unique] = set.carrier;
+      }
+    }
+  }
+  return carriers;
+}
+
+
+void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::map<int, int>& onSurface, MeshTopology& topology, int f)
+{
+  UniqueFace& face = topology.faces[f];
+  const FaceUse& owner = face.uses.front();
+  try
+  {
+    const auto surface = onSurface.find(f);
+    if (surface != onSurface.end())
+    {
+      surfaceFace(model, topology, geometry, surface->second, owner.block, owner.face, face.xyz);
+    }
+    else
+    {
+      faceFromEdges(model, topology, owner.block, owner.face, face.xyz);
+    }
+  }
+  catch (const GeometryError& error)
+  {
+    fail(model.blocks[owner.block].where, blockEntity(model, owner.block),
+      "face " + blockFaceText(model, owner.block, owner.face) + ": " + error.what());
+  }
+}
+
+void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::vector<NamedCurve>& curves, MeshTopology& topology)
+{
+  for (UniqueEdge& edge : topology.edges)
+  {
+    computeEdgeNodes(model, curves, geometry, edge);
+  }
+  // Periodic copies: named periodic edges, then the edges and faces of every periodic
+  // patch's partner, rotated node for node from the first patch of the pair.
+  computePeriodicEdges(model, topology);
+  findPeriodicPairs(model, topology.connectivity);
+  const std::vector<PeriodicPair>& images = topology.connectivity.periodic;
+  computePeriodicPatchEdges(model, topology);
+  checkCornerCells(model, topology, modelSize(model));
+  std::vector<bool> isImage(topology.faces.size(), false);
+  for (const PeriodicPair& entry : images)
+  {
+    isImage[entry.image] = true;
+  }
+  const std::map<int, int> onSurface = surfaceFaceCarriers(model, topology);
+  for (std::size_t f = 0; f < topology.faces.size(); ++f)
+  {
+    if (!isImage[f])
+    {
+      computeFaceGrid(model, geometry, onSurface, topology, static_cast<int>(f));
+    }
+  }
+  for (const PeriodicPair& entry : images)
+  {
+    periodicFace(model, topology, entry, topology.faces[entry.image].xyz);
+  }
+}
+
+void meshBlockNodes(const BlockModel& model, const MeshTopology& topology, int block, double* out)
+{
+  const MeshLinks& links = topology.blocks[block];
+  BlockBoundary boundary;
+  std::array<std::vector<double>, 6> faceStorage;
+  for (int f = 0; f < 6; ++f)
+  {
+    const int unique = links.face[f];
+    if (unique < 0)
+    {
+      // Collapsed to a line or a point: not shared, rebuilt from its (collapsed) edges.
+      faceFromEdges(model, topology, block, f, faceStorage[f]);
+      boundary.faces[f] = faceStorage[f].data();
+      continue;
+    }
+    const UniqueFace& face = topology.faces[unique];
+    const FaceUse& owner = face.uses.front();
+    if (owner.block == block && owner.face == f)
+    {
+      boundary.faces[f] = face.xyz.data();
+      continue;
+    }
+    // Another block owns the face: copy its nodes into this block's orientation, so the
+    // shared nodes are the very same doubles.
+    const int na = links.nodes[faceDirections(f)[0]], nb = links.nodes[faceDirections(f)[1]];
+    std::vector<double>& grid = faceStorage[f];
+    grid.resize(3 * static_cast<std::size_t>(na) * nb);
+    for (int b = 0; b < nb; ++b)
+    {
+      for (int a = 0; a < na; ++a)
+      {
+        int ownerA = 0, ownerB = 0;
+        links.transform[f].map(a, b, face.na, face.nb, ownerA, ownerB);
+        std::copy_n(&face.xyz[3 * (static_cast<std::size_t>(ownerB) * face.na + ownerA)], 3,
+          &grid[3 * (static_cast<std::size_t>(b) * na + a)]);
+      }
+    }
+    boundary.faces[f] = grid.data();
+  }
+  std::array<LocalEdge, 12> edges;
+  for (int e = 0; e < 12; ++e)
+  {
+    edges[e] = localEdge(model, topology, block, e);
+    boundary.edgeParams[e] = edges[e].params();
+  }
+  transfiniteBlock(boundary, links.nodes[0], links.nodes[1], links.nodes[2], out);
+}
+} // namespace model
+} // namespace blockforge

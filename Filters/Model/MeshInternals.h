@@ -1,0 +1,168 @@
+/**
+ * @file MeshInternals.h
+ * @brief Private to the mesher, the mesh plan and the model check (not installed): the
+ * geometry of named edges, the model's topology with the node data the mesher adds, and
+ * the steps that turn them into edge, face and block grids.
+ */
+#pragma once
+
+#include "BlockModel.h"
+#include "CarrierGeometry.h"
+#include "Errors.h"
+#include "ModelSyntax.h"
+#include "Topology.h"
+
+#include "../Core/Curve.h"
+#include "../Core/Transfinite.h"
+
+#include <array>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace blockforge
+{
+namespace model
+{
+constexpr double Pi = 3.14159265358979323846;
+
+[[noreturn]] inline void fail(
+  const SourceLocation& where, const std::string& entityText, const std::string& what)
+{
+  throw TemplateError(where.file, where.line, entityText, what);
+}
+
+inline std::string blockEntity(const BlockModel& model, int block)
+{
+  return syntax::entity("block", model.blocks[block].name);
+}
+
+// -------------------------------------------------------------------- edge geometry
+/// The curve of a named edge in its own direction (from -> to), with what it takes to
+/// place nodes at arc-length fractions.
+struct NamedCurve
+{
+  CurvePtr curve;
+  std::shared_ptr<const ArcLength> arcLength; ///< splines only: arcs are arc-length already
+  std::shared_ptr<const ArcLengthTable> lengthTable; ///< curves on carriers
+  double length = 0.0;
+  int projectOnto = -1; ///< Project: the nodes of the straight line are projected onto it
+};
+
+/// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.
+double carrierTolerance(const CarrierGeometry& geometry, int carrier, double size);
+
+/// The curve of named edge `edge` (`previous`: the curves of the edges before it, which a
+/// periodic or follow edge takes its shape from). Throws GeometryError.
+NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::vector<NamedCurve>& previous, const Edge& edge, double size);
+/// Curves of all named edges; GeometryError becomes a TemplateError naming the edge.
+std::vector<NamedCurve> buildNamedCurves(const BlockModel& model, const CarrierGeometry& geometry);
+
+/// Node parameters of `law` for `nodeCount` nodes on an edge of `length` (with the
+/// fallbacks of previews and density multipliers when `allowFallback`).
+std::vector<double> lawParameters(
+  const DistributionLaw& law, int nodeCount, double length, bool allowFallback);
+std::vector<double> reversedParameters(const std::vector<double>& params);
+
+// -------------------------------------------------------------------- mesh topology
+/// A shared edge with its nodes: parameters in the canonical direction (from the first
+/// block that uses it) and coordinates.
+struct UniqueEdge : TopologyEdge
+{
+  double length = 0.0;
+  std::vector<double> params;
+  std::vector<double> xyz;
+};
+
+/// A shared face with its grid, stored in the orientation of its owner.
+struct UniqueFace : TopologyFace
+{
+  std::vector<double> xyz;
+};
+
+struct MeshLinks : BlockLinks
+{
+  std::array<std::vector<double>, 12> collapsedParams; ///< for collapsed edges only
+};
+
+/// The model's public topology with what the mesher adds to its edges, faces and blocks.
+struct MeshTopology
+{
+  Topology connectivity;
+  std::vector<UniqueEdge> edges;
+  std::vector<UniqueFace> faces;
+  std::vector<MeshLinks> blocks;
+};
+
+MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const std::vector<std::array<int, 3>>& nodes, bool allowFallback);
+/// Node parameters of unique edge `e` from the laws of the blocks that use it (checked to
+/// agree), with its current length.
+void computeEdgeParameters(const BlockModel& model, MeshTopology& topology, int e, bool allowFallback);
+/// Parameters of the collapsed edges of block `b`.
+void computeCollapsedParameters(const BlockModel& model, MeshTopology& topology, int b);
+
+// -------------------------------------------------------------------- grids
+/// Nodes of one edge as a block sees it (its local direction), possibly borrowed.
+struct LocalEdge
+{
+  std::vector<double> xyzStorage, paramStorage;
+  const double* borrowedXyz = nullptr;
+  const double* borrowedParams = nullptr;
+  int count = 0;
+  const double* xyz() const { return xyzStorage.empty() ? borrowedXyz : xyzStorage.data(); }
+  const double* params() const
+  {
+    return paramStorage.empty() ? borrowedParams : paramStorage.data();
+  }
+  EdgeNodes nodes() const { return EdgeNodes{ xyz(), params(), count }; }
+};
+
+LocalEdge localEdge(
+  const BlockModel& model, const MeshTopology& topology, int block, int localEdgeIndex);
+/// Throws TemplateError when the first cells at a corner of block `b` are inverted.
+void checkCornerCells(const BlockModel& model, const MeshTopology& topology, int block, double size);
+void checkCornerCells(const BlockModel& model, const MeshTopology& topology, double size);
+void faceFromEdges(const BlockModel& model, const MeshTopology& topology, int block, int face,
+  std::vector<double>& out);
+void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const CarrierGeometry& geometry, UniqueEdge& edge);
+std::map<std::pair<int, int>, int> edgeLookup(const MeshTopology& topology);
+int findUniqueEdge(const std::map<std::pair<int, int>, int>& lookup, int a, int b);
+/// Named periodic edges: rotated copies of their source edges.
+void computePeriodicEdges(const BlockModel& model, MeshTopology& topology);
+/// The edges of every periodic image face: rotations of the source face's edges.
+void computePeriodicPatchEdges(const BlockModel& model, MeshTopology& topology);
+void surfaceFace(const BlockModel& model, const MeshTopology& topology, const CarrierGeometry& geometry,
+  int carrier, int block, int face, std::vector<double>& out);
+void periodicFace(const BlockModel& model, const MeshTopology& topology, const PeriodicPair& entry,
+  std::vector<double>& out);
+/// Unique face -> surface carrier of the model's surface face sets.
+std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopology& topology);
+/// The grid of unique face f (not a periodic image), on its surface carrier if it has one.
+void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::map<int, int>& onSurface, MeshTopology& topology, int f);
+/// Every edge and face grid of the model (computeBoundaries), after buildMeshTopology.
+void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::vector<NamedCurve>& curves, MeshTopology& topology);
+/// The nodes of block b by transfinite interpolation from its face and edge grids.
+void meshBlockNodes(const BlockModel& model, const MeshTopology& topology, int block, double* out);
+
+// -------------------------------------------------------------------- model check
+void checkBasics(const BlockModel& model);
+/// Inside-out and folded blocks; only `blocks` when given.
+void checkOrientation(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  double size, const std::vector<int>* blocks = nullptr);
+/// Control points on their carriers, periodic vertices rotations of their sources; only
+/// `vertices` when given (the carriers' own checks then are skipped).
+void checkCarriers(const BlockModel& model, const CarrierGeometry& geometry, double size,
+  const std::vector<int>* vertices = nullptr);
+void checkSurfaceFaces(const BlockModel& model, const CarrierGeometry& geometry,
+  const MeshTopology& topology, double size);
+void checkNamedEdgesUsed(const BlockModel& model, const MeshTopology& topology);
+/// Everything checkModel checks after the basics.
+void checkModelWith(const BlockModel& model, const CarrierGeometry& geometry);
+} // namespace model
+} // namespace blockforge
