@@ -259,6 +259,45 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
   return named;
 }
 
+void followEdgeEnds(
+  BlockModel& model, const CarrierGeometry& geometry, int index, const std::vector<char>& movedVertex)
+{
+  Edge& edge = model.edges[index];
+  if (edge.at.empty() || (edge.kind != Edge::Kind::OnCurve && edge.kind != Edge::Kind::OnSurface))
+  {
+    return;
+  }
+  const bool surface = edge.kind == Edge::Kind::OnSurface;
+  const std::size_t per = surface ? 2 : 1;
+  if (edge.at.size() != 2 * per)
+  {
+    return;
+  }
+  const bool closed[2] = { geometry.closedS(edge.carrier), geometry.closedT(edge.carrier) };
+  for (int end = 0; end < 2; ++end)
+  {
+    const int vertex = end == 0 ? edge.from : edge.to;
+    if (!movedVertex[vertex])
+    {
+      continue;
+    }
+    double st[2] = { 0.0, 0.0 }, distance = 0.0;
+    geometry.vertexParameters(model, vertex, edge.carrier, st[0], st[1], distance);
+    for (std::size_t k = 0; k < per; ++k)
+    {
+      double& at = edge.at[end * per + k];
+      if (!closed[k])
+      {
+        at = st[k];
+        continue;
+      }
+      double change = st[k] - wrapUnit(at);
+      change -= std::floor(change + 0.5); // the short way round
+      at += change;
+    }
+  }
+}
+
 /// Curves of all named edges; GeometryError becomes a TemplateError naming the edge.
 std::vector<NamedCurve> buildNamedCurves(const BlockModel& model, const CarrierGeometry& geometry)
 {

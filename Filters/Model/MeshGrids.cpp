@@ -19,6 +19,22 @@ using syntax::shortNumber;
 
 // -------------------------------------------------------------------- mesh topology
 
+std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int cap)
+{
+  std::array<int, 3> nodes{};
+  for (int d = 0; d < 3; ++d)
+  {
+    const double scaled = std::round(block.cells[d] * multiplier);
+    int cells = static_cast<int>(std::max(1.0, std::min(scaled, 1.0e6)));
+    if (cap > 0)
+    {
+      cells = std::min(cells, cap);
+    }
+    nodes[d] = cells + 1;
+  }
+  return nodes;
+}
+
 /**
  * The topology of the model for the given node counts (buildConnectivity's checks) with
  * the node parameters of every edge, checked on shared edges: the same laws must put the
@@ -354,10 +370,11 @@ void rotateEdgeNodes(const BlockModel& model, MeshTopology& topology, int source
   }
 }
 
-/// Named periodic edges: rotated copies of their source edges.
-void computePeriodicEdges(const BlockModel& model, MeshTopology& topology)
+std::vector<EdgeCopy> periodicEdgeCopies(const BlockModel& model, const MeshTopology& topology)
 {
+  std::vector<EdgeCopy> copies;
   const auto lookup = edgeLookup(topology);
+  // Named periodic edges: rotated copies of their source edges.
   for (std::size_t e = 0; e < topology.edges.size(); ++e)
   {
     const UniqueEdge& edge = topology.edges[e];
@@ -373,16 +390,11 @@ void computePeriodicEdges(const BlockModel& model, MeshTopology& topology)
       fail(named.where, entity("edge", named.name),
         "its source edge '" + source.name + "' is not an edge of any block");
     }
-    rotateEdgeNodes(model, topology, sourceEdge, source.from, static_cast<int>(e), named.from,
+    copies.push_back(EdgeCopy{ sourceEdge, source.from, static_cast<int>(e), named.from,
       model.machine.axisPoint, model.machine.axis, named.pitches * model.machine.pitch(),
-      named.where, entity("edge", named.name));
+      named.where, entity("edge", named.name) });
   }
-}
-
-/// The edges of every periodic image face: rotations of the source face's edges.
-void computePeriodicPatchEdges(const BlockModel& model, MeshTopology& topology)
-{
-  const auto lookup = edgeLookup(topology);
+  // The edges of every periodic image face: rotations of the source face's edges.
   for (const PeriodicPair& entry : topology.connectivity.periodic)
   {
     const UniqueFace& from = topology.faces[entry.source];
@@ -403,10 +415,17 @@ void computePeriodicPatchEdges(const BlockModel& model, MeshTopology& topology)
         continue;
       }
       const Patch& patch = model.patches[entry.patch];
-      rotateEdgeNodes(model, topology, source, f0, image, g0, entry.axisPoint, entry.axis,
-        entry.angle, patch.where, entity("patch", patch.name));
+      copies.push_back(EdgeCopy{ source, f0, image, g0, entry.axisPoint, entry.axis, entry.angle,
+        patch.where, entity("patch", patch.name) });
     }
   }
+  return copies;
+}
+
+void copyPeriodicEdge(const BlockModel& model, MeshTopology& topology, const EdgeCopy& copy)
+{
+  rotateEdgeNodes(model, topology, copy.source, copy.sourceFrom, copy.image, copy.imageFrom,
+    copy.axisPoint, copy.axis, copy.angle, copy.where, copy.entity);
 }
 
 /// Copies the boundary nodes of a face grid from its block's edges (bit for bit).
@@ -587,10 +606,12 @@ void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geomet
   }
   // Periodic copies: named periodic edges, then the edges and faces of every periodic
   // patch's partner, rotated node for node from the first patch of the pair.
-  computePeriodicEdges(model, topology);
   findPeriodicPairs(model, topology.connectivity);
   const std::vector<PeriodicPair>& images = topology.connectivity.periodic;
-  computePeriodicPatchEdges(model, topology);
+  for (const EdgeCopy& copy : periodicEdgeCopies(model, topology))
+  {
+    copyPeriodicEdge(model, topology, copy);
+  }
   checkCornerCells(model, topology, modelSize(model));
   std::vector<bool> isImage(topology.faces.size(), false);
   for (const PeriodicPair& entry : images)

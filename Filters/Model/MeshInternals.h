@@ -60,6 +60,15 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
 /// Curves of all named edges; GeometryError becomes a TemplateError naming the edge.
 std::vector<NamedCurve> buildNamedCurves(const BlockModel& model, const CarrierGeometry& geometry);
 
+/**
+ * Keeps the explicit end parameters (`at`) of an on_curve or on_surface edge on its end
+ * vertices after they moved: each moved end takes its vertex's parameters on the edge's
+ * carrier; on closed carriers the change is taken the short way round, so an edge that
+ * ran across the seam (ends outside [0, 1]) still does.
+ */
+void followEdgeEnds(
+  BlockModel& model, const CarrierGeometry& geometry, int edge, const std::vector<char>& movedVertex);
+
 /// Node parameters of `law` for `nodeCount` nodes on an edge of `length` (with the
 /// fallbacks of previews and density multipliers when `allowFallback`).
 std::vector<double> lawParameters(
@@ -96,6 +105,10 @@ struct MeshTopology
   std::vector<MeshLinks> blocks;
 };
 
+/// Node counts of a block at a density multiplier (max(1, round(cells * m)) cells per
+/// direction, at most `cap` when cap > 0), plus one.
+std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int cap);
+
 MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedCurve>& curves,
   const std::vector<std::array<int, 3>>& nodes, bool allowFallback);
 /// Node parameters of unique edge `e` from the laws of the blocks that use it (checked to
@@ -131,10 +144,20 @@ void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& cu
   const CarrierGeometry& geometry, UniqueEdge& edge);
 std::map<std::pair<int, int>, int> edgeLookup(const MeshTopology& topology);
 int findUniqueEdge(const std::map<std::pair<int, int>, int>& lookup, int a, int b);
-/// Named periodic edges: rotated copies of their source edges.
-void computePeriodicEdges(const BlockModel& model, MeshTopology& topology);
-/// The edges of every periodic image face: rotations of the source face's edges.
-void computePeriodicPatchEdges(const BlockModel& model, MeshTopology& topology);
+/// A unique edge whose nodes are the rotated nodes of another.
+struct EdgeCopy
+{
+  int source = -1, sourceFrom = -1; ///< unique edge, and the vertex it is read from
+  int image = -1, imageFrom = -1;
+  Vec3 axisPoint, axis;
+  double angle = 0.0;
+  SourceLocation where;
+  std::string entity;
+};
+/// The periodic copies, in the order they must be made: named periodic edges, then the
+/// edges of every periodic image face (topology.connectivity.periodic must be current).
+std::vector<EdgeCopy> periodicEdgeCopies(const BlockModel& model, const MeshTopology& topology);
+void copyPeriodicEdge(const BlockModel& model, MeshTopology& topology, const EdgeCopy& copy);
 void surfaceFace(const BlockModel& model, const MeshTopology& topology, const CarrierGeometry& geometry,
   int carrier, int block, int face, std::vector<double>& out);
 void periodicFace(const BlockModel& model, const MeshTopology& topology, const PeriodicPair& entry,

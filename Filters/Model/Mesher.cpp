@@ -25,18 +25,7 @@ struct MultiBlockMesher::Impl
 
   std::array<int, 3> nodeCounts(int block) const
   {
-    std::array<int, 3> nodes{};
-    for (int d = 0; d < 3; ++d)
-    {
-      const double scaled = std::round(Model.blocks[block].cells[d] * Multiplier);
-      int cells = static_cast<int>(std::max(1.0, std::min(scaled, 1.0e6)));
-      if (Cap > 0)
-      {
-        cells = std::min(cells, Cap);
-      }
-      nodes[d] = cells + 1;
-    }
-    return nodes;
+    return scaledNodeCounts(Model.blocks[block], Multiplier, Cap);
   }
 };
 

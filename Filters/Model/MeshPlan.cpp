@@ -1,0 +1,451 @@
+#include "MeshPlan.h"
+
+#include "MeshInternals.h"
+#include "Mesher.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+namespace blockforge
+{
+namespace model
+{
+struct MeshPlan::Impl
+{
+  BlockModel Model;
+  CarrierGeometry Geometry;
+  double Multiplier = 1.0;
+  bool AllowFallback = false;
+  std::vector<NamedCurve> Curves;
+  MeshTopology Topo;
+  std::vector<EdgeCopy> Copies;
+  std::map<int, int> OnSurface;
+  std::vector<bool> IsImage;
+  std::vector<std::vector<double>> Nodes;
+  std::vector<int> Updated;
+  std::vector<int> Pending; ///< vertices of failed updates, recomputed with the next one
+
+  // What depends on what, built once.
+  std::vector<std::vector<int>> VertexNamedEdges;  ///< vertex -> named edges ending at it
+  std::vector<std::vector<int>> NamedFollowers;    ///< named edge -> periodic/follow edges
+  std::vector<std::vector<int>> VertexUniqueEdges; ///< vertex -> unique edges ending at it
+  std::vector<int> NamedUnique;                    ///< named edge -> unique edge, -1
+  std::vector<std::vector<int>> EdgeFaces;         ///< unique edge -> unique faces
+  std::vector<std::vector<int>> EdgeBlocks;        ///< unique edge -> blocks
+  std::vector<std::vector<int>> FaceBlocks;        ///< unique face -> blocks
+  std::vector<std::vector<int>> VertexBlocks;      ///< vertex -> blocks
+
+  void buildDependencies();
+  void run(const std::vector<int>& moved);
+};
+
+namespace
+{
+template <typename T>
+void addUnique(std::vector<T>& list, const T& value)
+{
+  if (std::find(list.begin(), list.end(), value) == list.end())
+  {
+    list.push_back(value);
+  }
+}
+
+Feasibility infeasible(Feasibility::Problem problem, int block, const std::string& message)
+{
+  Feasibility result;
+  result.problem = problem;
+  result.block = block;
+  result.message = message;
+  return result;
+}
+} // namespace
+
+void MeshPlan::Impl::buildDependencies()
+{
+  const std::size_t vertexCount = Model.vertices.size();
+  VertexNamedEdges.assign(vertexCount, {});
+  VertexUniqueEdges.assign(vertexCount, {});
+  VertexBlocks.assign(vertexCount, {});
+  NamedFollowers.assign(Model.edges.size(), {});
+  NamedUnique.assign(Model.edges.size(), -1);
+  for (std::size_t e = 0; e < Model.edges.size(); ++e)
+  {
+    const Edge& edge = Model.edges[e];
+    VertexNamedEdges[edge.from].push_back(static_cast<int>(e));
+    VertexNamedEdges[edge.to].push_back(static_cast<int>(e));
+    if ((edge.kind == Edge::Kind::Periodic || edge.kind == Edge::Kind::Follow) && edge.source >= 0)
+    {
+      NamedFollowers[edge.source].push_back(static_cast<int>(e));
+    }
+  }
+  EdgeFaces.assign(Topo.edges.size(), {});
+  EdgeBlocks.assign(Topo.edges.size(), {});
+  FaceBlocks.assign(Topo.faces.size(), {});
+  for (std::size_t u = 0; u < Topo.edges.size(); ++u)
+  {
+    const UniqueEdge& edge = Topo.edges[u];
+    VertexUniqueEdges[edge.a].push_back(static_cast<int>(u));
+    VertexUniqueEdges[edge.b].push_back(static_cast<int>(u));
+    if (edge.named >= 0)
+    {
+      NamedUnique[edge.named] = static_cast<int>(u);
+    }
+    for (const EdgeUse& use : edge.uses)
+    {
+      addUnique(EdgeBlocks[u], use.block);
+    }
+  }
+  for (std::size_t b = 0; b < Topo.blocks.size(); ++b)
+  {
+    const MeshLinks& links = Topo.blocks[b];
+    for (int v : Model.blocks[b].vertices)
+    {
+      addUnique(VertexBlocks[v], static_cast<int>(b));
+    }
+    for (int f = 0; f < 6; ++f)
+    {
+      const int face = links.face[f];
+      if (face < 0)
+      {
+        continue;
+      }
+      addUnique(FaceBlocks[face], static_cast<int>(b));
+      for (const int local : faceEdges(f))
+      {
+        if (links.edge[local] >= 0)
+        {
+          addUnique(EdgeFaces[links.edge[local]], face);
+        }
+      }
+    }
+  }
+}
+
+MeshPlan::MeshPlan(const BlockModel& model, const CarrierGeometry& carriers, double densityMultiplier)
+  : P(new Impl)
+{
+  if (!std::isfinite(densityMultiplier) || !(densityMultiplier > 0.0))
+  {
+    throw TemplateError(model.sourceFile, 0, syntax::entity("model", model.name),
+      "the density multiplier must be a positive number, got " +
+        syntax::formatNumber(densityMultiplier));
+  }
+  checkBasics(model);
+  P->Model = model;
+  P->Geometry = carriers;
+  P->Multiplier = densityMultiplier;
+  checkModelWith(P->Model, P->Geometry);
+  P->Curves = buildNamedCurves(P->Model, P->Geometry);
+  std::vector<std::array<int, 3>> nodes;
+  for (const Block& block : P->Model.blocks)
+  {
+    nodes.push_back(scaledNodeCounts(block, densityMultiplier, 0));
+  }
+  P->AllowFallback = nodes != baseNodeCounts(P->Model);
+  P->Topo = buildMeshTopology(P->Model, P->Curves, nodes, P->AllowFallback);
+  computeAllBoundaries(P->Model, P->Geometry, P->Curves, P->Topo);
+  P->Copies = periodicEdgeCopies(P->Model, P->Topo);
+  P->OnSurface = surfaceFaceCarriers(P->Model, P->Topo);
+  P->IsImage.assign(P->Topo.faces.size(), false);
+  for (const PeriodicPair& pair : P->Topo.connectivity.periodic)
+  {
+    P->IsImage[pair.image] = true;
+  }
+  P->buildDependencies();
+  P->Nodes.resize(P->Model.blocks.size());
+  for (int b = 0; b < blockCount(); ++b)
+  {
+    const std::array<int, 3>& n = P->Topo.blocks[b].nodes;
+    P->Nodes[b].resize(3 * static_cast<std::size_t>(n[0]) * n[1] * n[2]);
+    meshBlockNodes(P->Model, P->Topo, b, P->Nodes[b].data());
+    P->Updated.push_back(b);
+  }
+}
+
+MeshPlan::~MeshPlan() = default;
+
+BlockModel& MeshPlan::model()
+{
+  return P->Model;
+}
+
+const BlockModel& MeshPlan::model() const
+{
+  return P->Model;
+}
+
+const CarrierGeometry& MeshPlan::carriers() const
+{
+  return P->Geometry;
+}
+
+const Topology& MeshPlan::topology() const
+{
+  return P->Topo.connectivity;
+}
+
+const std::vector<int>& MeshPlan::updatedBlocks() const
+{
+  return P->Updated;
+}
+
+int MeshPlan::blockCount() const
+{
+  return static_cast<int>(P->Model.blocks.size());
+}
+
+std::array<int, 3> MeshPlan::nodeCounts(int block) const
+{
+  return P->Topo.blocks.at(block).nodes;
+}
+
+const std::vector<double>& MeshPlan::blockNodes(int block) const
+{
+  return P->Nodes.at(block);
+}
+
+/// The update itself; throws TemplateError or GeometryError like the mesher would.
+void MeshPlan::Impl::run(const std::vector<int>& moved)
+{
+  BlockModel& model = Model;
+  const double size = modelSize(model);
+  std::vector<char> movedVertex(model.vertices.size(), 0);
+  for (const int v : moved)
+  {
+    movedVertex.at(v) = 1;
+  }
+  checkCarriers(model, Geometry, size, &moved);
+
+  // Named edge curves: those ending at a moved vertex, and those following a rebuilt one
+  // (a follow or periodic edge always comes after its source).
+  std::vector<char> rebuilt(model.edges.size(), 0);
+  for (const int v : moved)
+  {
+    for (const int e : VertexNamedEdges[v])
+    {
+      rebuilt[e] = 1;
+    }
+  }
+  for (std::size_t e = 0; e < model.edges.size(); ++e)
+  {
+    if (!rebuilt[e])
+    {
+      continue;
+    }
+    for (const int follower : NamedFollowers[e])
+    {
+      rebuilt[follower] = 1;
+    }
+    try
+    {
+      followEdgeEnds(model, Geometry, static_cast<int>(e), movedVertex);
+      Curves[e] = buildNamedCurve(model, Geometry, Curves, model.edges[e], size);
+    }
+    catch (const GeometryError& error)
+    {
+      fail(model.edges[e].where, syntax::entity("edge", model.edges[e].name), error.what());
+    }
+  }
+
+  // Shared edges: node parameters (the length may change them) and nodes.
+  std::vector<char> changedEdge(Topo.edges.size(), 0);
+  for (const int v : moved)
+  {
+    for (const int u : VertexUniqueEdges[v])
+    {
+      changedEdge[u] = 1;
+    }
+  }
+  for (std::size_t e = 0; e < model.edges.size(); ++e)
+  {
+    if (rebuilt[e] && NamedUnique[e] >= 0)
+    {
+      changedEdge[NamedUnique[e]] = 1;
+    }
+  }
+  std::vector<int> blocks;
+  for (std::size_t u = 0; u < Topo.edges.size(); ++u)
+  {
+    if (!changedEdge[u])
+    {
+      continue;
+    }
+    UniqueEdge& edge = Topo.edges[u];
+    edge.length = edge.named >= 0
+      ? Curves[edge.named].length
+      : (model.vertices[edge.b].position - model.vertices[edge.a].position).norm();
+    computeEdgeParameters(model, Topo, static_cast<int>(u), AllowFallback);
+    computeEdgeNodes(model, Curves, Geometry, edge);
+    for (const int b : EdgeBlocks[u])
+    {
+      addUnique(blocks, b);
+    }
+  }
+  for (const int b : blocks)
+  {
+    computeCollapsedParameters(model, Topo, b);
+  }
+
+  // Periodic copies of changed edges (their pairing checked again: vertices moved).
+  findPeriodicPairs(model, Topo.connectivity);
+  for (const EdgeCopy& copy : Copies)
+  {
+    if (changedEdge[copy.source] || changedEdge[copy.image])
+    {
+      copyPeriodicEdge(model, Topo, copy);
+      changedEdge[copy.image] = 1;
+      for (const int b : EdgeBlocks[copy.image])
+      {
+        addUnique(blocks, b);
+      }
+    }
+  }
+
+  // Faces with a changed edge, then the periodic images of changed faces.
+  std::vector<char> changedFace(Topo.faces.size(), 0);
+  for (std::size_t u = 0; u < Topo.edges.size(); ++u)
+  {
+    if (changedEdge[u])
+    {
+      for (const int f : EdgeFaces[u])
+      {
+        changedFace[f] = 1;
+      }
+    }
+  }
+  for (std::size_t f = 0; f < Topo.faces.size(); ++f)
+  {
+    if (changedFace[f] && !IsImage[f])
+    {
+      computeFaceGrid(model, Geometry, OnSurface, Topo, static_cast<int>(f));
+    }
+  }
+  for (const PeriodicPair& pair : Topo.connectivity.periodic)
+  {
+    if (changedFace[pair.source] || changedFace[pair.image])
+    {
+      changedFace[pair.image] = 1;
+      periodicFace(model, Topo, pair, Topo.faces[pair.image].xyz);
+    }
+  }
+  for (std::size_t f = 0; f < Topo.faces.size(); ++f)
+  {
+    if (changedFace[f])
+    {
+      for (const int b : FaceBlocks[f])
+      {
+        addUnique(blocks, b);
+      }
+    }
+  }
+  for (const int v : moved)
+  {
+    for (const int b : VertexBlocks[v])
+    {
+      addUnique(blocks, b);
+    }
+  }
+  std::sort(blocks.begin(), blocks.end());
+  Updated = blocks;
+}
+
+Feasibility MeshPlan::update(const std::vector<int>& moved)
+{
+  std::vector<int> vertices = P->Pending;
+  for (const int v : moved)
+  {
+    if (v < 0 || v >= static_cast<int>(P->Model.vertices.size()))
+    {
+      return infeasible(Feasibility::Problem::ModelError, -1,
+        "MeshPlan::update: no vertex " + std::to_string(v));
+    }
+    addUnique(vertices, v);
+  }
+  P->Pending = vertices;
+  P->Updated.clear();
+  try
+  {
+    P->run(vertices);
+  }
+  catch (const std::exception& error)
+  {
+    return infeasible(Feasibility::Problem::ModelError, -1, error.what());
+  }
+  const double size = modelSize(P->Model);
+  for (const int b : P->Updated)
+  {
+    try
+    {
+      const std::vector<int> one = { b };
+      checkOrientation(P->Model, P->Curves, size, &one);
+      checkCornerCells(P->Model, P->Topo, b, size);
+    }
+    catch (const TemplateError& error)
+    {
+      return infeasible(Feasibility::Problem::FoldedCorner, b, error.what());
+    }
+  }
+  for (const int b : P->Updated)
+  {
+    meshBlockNodes(P->Model, P->Topo, b, P->Nodes[b].data());
+  }
+  P->Pending.clear();
+  for (const int b : P->Updated)
+  {
+    const Feasibility cells = checkCells(P->Nodes[b].data(), P->Topo.blocks[b].nodes, b, size);
+    if (!cells.feasible())
+    {
+      return cells;
+    }
+  }
+  return Feasibility();
+}
+
+Feasibility checkCells(const double* xyz, const std::array<int, 3>& nodes, int block, double size)
+{
+  const int ni = nodes[0], nj = nodes[1], nk = nodes[2];
+  auto at = [&](int i, int j, int k) {
+    const double* p = xyz + 3 * (i + static_cast<std::size_t>(ni) * (j + static_cast<std::size_t>(nj) * k));
+    return Vec3(p[0], p[1], p[2]);
+  };
+  const double tiny = 1e-12 * size;
+  for (int k = 0; k + 1 < nk; ++k)
+  {
+    for (int j = 0; j + 1 < nj; ++j)
+    {
+      for (int i = 0; i + 1 < ni; ++i)
+      {
+        for (int corner = 0; corner < 8; ++corner)
+        {
+          const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
+          const Vec3 p = at(i + di, j + dj, k + dk);
+          // Edges towards the neighbours along +i, +j, +k as seen from the cell's
+          // (0, 0, 0) corner: flip the ones that point backwards from this corner.
+          const Vec3 ds = (at(i + 1 - di, j + dj, k + dk) - p) * (di ? -1.0 : 1.0);
+          const Vec3 dt = (at(i + di, j + 1 - dj, k + dk) - p) * (dj ? -1.0 : 1.0);
+          const Vec3 du = (at(i + di, j + dj, k + 1 - dk) - p) * (dk ? -1.0 : 1.0);
+          const double ls = ds.norm(), lt = dt.norm(), lu = du.norm();
+          if (ls <= tiny || lt <= tiny || lu <= tiny)
+          {
+            continue; // a collapsed edge (wedge): degenerate corners are allowed
+          }
+          if (ds.dot(dt.cross(du)) < -1e-10 * ls * lt * lu)
+          {
+            Feasibility result;
+            result.problem = Feasibility::Problem::InvertedCell;
+            result.block = block;
+            result.message = "cell (" + std::to_string(i) + ", " + std::to_string(j) + ", " +
+              std::to_string(k) + ") of block " + std::to_string(block) +
+              " is inverted at a corner";
+            return result;
+          }
+        }
+      }
+    }
+  }
+  return Feasibility();
+}
+} // namespace model
+} // namespace blockforge
