@@ -403,6 +403,11 @@ Feasibility MeshPlan::update(const std::vector<int>& moved)
   return Feasibility();
 }
 
+void MeshPlan::rebuildCarrier(int index)
+{
+  P->Geometry.rebuild(P->Model, index);
+}
+
 Feasibility checkCells(const double* xyz, const std::array<int, 3>& nodes, int block, double size)
 {
   const int ni = nodes[0], nj = nodes[1], nk = nodes[2];

@@ -13,6 +13,7 @@ from vtkmodules import vtkCommonCore, vtkCommonDataModel, vtkCommonExecutionMode
 
 from .BlockForgeFilters import (  # noqa: F401
     vtkBlockMesher,
+    vtkBlockOptimizer,
     vtkBlockTemplate,
     vtkBlockTemplateAlgorithm,
     vtkBlockTemplateSource,
@@ -22,6 +23,7 @@ from .BlockForgeFilters import (  # noqa: F401
 
 __all__ = [
     "vtkBlockMesher",
+    "vtkBlockOptimizer",
     "vtkBlockTemplate",
     "vtkBlockTemplateAlgorithm",
     "vtkBlockTemplateSource",
