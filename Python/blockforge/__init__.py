@@ -50,11 +50,11 @@ def _message(text):
 
 
 def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_file=None,
-                  timings=None, allow_inverted_cells=False, warnings=None):
+                  timings=None, allow_inverted_cells=False, warnings=None, optimize=True):
     """:func:`mesh_template`; with a dict *timings*, also records the seconds of each
-    stage under "read" (only with an input file), "template" and "mesh + quality"; with a
-    list *warnings*, collects the stages' warnings (reader repairs, inverted cells let
-    through) without VTK's header."""
+    stage under "read" (only with an input file), "template", "optimize" (unless
+    *optimize* is false) and "mesh + quality"; with a list *warnings*, collects the stages'
+    warnings (reader repairs, inverted cells let through) without VTK's header."""
     import time
 
     from vtkmodules.util.misc import calldata_type
@@ -74,10 +74,17 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     for name, value in (parameters or {}).items():
         template.SetParameter(str(name), str(value))
     stages.append(("template", template))
+    model = template
+    if optimize:
+        optimizer = vtkBlockOptimizer()
+        optimizer.SetDensityMultiplier(float(density_multiplier))
+        optimizer.SetInputConnection(template.GetOutputPort())
+        stages.append(("optimize", optimizer))
+        model = optimizer
     mesher = vtkBlockMesher()
     mesher.SetDensityMultiplier(float(density_multiplier))
     mesher.SetAllowInvertedCells(bool(allow_inverted_cells))
-    mesher.SetInputConnection(template.GetOutputPort())
+    mesher.SetInputConnection(model.GetOutputPort(0))
     quality = vtkGridQuality()
     quality.SetInputConnection(mesher.GetOutputPort())
     stages.append(("mesh + quality", quality))
@@ -114,13 +121,14 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
 
 
 def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None,
-                  allow_inverted_cells=False):
-    """Applies a template, meshes it and measures the grid.
+                  allow_inverted_cells=False, optimize=True):
+    """Applies a template, optimizes its control points, meshes it and measures the grid.
 
-    Without *input_file* the pipeline is vtkBlockTemplateSource -> vtkBlockMesher ->
-    vtkGridQuality (templates without inputs); with it, vtkTurboPointSetsReader(input_file)
-    -> vtkBlockTemplate -> vtkBlockMesher -> vtkGridQuality (templates whose ``inputs:``
-    name point sets, e.g. Templates/axial_passage_oh.yaml).
+    Without *input_file* the pipeline is vtkBlockTemplateSource -> vtkBlockOptimizer ->
+    vtkBlockMesher -> vtkGridQuality (templates without inputs); with it,
+    vtkTurboPointSetsReader(input_file) -> vtkBlockTemplate -> vtkBlockOptimizer ->
+    vtkBlockMesher -> vtkGridQuality (templates whose ``inputs:`` name point sets, e.g.
+    Templates/axial_passage_oh.yaml).
 
     :param template_file: path of a BlockForge template (.yaml)
     :param parameters: dict of parameter overrides, name -> number or expression
@@ -131,6 +139,9 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
     :param allow_inverted_cells: False (default): a grid with an inverted cell is an error
         naming the block and the cell range; True: the grid is returned anyway for
         inspection (field data ``InvertedCellCount``, a VTK warning per folded block)
+    :param optimize: True (default): the vtkBlockOptimizer moves the control points along
+        their carriers to maximise the smallest element angle (paper step 3); False: the
+        template's vertices are meshed as placed
     :returns: the vtkGridQuality algorithm after its update (port 0: the grid with the
         quality arrays; port 1: MinAngle class table; port 2: statistics table)
     :raises RuntimeError: when a stage (reader, template, mesher or quality) reports an
@@ -139,4 +150,4 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
         "<template>:<line>: ..." message). No later stage runs after a failing one.
     """
     return _run_pipeline(template_file, parameters, density_multiplier, input_file,
-                         allow_inverted_cells=allow_inverted_cells)
+                         allow_inverted_cells=allow_inverted_cells, optimize=optimize)

@@ -1,8 +1,9 @@
 """Command line: ``python3 -m blockforge TEMPLATE [-i POINTS] [-o grid.vtm] [-p NAME=EXPR ...]
-[-d DENSITY] [--allow-inverted-cells]``.
+[-d DENSITY] [--allow-inverted-cells] [--no-optimize]``.
 
 Applies a template (to the point data of -i, read by the TurboPointSetsReader, for a
-template with inputs), meshes it, prints a quality summary (cell count, the paper's
+template with inputs), optimizes its control points (the BlockOptimizer; --no-optimize
+skips it), meshes it, prints a quality summary (cell count, the paper's
 MinAngle classes, min/mean/max of every measure) and writes the grid with its quality
 arrays. The grid file (x.vtm and its directory of pieces x/) is written next to the
 target first and then moved into place, replacing older ones: a failing run leaves no
@@ -123,6 +124,9 @@ def main(argv=None):
     parser.add_argument("--allow-inverted-cells", action="store_true",
                         help="output a grid with inverted cells anyway, for inspection "
                              "(default: an error naming the block and the cell range)")
+    parser.add_argument("--no-optimize", action="store_true",
+                        help="mesh the template's vertices as placed (default: the "
+                             "BlockOptimizer moves the control points first)")
     args = parser.parse_args(argv)
     if args.output and not args.output.endswith(".vtm"):
         parser.error(f"the output must be a .vtm file (a multiblock grid), got '{args.output}'")
@@ -132,7 +136,7 @@ def main(argv=None):
     try:
         quality = blockforge._run_pipeline(args.template, dict(args.parameter), args.density,
                                            args.input, timings, args.allow_inverted_cells,
-                                           warnings)
+                                           warnings, optimize=not args.no_optimize)
     except RuntimeError as error:
         print(f"error: {error}", file=sys.stderr)
         return 1

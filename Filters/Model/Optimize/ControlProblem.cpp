@@ -591,6 +591,24 @@ BlockModel ControlProblem::modelAt(const std::vector<double>& x)
   return P->Plan->model();
 }
 
+std::vector<Vec3> ControlProblem::verticesAt(const std::vector<double>& x) const
+{
+  BlockModel work = P->Base;
+  std::vector<int> moved;
+  for (std::size_t i = 0; i < Variables.size(); ++i)
+  {
+    setParameter(work, P->Geometry, Variables[i].vertex, Variables[i].component, x[i]);
+    moved.push_back(Variables[i].vertex);
+  }
+  model::applyPlacement(work, P->Geometry, moved);
+  std::vector<Vec3> positions;
+  for (const model::Vertex& vertex : work.vertices)
+  {
+    positions.push_back(vertex.position);
+  }
+  return positions;
+}
+
 std::vector<std::vector<double>> ControlProblem::gridAt(const std::vector<double>& x)
 {
   const model::Feasibility feasibility = P->place(x);

@@ -90,6 +90,9 @@ public:
   GridMeasures evaluate(const std::vector<double>& x);
   /// The model at configuration x (vertices, carrier edges and surface curves moved).
   model::BlockModel modelAt(const std::vector<double>& x);
+  /// The vertices placed at configuration x (placement rules only: no edge, curve or
+  /// grid follows), e.g. for scores of the blocks as single cells.
+  std::vector<Vec3> verticesAt(const std::vector<double>& x) const;
   /// The grid (nodes of every block, i fastest) at configuration x; throws
   /// std::runtime_error when it is infeasible.
   std::vector<std::vector<double>> gridAt(const std::vector<double>& x);
