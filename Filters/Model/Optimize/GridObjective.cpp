@@ -15,8 +15,9 @@ namespace
 constexpr double radiansToDegrees = 57.295779513082320876798;
 /// Edges shorter than this fraction of the block's extent take Core's collapsed-edge rules.
 constexpr double collapsedFraction = 1.0e-12;
-/// Beyond this many 1/sharpness above the minimum an exponential term is below 1e-17.
-constexpr double softRange = 40.0;
+/// Beyond this many 1/sharpness above the minimum an exponential term is below 2e-9 of
+/// the worst corner's: left out (most right angles drop out of the sum).
+constexpr double softRange = 20.0;
 /// Neighbour size ratios are capped here (a collapsed neighbour is not a ratio).
 constexpr double ratioCap = 100.0;
 

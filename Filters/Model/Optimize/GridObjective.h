@@ -61,8 +61,8 @@ public:
   const std::vector<double>& cellMinimum() const { return CellMin; }
   /**
    * Sum of exp(-sharpness (angle - lowest)) over the 24 face corner angles of every cell
-   * (the terms of the smooth minimum); corners more than 40 / sharpness degrees above
-   * `lowest` are left out (below double precision against the worst corner's term).
+   * (the terms of the smooth minimum); corners more than 20 / sharpness degrees above
+   * `lowest` are left out (below 2e-9 of the worst corner's term).
    * Cells with a collapsed edge contribute their smallest angle once.
    */
   double cornerSum(double lowest, double sharpness) const;
@@ -85,8 +85,8 @@ void cellMinAngles(const BlockGrid& grid, double* out);
 /**
  * Smooth minimum (Kreisselmeier-Steinhauser) of `values`:
  * m - ln(sum exp(-k (v - m))) / k with m the true minimum; never above m and at most
- * ln(count) / k below it. Values more than 40 / k above m are skipped (their terms are
- * below double precision).
+ * ln(count) / k below it. Values more than 20 / k above m are skipped (their terms are
+ * below 2e-9 of the minimum's).
  */
 double softMinimum(const std::vector<double>& values, double sharpness);
 
