@@ -290,10 +290,19 @@ void basisFunctions(int span, double t, int degree, const std::vector<double>& k
   }
 }
 
-void basisDerivatives(int span, double t, int degree, int order,
+namespace
+{
+/**
+ * Piegl & Tiller's algorithm A2.3. With FixedDegree > 0 the degree is a compile-time
+ * constant, so the compiler unrolls the loops (cubic carriers are most of the evaluations
+ * of a template); the operations and their order are the same, so are the results, bit
+ * for bit.
+ */
+template <int FixedDegree>
+void basisDerivativesOf(int span, double t, int degree, int order,
   const std::vector<double>& knots, double* ders)
 {
-  const int p = degree;
+  const int p = FixedDegree > 0 ? FixedDegree : degree;
   const int width = p + 1;
   // ndu holds the basis functions (upper triangle) and knot differences (lower triangle).
   double ndu[MaxBasis][MaxBasis];
@@ -365,6 +374,20 @@ void basisDerivatives(int span, double t, int degree, int order,
   }
   // Same exact end values as basisFunctions(), so point and derivatives agree bit for bit.
   exactEndBasis(span, t, degree, knots, ders);
+}
+} // namespace
+
+void basisDerivatives(int span, double t, int degree, int order,
+  const std::vector<double>& knots, double* ders)
+{
+  if (degree == 3)
+  {
+    basisDerivativesOf<3>(span, t, degree, order, knots, ders);
+  }
+  else
+  {
+    basisDerivativesOf<0>(span, t, degree, order, knots, ders);
+  }
 }
 
 std::vector<double> interpolationParameters(const std::vector<Vec3>& points,

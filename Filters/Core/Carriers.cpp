@@ -50,20 +50,21 @@ Vec3 extendedCurvePoint(const Curve& curve, double u)
   return curve.point(inside) + (u - inside) * curve.derivative(inside, 1);
 }
 
-/// Point, first and second derivative of the continued curve; B-splines from one basis
-/// evaluation.
-void extendedCurveJet(const Curve& curve, const BSplineCurve* spline, double u, Vec3 jet[3])
+/// Point, first and (order 2) second derivative of the continued curve; B-splines from
+/// one basis evaluation. The point and first derivative do not depend on `order`.
+void extendedCurveJet(
+  const Curve& curve, const BSplineCurve* spline, double u, Vec3 jet[3], int order = 2)
 {
   const double inside = clampUnit(u);
   if (spline)
   {
-    spline->derivatives(inside, 2, jet);
+    spline->derivatives(inside, order, jet);
   }
   else
   {
     jet[0] = curve.point(inside);
     jet[1] = curve.derivative(inside, 1);
-    jet[2] = curve.derivative(inside, 2);
+    jet[2] = order >= 2 ? curve.derivative(inside, 2) : Vec3::Zero();
   }
   if (inside != u)
   {
@@ -416,6 +417,29 @@ void SurfaceOfRevolution::derivatives(double s, double t, SurfaceDerivatives& ou
   out.Pst = sweep * k.cross(out.Ps);
 }
 
+// The same as derivatives() without the second-order terms.
+void SurfaceOfRevolution::firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const
+{
+  Vec3 c[3];
+  if (const auto* spline = dynamic_cast<const BSplineCurve*>(Contour.get()))
+  {
+    spline->derivatives(s, 1, c);
+  }
+  else
+  {
+    c[0] = Contour->point(s);
+    c[1] = Contour->derivative(s, 1);
+  }
+  const double sweep = AngleEnd - AngleStart;
+  const double angle = AngleStart + t * sweep;
+  const double cs = std::cos(angle), sn = std::sin(angle);
+  const Vec3& k = AxisDirection;
+  const Vec3 arm = angle == 0.0 ? Vec3(c[0] - AxisPoint) : rotateVector(c[0] - AxisPoint, k, cs, sn);
+  P = angle == 0.0 ? c[0] : Vec3(AxisPoint + arm);
+  Ps = rotateVector(c[1], k, cs, sn);
+  Pt = sweep * k.cross(arm);
+}
+
 void SurfaceOfRevolution::axialRadial(const Vec3& p, double& axial, double& radius) const
 {
   const Vec3 v = p - AxisPoint;
@@ -726,6 +750,41 @@ void GordonSurface::derivatives(double s, double t, SurfaceDerivatives& out) con
   }
 }
 
+// The same sums as derivatives() without the second-order ones.
+void GordonSurface::firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const
+{
+  const int n = static_cast<int>(TNodes.size());
+  const int m = static_cast<int>(SNodes.size());
+  const BlendAt b(TheBlending, TNodes, TBlendCoefficients, t);
+  const BlendAt a(TheBlending, SNodes, SBlendCoefficients, s);
+  P = Ps = Pt = Vec3::Zero();
+  Vec3 c[3];
+  double bj[3], ai[3];
+  for (int j = 0; j < n; ++j)
+  {
+    b.jet(j, bj);
+    extendedCurveJet(*SCurves[j], SSplines[j], s, c, 1);
+    for (int i = 0; i < m; ++i)
+    {
+      a.jet(i, ai);
+      const Vec3& q = NodePoints[i + j * m];
+      c[0] -= ai[0] * q;
+      c[1] -= ai[1] * q;
+    }
+    P += bj[0] * c[0];
+    Ps += bj[0] * c[1];
+    Pt += bj[1] * c[0];
+  }
+  for (int i = 0; i < m; ++i)
+  {
+    a.jet(i, ai);
+    extendedCurveJet(*TCurves[i], TSplines[i], t, c, 1);
+    P += ai[0] * c[0];
+    Ps += ai[1] * c[0];
+    Pt += ai[0] * c[1];
+  }
+}
+
 // =======================================================================================
 SurfaceCurve::SurfaceCurve(SurfacePtr surface, std::vector<Eigen::Vector2d> parameterPoints)
   : TheSurface(std::move(surface))
@@ -781,14 +840,17 @@ Vec3 SurfaceCurve::derivative(double u, int order) const
     return Vec3::Zero();
   }
   Vec3 q[3];
+  if (order == 1)
+  {
+    ParameterCurve->derivatives(u, 1, q);
+    Vec3 P, Ps, Pt;
+    TheSurface->firstDerivatives(q[0].x(), q[0].y(), P, Ps, Pt);
+    return q[1].x() * Ps + q[1].y() * Pt;
+  }
   ParameterCurve->derivatives(u, 2, q);
   SurfaceDerivatives d;
   TheSurface->derivatives(q[0].x(), q[0].y(), d);
   const double s1 = q[1].x(), t1 = q[1].y();
-  if (order == 1)
-  {
-    return s1 * d.Ps + t1 * d.Pt;
-  }
   // Chain rule: d2/du2 S(s(u), t(u)).
   return s1 * s1 * d.Pss + 2.0 * s1 * t1 * d.Pst + t1 * t1 * d.Ptt + q[2].x() * d.Ps +
     q[2].y() * d.Pt;

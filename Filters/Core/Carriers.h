@@ -41,6 +41,7 @@ public:
     double angleStart, double angleEnd);
   Vec3 point(double s, double t) const override;
   void derivatives(double s, double t, SurfaceDerivatives& out) const override;
+  void firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const override;
 
   const Vec3& axisPoint() const { return AxisPoint; }
   const Vec3& axisDirection() const { return AxisDirection; } ///< unit vector
@@ -134,6 +135,7 @@ public:
 
   Vec3 point(double s, double t) const override;
   void derivatives(double s, double t, SurfaceDerivatives& out) const override;
+  void firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const override;
   /// Same as point() (which extrapolates too); kept as the explicit name for callers.
   Vec3 extendedPoint(double s, double t) const { return point(s, t); }
 

@@ -21,6 +21,16 @@ public:
   virtual ~Surface() = default;
   virtual Vec3 point(double s, double t) const = 0;
   virtual void derivatives(double s, double t, SurfaceDerivatives& out) const = 0;
+  /// Point and first derivatives only, the same bits as derivatives() gives for them;
+  /// surfaces where the second derivatives cost much (Gordon) skip computing them.
+  virtual void firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const
+  {
+    SurfaceDerivatives d;
+    derivatives(s, t, d);
+    P = d.P;
+    Ps = d.Ps;
+    Pt = d.Pt;
+  }
 };
 
 using SurfacePtr = std::shared_ptr<const Surface>;

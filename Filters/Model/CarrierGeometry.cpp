@@ -98,13 +98,15 @@ Vec3 ParameterLineCurve::point(double u) const
 Vec3 ParameterLineCurve::derivative(double u, int order) const
 {
   const Eigen::Vector2d st = parameters(u);
-  SurfaceDerivatives d;
-  TheSurface->derivatives(st[0], st[1], d);
   const Eigen::Vector2d delta = To - From;
   if (order == 1)
   {
-    return d.Ps * delta[0] + d.Pt * delta[1];
+    Vec3 P, Ps, Pt;
+    TheSurface->firstDerivatives(st[0], st[1], P, Ps, Pt);
+    return Ps * delta[0] + Pt * delta[1];
   }
+  SurfaceDerivatives d;
+  TheSurface->derivatives(st[0], st[1], d);
   return d.Pss * delta[0] * delta[0] + 2.0 * d.Pst * delta[0] * delta[1] +
     d.Ptt * delta[1] * delta[1];
 }
@@ -118,14 +120,53 @@ const double GaussW[5] = { 0.2369268850561891, 0.4786286704993665, 0.56888888888
   0.4786286704993665, 0.2369268850561891 };
 }
 
-ArcLengthTable::ArcLengthTable(CurvePtr curve, int pieces)
+ArcLengthTable::ArcLengthTable(CurvePtr curve, int pieces, bool keepDerivatives)
   : TheCurve(std::move(curve))
 {
   Cumulative.assign(pieces + 1, 0.0);
+  if (keepDerivatives)
+  {
+    Derivatives.resize(5 * static_cast<std::size_t>(pieces));
+  }
   for (int k = 0; k < pieces; ++k)
   {
-    Cumulative[k + 1] =
-      Cumulative[k] + piece(static_cast<double>(k) / pieces, static_cast<double>(k + 1) / pieces);
+    const double a = static_cast<double>(k) / pieces, b = static_cast<double>(k + 1) / pieces;
+    if (!keepDerivatives)
+    {
+      Cumulative[k + 1] = Cumulative[k] + piece(a, b);
+      continue;
+    }
+    // piece(a, b), remembering the derivatives
+    const double half = 0.5 * (b - a), centre = 0.5 * (a + b);
+    double sum = 0.0;
+    for (int g = 0; g < 5; ++g)
+    {
+      Vec3& derivative = Derivatives[5 * static_cast<std::size_t>(k) + g];
+      derivative = TheCurve->derivative(centre + half * GaussX[g], 1);
+      sum += GaussW[g] * derivative.norm();
+    }
+    Cumulative[k + 1] = Cumulative[k] + sum * half;
+  }
+}
+
+ArcLengthTable::ArcLengthTable(
+  CurvePtr curve, const ArcLengthTable& base, const Vec3& startShift, const Vec3& endShift)
+  : TheCurve(std::move(curve))
+{
+  const int pieces = static_cast<int>(base.Cumulative.size()) - 1;
+  Cumulative.assign(pieces + 1, 0.0);
+  for (int k = 0; k < pieces; ++k)
+  {
+    const double a = static_cast<double>(k) / pieces, b = static_cast<double>(k + 1) / pieces;
+    const double half = 0.5 * (b - a);
+    double sum = 0.0;
+    for (int g = 0; g < 5; ++g)
+    {
+      // As FollowCurve::derivative: (base + endShift) - startShift.
+      const Vec3& derivative = base.Derivatives[5 * static_cast<std::size_t>(k) + g];
+      sum += GaussW[g] * Vec3(derivative + endShift - startShift).norm();
+    }
+    Cumulative[k + 1] = Cumulative[k] + sum * half;
   }
 }
 

@@ -72,7 +72,16 @@ private:
 class ArcLengthTable
 {
 public:
-  explicit ArcLengthTable(CurvePtr curve, int pieces = 512);
+  /// `keepDerivatives`: remember the sampled derivatives, for tables that follow this one.
+  explicit ArcLengthTable(CurvePtr curve, int pieces = 512, bool keepDerivatives = false);
+  /**
+   * The table of `curve`, whose derivative is base's plus endShift minus startShift at
+   * every parameter (a follow edge running the same way as its source): from base's kept
+   * derivatives, the same bits as sampling `curve` itself, at no cost.
+   */
+  ArcLengthTable(CurvePtr curve, const ArcLengthTable& base, const Vec3& startShift,
+    const Vec3& endShift);
+  bool keepsDerivatives() const { return !Derivatives.empty(); }
   double totalLength() const { return Cumulative.back(); }
   /// Parameter t at which the length from 0 is `fraction` of the total; 0 and 1 exactly
   /// at the ends.
@@ -82,6 +91,7 @@ private:
   double piece(double a, double b) const;
   CurvePtr TheCurve;
   std::vector<double> Cumulative;
+  std::vector<Vec3> Derivatives; ///< 5 per piece when kept
 };
 
 /**

@@ -53,6 +53,20 @@ private:
 };
 
 /// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.
+/// Whether a follow edge takes its shape from `edge` (its arc-length table then keeps the
+/// sampled derivatives, which the follower's table reuses).
+bool isFollowed(const BlockModel& model, const Edge& edge)
+{
+  const int self = static_cast<int>(&edge - model.edges.data());
+  for (const Edge& other : model.edges)
+  {
+    if (other.kind == Edge::Kind::Follow && other.source == self)
+    {
+      return true;
+    }
+  }
+  return false;
+}
 } // namespace
 
 double carrierTolerance(const CarrierGeometry& geometry, int carrier, double size)
@@ -128,7 +142,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       }
       named.curve = std::make_shared<SubCurve>(
         geometry.curve(edge.carrier), u0, u1, geometry.closedS(edge.carrier));
-      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve);
+      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve, 512, isFollowed(model, edge));
       named.length = named.lengthTable->totalLength();
       break;
     }
@@ -144,7 +158,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       named.curve = std::make_shared<ParameterLineCurve>(geometry.surface(edge.carrier), a, b,
         geometry.closedS(edge.carrier), geometry.closedT(edge.carrier),
         geometry.extendsT(edge.carrier));
-      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve);
+      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve, 512, isFollowed(model, edge));
       named.length = named.lengthTable->totalLength();
       break;
     }
@@ -215,7 +229,11 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       named.curve = reversed
         ? std::make_shared<FollowCurve>(base.curve, start - sourceEnd, end - sourceStart, true)
         : std::make_shared<FollowCurve>(base.curve, start - sourceStart, end - sourceEnd, false);
-      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve);
+      const bool shared = !reversed && base.lengthTable && base.lengthTable->keepsDerivatives();
+      named.lengthTable = shared
+        ? std::make_shared<ArcLengthTable>(
+            named.curve, *base.lengthTable, Vec3(start - sourceStart), Vec3(end - sourceEnd))
+        : std::make_shared<ArcLengthTable>(named.curve);
       named.length = named.lengthTable->totalLength();
       break;
     }

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace blockforge
 {
@@ -434,8 +435,39 @@ void copyFaceBoundary(const BlockModel& model, const MeshTopology& topology, int
 
 /// Grid of a face that lies on a surface: TFI in the surface's (s, t) space, boundary
 /// nodes kept from the edges, interior nodes evaluated on the surface.
+void ProjectionCache::project(
+  const CarrierGeometry& geometry, int carrier, const Vec3& p, double& s, double& t)
+{
+  Key key{ carrier, {} };
+  std::memcpy(key.bits.data(), p.data(), sizeof(key.bits));
+  const auto found = Known.find(key);
+  if (found != Known.end())
+  {
+    s = found->second.first;
+    t = found->second.second;
+    return;
+  }
+  if (Known.size() > 1000000)
+  {
+    Known.clear(); // bounded: a long optimisation must not grow it without end
+  }
+  double distance = 0.0;
+  geometry.project(carrier, p, s, t, distance);
+  Known.emplace(key, std::make_pair(s, t));
+}
+
+std::size_t ProjectionCache::KeyHash::operator()(const Key& key) const
+{
+  std::uint64_t h = static_cast<std::uint64_t>(key.carrier) * 0x9E3779B97F4A7C15ull;
+  for (const std::uint64_t b : key.bits)
+  {
+    h ^= b + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
+  }
+  return static_cast<std::size_t>(h);
+}
+
 void surfaceFace(const BlockModel& model, const MeshTopology& topology, const CarrierGeometry& geometry,
-  int carrier, int block, int face, std::vector<double>& out)
+  int carrier, int block, int face, std::vector<double>& out, ProjectionCache* cache)
 {
   const std::array<int, 4> edges = faceEdges(face);
   const LocalEdge bottom = localEdge(model, topology, block, edges[0]);
@@ -462,7 +494,14 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
   for (int k = 0; k < loopSize; ++k)
   {
     double s = 0.0, t = 0.0, distance = 0.0;
-    geometry.project(carrier, loop[k], s, t, distance);
+    if (cache)
+    {
+      cache->project(geometry, carrier, loop[k], s, t);
+    }
+    else
+    {
+      geometry.project(carrier, loop[k], s, t, distance);
+    }
     st[k] = Eigen::Vector2d(s, t);
   }
   // Unwrap across the seam of closed directions.
@@ -574,7 +613,7 @@ std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopolo
 
 
 void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
-  const std::map<int, int>& onSurface, MeshTopology& topology, int f)
+  const std::map<int, int>& onSurface, MeshTopology& topology, int f, ProjectionCache* cache)
 {
   UniqueFace& face = topology.faces[f];
   const FaceUse& owner = face.uses.front();
@@ -583,7 +622,7 @@ void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
     const auto surface = onSurface.find(f);
     if (surface != onSurface.end())
     {
-      surfaceFace(model, topology, geometry, surface->second, owner.block, owner.face, face.xyz);
+      surfaceFace(model, topology, geometry, surface->second, owner.block, owner.face, face.xyz, cache);
     }
     else
     {

@@ -16,6 +16,8 @@
 #include "../Core/Transfinite.h"
 
 #include <array>
+#include <cstdint>
+#include <unordered_map>
 #include <map>
 #include <memory>
 #include <string>
@@ -158,15 +160,41 @@ struct EdgeCopy
 /// edges of every periodic image face (topology.connectivity.periodic must be current).
 std::vector<EdgeCopy> periodicEdgeCopies(const BlockModel& model, const MeshTopology& topology);
 void copyPeriodicEdge(const BlockModel& model, MeshTopology& topology, const EdgeCopy& copy);
+/**
+ * Projections of points onto carriers already made, by carrier and exact coordinates:
+ * CarrierGeometry::project is a function of these alone, so a remembered result is the
+ * same bits as a new projection. The mesh plan keeps one, so that a surface face whose
+ * boundary changed in one edge projects only that edge's nodes again.
+ */
+class ProjectionCache
+{
+public:
+  void project(const CarrierGeometry& geometry, int carrier, const Vec3& p, double& s, double& t);
+
+private:
+  struct Key
+  {
+    int carrier;
+    std::array<std::uint64_t, 3> bits;
+    bool operator==(const Key& o) const { return carrier == o.carrier && bits == o.bits; }
+  };
+  struct KeyHash
+  {
+    std::size_t operator()(const Key& key) const;
+  };
+  std::unordered_map<Key, std::pair<double, double>, KeyHash> Known;
+};
+
 void surfaceFace(const BlockModel& model, const MeshTopology& topology, const CarrierGeometry& geometry,
-  int carrier, int block, int face, std::vector<double>& out);
+  int carrier, int block, int face, std::vector<double>& out, ProjectionCache* cache = nullptr);
 void periodicFace(const BlockModel& model, const MeshTopology& topology, const PeriodicPair& entry,
   std::vector<double>& out);
 /// Unique face -> surface carrier of the model's surface face sets.
 std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopology& topology);
 /// The grid of unique face f (not a periodic image), on its surface carrier if it has one.
 void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
-  const std::map<int, int>& onSurface, MeshTopology& topology, int f);
+  const std::map<int, int>& onSurface, MeshTopology& topology, int f,
+  ProjectionCache* cache = nullptr);
 /// Every edge and face grid of the model (computeBoundaries), after buildMeshTopology.
 void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geometry,
   const std::vector<NamedCurve>& curves, MeshTopology& topology);

@@ -26,6 +26,7 @@ struct MeshPlan::Impl
   std::vector<std::vector<double>> Nodes;
   std::vector<int> Updated;
   std::vector<int> Pending; ///< vertices of failed updates, recomputed with the next one
+  ProjectionCache Projections;
 
   // What depends on what, built once.
   std::vector<std::vector<int>> VertexNamedEdges;  ///< vertex -> named edges ending at it
@@ -319,7 +320,7 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
   {
     if (changedFace[f] && !IsImage[f])
     {
-      computeFaceGrid(model, Geometry, OnSurface, Topo, static_cast<int>(f));
+      computeFaceGrid(model, Geometry, OnSurface, Topo, static_cast<int>(f), &Projections);
     }
   }
   for (const PeriodicPair& pair : Topo.connectivity.periodic)

@@ -1,0 +1,239 @@
+/**
+ * @file bench_model.cpp
+ * @brief Google Benchmark program for the block model kept alive (issue 7): what one
+ * evaluation costs after a control point moves, against building everything again.
+ *
+ * On Templates/axial_passage_oh.yaml with Data/rotor37/turbogrid (Rotor 37, 36 blades) at
+ * the template's default density (9,600 cells):
+ * - ApplyTemplate:      loadTemplate() with the point sets read once (what BlockTemplate
+ *                       does per update), the carriers handed over;
+ * - FullEvaluation:     MultiBlockMesher (full model check) + computeBoundaries() +
+ *                       meshBlock() of every block + computeGridQuality() of the grid:
+ *                       what an evaluation cost before the mesh plan;
+ * - MoveOneControlPoint: one evaluation with a MeshPlan built once: the O-grid corner
+ *                       oa_f_h moved along its carrier (moveParameter: placement of it and
+ *                       of what follows it), update() (dependent edges, faces, checks, TFI
+ *                       of the affected blocks) and MinAngle of the affected cells.
+ * Run with repetitions and read the medians:
+ *   bench_model --benchmark_repetitions=7 --benchmark_report_aggregates_only=true
+ */
+#include <benchmark/benchmark.h>
+
+#include "Mesher.h"
+#include "Quality.h"
+#include "Template.h"
+#include "TurboPointSets.h"
+#if __has_include("MeshPlan.h")
+#include "MeshPlan.h"
+#include "Placement.h"
+#define BLOCKFORGE_HAS_MESH_PLAN 1
+#endif
+
+#include <array>
+#include <cmath>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#ifndef BLOCKFORGE_SOURCE_DIR
+#define BLOCKFORGE_SOURCE_DIR "."
+#endif
+
+namespace
+{
+using namespace blockforge;
+
+const std::string Source = BLOCKFORGE_SOURCE_DIR;
+
+/// The reader's point sets as vtkBlockTemplate hands them to the template (metres).
+const model::TemplateInputs& rotor37Inputs()
+{
+  static const model::TemplateInputs inputs = [] {
+    const io::TurboPointSets sets =
+      io::readTurboPointSets(Source + "/Data/rotor37/turbogrid/BladeGen.inf");
+    model::TemplateInputs result;
+    auto curve = [&](const io::PointSet& set) {
+      model::InputCurve c;
+      c.name = set.name;
+      for (const Eigen::Vector3d& p : set.points)
+      {
+        c.points.push_back(p * sets.scale);
+      }
+      return c;
+    };
+    model::InputPointSet hub, shroud, profiles;
+    hub.name = "Hub";
+    hub.curves.push_back(curve(sets.hub));
+    shroud.name = "Shroud";
+    shroud.curves.push_back(curve(sets.shroud));
+    profiles.name = "Profiles";
+    profiles.isList = true;
+    for (const io::ProfileSection& section : sets.profiles)
+    {
+      profiles.curves.push_back(curve(section));
+      profiles.curves.back().span = section.spanPercent / 100.0;
+    }
+    result.pointSets = { hub, shroud, profiles };
+    result.hasMachine = true;
+    result.axis = sets.axis;
+    result.bladeCount = sets.bladeCount;
+    return result;
+  }();
+  return inputs;
+}
+
+const std::string& templatePath()
+{
+  static const std::string path = Source + "/Templates/axial_passage_oh.yaml";
+  return path;
+}
+
+struct Applied
+{
+  model::BlockModel model;
+  model::CarrierGeometry carriers;
+};
+
+const Applied& applied()
+{
+  static const Applied result = [] {
+    Applied a;
+    a.model = model::loadTemplate(templatePath(), {}, &rotor37Inputs(), &a.carriers);
+    return a;
+  }();
+  return result;
+}
+
+void BM_ApplyTemplate(benchmark::State& state)
+{
+  const model::TemplateInputs& inputs = rotor37Inputs();
+  for (auto _ : state)
+  {
+    model::CarrierGeometry carriers;
+    model::BlockModel model = model::loadTemplate(templatePath(), {}, &inputs, &carriers);
+    benchmark::DoNotOptimize(model.vertices.data());
+  }
+}
+
+void BM_FullEvaluation(benchmark::State& state)
+{
+  const Applied& a = applied();
+  std::vector<std::vector<double>> xyz;
+  long long cells = 0;
+  for (auto _ : state)
+  {
+    model::MultiBlockMesher mesher(a.model, a.carriers);
+    mesher.computeBoundaries();
+    xyz.resize(mesher.blockCount());
+    std::vector<StructuredBlock> blocks;
+    cells = 0;
+    for (int b = 0; b < mesher.blockCount(); ++b)
+    {
+      const auto n = mesher.nodeCounts(b);
+      xyz[b].resize(3 * static_cast<std::size_t>(n[0]) * n[1] * n[2]);
+      mesher.meshBlock(b, xyz[b].data());
+      blocks.push_back({ xyz[b].data(), n[0], n[1], n[2] });
+      cells += static_cast<long long>(n[0] - 1) * (n[1] - 1) * (n[2] - 1);
+    }
+    const auto quality = computeGridQuality(blocks);
+    benchmark::DoNotOptimize(quality.data());
+  }
+  state.counters["cells"] = static_cast<double>(cells);
+}
+
+#ifdef BLOCKFORGE_HAS_MESH_PLAN
+/// Smallest MinAngle of the cells of block b (hexFaceAngles cell by cell).
+double smallestMinAngle(const std::vector<double>& xyz, const std::array<int, 3>& n, long long& cells)
+{
+  double smallest = 180.0;
+  auto at = [&](int i, int j, int k) {
+    const double* p = &xyz[3 * (i + static_cast<std::size_t>(n[0]) * (j + static_cast<std::size_t>(n[1]) * k))];
+    return Vec3(p[0], p[1], p[2]);
+  };
+  for (int k = 0; k + 1 < n[2]; ++k)
+    for (int j = 0; j + 1 < n[1]; ++j)
+      for (int i = 0; i + 1 < n[0]; ++i)
+      {
+        const std::array<Vec3, 8> corners = { at(i, j, k), at(i + 1, j, k), at(i + 1, j + 1, k),
+          at(i, j + 1, k), at(i, j, k + 1), at(i + 1, j, k + 1), at(i + 1, j + 1, k + 1),
+          at(i, j + 1, k + 1) };
+        double minAngle = 0.0, maxAngle = 0.0;
+        hexFaceAngles(corners, minAngle, maxAngle);
+        smallest = std::min(smallest, minAngle);
+        ++cells;
+      }
+  return smallest;
+}
+
+void BM_MoveOneControlPoint(benchmark::State& state)
+{
+  const Applied& a = applied();
+  model::MeshPlan plan(a.model, a.carriers);
+  const int vertex = plan.model().findVertex("oa_f_h");
+  model::FreeParameter parameter;
+  for (const model::FreeParameter& p : model::freeParameters(plan.model(), plan.carriers()))
+  {
+    if (p.vertex == vertex && p.component == 0)
+    {
+      parameter = p;
+    }
+  }
+  const double original = plan.model().vertices[vertex].constraint.s;
+  long long step = 0, cells = 0, blocks = 0, infeasible = 0;
+  for (auto _ : state)
+  {
+    // Along the O-grid curve by up to 0.003 either way, never to the same place twice
+    // (nothing is served from what an earlier iteration computed at the same position).
+    const double offset = 0.003 * std::sin(0.7 * static_cast<double>(++step));
+    const std::vector<int> moved =
+      model::moveParameter(plan.model(), plan.carriers(), parameter, original + offset);
+    const model::Feasibility feasibility = plan.update(moved);
+    infeasible += feasibility.feasible() ? 0 : 1;
+    double smallest = 180.0;
+    cells = 0;
+    for (const int b : plan.updatedBlocks())
+    {
+      smallest = std::min(smallest, smallestMinAngle(plan.blockNodes(b), plan.nodeCounts(b), cells));
+    }
+    blocks = static_cast<long long>(plan.updatedBlocks().size());
+    benchmark::DoNotOptimize(smallest);
+  }
+  state.counters["blocks"] = static_cast<double>(blocks);
+  state.counters["cells"] = static_cast<double>(cells);
+  state.counters["infeasible"] = static_cast<double>(infeasible);
+}
+#endif
+} // namespace
+
+int main(int argc, char** argv)
+{
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv))
+  {
+    return 1;
+  }
+  try
+  {
+    benchmark::AddCustomContext("template", templatePath());
+    benchmark::AddCustomContext("blocks", std::to_string(applied().model.blocks.size()));
+  }
+  catch (const std::exception& error)
+  {
+    std::cerr << "bench_model: " << error.what() << "\n";
+    return 1;
+  }
+  benchmark::RegisterBenchmark("ApplyTemplate", BM_ApplyTemplate)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("FullEvaluation", BM_FullEvaluation)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+#ifdef BLOCKFORGE_HAS_MESH_PLAN
+  benchmark::RegisterBenchmark("MoveOneControlPoint", BM_MoveOneControlPoint)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+#endif
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
