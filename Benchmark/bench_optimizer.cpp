@@ -53,6 +53,21 @@ std::string classes(const GridMeasures& m)
   return text;
 }
 
+/// The smallest angle, or why there is none.
+std::string angleText(const GridMeasures& m)
+{
+  char text[64];
+  if (!m.feasible)
+  {
+    std::snprintf(text, sizeof text, "inverted cells");
+  }
+  else
+  {
+    std::snprintf(text, sizeof text, "%.1f", m.minAngle);
+  }
+  return text;
+}
+
 std::string baseName(const std::string& path)
 {
   const std::size_t slash = path.find_last_of('/');
@@ -166,6 +181,7 @@ int main(int argc, char** argv)
 {
   int repetitions = 5;
   bool blocks = false;
+  bool timing = false;
   OptimizerSettings settings;
   std::vector<std::pair<std::string, std::string>> cases;
   for (int a = 1; a < argc; ++a)
@@ -192,11 +208,16 @@ int main(int argc, char** argv)
       const std::string name = argv[++a];
       settings.search.algorithm = name == "cobyla" ? SearchAlgorithm::Cobyla
         : name == "subplex"                        ? SearchAlgorithm::Subplex
+        : name == "compass"                        ? SearchAlgorithm::Compass
                                                    : SearchAlgorithm::Bobyqa;
     }
     else if (arg == "--blocks")
     {
       blocks = true;
+    }
+    else if (arg == "--timing")
+    {
+      timing = true;
     }
     else if (a + 1 < argc)
     {
@@ -212,6 +233,36 @@ int main(int argc, char** argv)
     const model::BlockModel model = model::loadTemplate(templateFile, {}, &inputs, &geometry);
     Row row;
     row.name = baseName(templateFile) + ", " + inputFile;
+    if (timing)
+    {
+      // Cost of one evaluation: one parameter moved (the plan updates its neighbourhood)
+      // against all of them moved (median of 20 each).
+      ControlProblem problem(model, geometry, 1.0, settings.objective, {});
+      std::vector<double> x = problem.start();
+      problem.evaluate(x);
+      std::vector<double> one, all;
+      for (int r = 0; r < 20; ++r)
+      {
+        const std::size_t i = r % x.size();
+        const double sign = r % 2 ? 1.0 : -1.0;
+        std::vector<double> y = x;
+        y[i] += sign * 0.01 * (problem.high()[i] - problem.low()[i]);
+        auto begin = std::chrono::steady_clock::now();
+        problem.evaluate(y);
+        one.push_back(seconds(begin));
+        problem.evaluate(x);
+        for (std::size_t j = 0; j < x.size(); ++j)
+        {
+          y[j] = x[j] + sign * 0.001 * (problem.high()[j] - problem.low()[j]);
+        }
+        begin = std::chrono::steady_clock::now();
+        problem.evaluate(y);
+        all.push_back(seconds(begin));
+        problem.evaluate(x);
+      }
+      std::fprintf(stderr, "%s: evaluation with one parameter moved %.2f ms, all %.2f ms\n",
+        row.name.c_str(), 1e3 * median(one), 1e3 * median(all));
+    }
     std::vector<double> times;
     OptimizerResult result;
     for (int r = 0; r < repetitions; ++r)
@@ -252,10 +303,10 @@ int main(int argc, char** argv)
       row.evaluations, row.seconds, row.stop.c_str());
     if (blocks)
     {
-      model::CarrierGeometry copy = geometry;
-      ControlProblem problem(result.model, copy, 1.0, settings.objective, {});
+      const model::CarrierGeometry built(result.model);
+      ControlProblem problem(result.model, built, 1.0, settings.objective, {});
       const std::vector<std::vector<double>> grids = problem.gridAt(problem.start());
-      model::MeshPlan plan(result.model, copy);
+      model::MeshPlan plan(result.model, built);
       for (std::size_t b = 0; b < grids.size(); ++b)
       {
         const auto n = plan.nodeCounts(static_cast<int>(b));
@@ -276,12 +327,12 @@ int main(int argc, char** argv)
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (const Row& row : rows)
   {
-    std::printf("| %s | %zu | %.1f, %s | %.1f, %s | %.2f s | %d, %.0f/s | %.1f, %.2f s | %.1f, "
+    std::printf("| %s | %zu | %.1f, %s | %.1f, %s | %.2f s | %d, %.0f/s | %s, %.2f s | %s, "
                 "%.2f s |\n",
       row.name.c_str(), row.variables, row.before.minAngle, classes(row.before).c_str(),
       row.after.minAngle, classes(row.after).c_str(), row.seconds, row.evaluations,
-      row.evaluations / row.searchSeconds, row.laplace.feasible ? row.laplace.minAngle : 0.0,
-      row.laplaceSeconds, row.classy.feasible ? row.classy.minAngle : 0.0, row.classySeconds);
+      row.evaluations / row.searchSeconds, angleText(row.laplace).c_str(), row.laplaceSeconds,
+      angleText(row.classy).c_str(), row.classySeconds);
   }
   return 0;
 }

@@ -74,6 +74,7 @@ vtkSmartPointer<vtkDoubleArray> scalarArray(const char* name, double value)
 } // namespace
 
 vtkBlockOptimizer::vtkBlockOptimizer()
+  : ControlPointNames(vtkStringArray::New())
 {
   this->SetNumberOfOutputPorts(2);
 }
@@ -81,6 +82,7 @@ vtkBlockOptimizer::vtkBlockOptimizer()
 vtkBlockOptimizer::~vtkBlockOptimizer()
 {
   this->SetHandleControlPoint(nullptr);
+  this->ControlPointNames->Delete();
 }
 
 void vtkBlockOptimizer::AddFixedControlPoint(const char* name)
@@ -188,7 +190,15 @@ int vtkBlockOptimizer::RequestData(
     {
       settings.moves.push_back({ move.first, parseParameters(move.first, move.second) });
     }
-    if (this->HandleControlPoint && *this->HandleControlPoint)
+    // The handle moves its point once it has been located (an update with the same point
+    // reported where it is) and has been dragged away from there.
+    const bool handleLocated = this->HandleControlPoint && *this->HandleControlPoint &&
+      this->LocatedControlPoint == this->HandleControlPoint;
+    const bool handleDragged = handleLocated &&
+      (this->HandlePosition[0] != this->HandleControlPointPosition[0] ||
+        this->HandlePosition[1] != this->HandleControlPointPosition[1] ||
+        this->HandlePosition[2] != this->HandleControlPointPosition[2]);
+    if (handleDragged)
     {
       const blockforge::Vec3 point(
         this->HandlePosition[0], this->HandlePosition[1], this->HandlePosition[2]);
@@ -216,6 +226,24 @@ int vtkBlockOptimizer::RequestData(
       vtkWarningMacro(<< "The optimized model still cannot be meshed without inverted cells: "
                       << result.after.failure);
     }
+    // For the GUI: the points a move can take, and where the handle's point is now.
+    this->ControlPointNames->Initialize();
+    for (const blockforge::model::Vertex& vertex : result.model.vertices)
+    {
+      if (vertex.rule.kind == blockforge::model::VertexRule::Kind::OnCarrier)
+      {
+        this->ControlPointNames->InsertNextValue(vertex.name);
+      }
+    }
+    const int handle = this->HandleControlPoint
+      ? result.model.findVertex(this->HandleControlPoint)
+      : -1;
+    for (int c = 0; c < 3; ++c)
+    {
+      this->HandleControlPointPosition[c] =
+        handle >= 0 ? result.model.vertices[handle].position[c] : 0.0;
+    }
+    this->LocatedControlPoint = handle >= 0 ? this->HandleControlPoint : "";
     const std::string moved = blockforge::model::writeModelDocument(result.model);
     blockforge::vtkglue::meshModel(result.model, moved, 1.0, this->PreviewCells, piece,
       pieceCount, output, [this](double fraction) { this->UpdateProgress(0.9 + 0.1 * fraction); },

@@ -31,6 +31,8 @@
 #include <utility>
 #include <vector>
 
+class vtkStringArray;
+
 class BLOCKFORGEFILTERS_EXPORT vtkBlockOptimizer : public vtkMultiBlockDataSetAlgorithm
 {
 public:
@@ -93,11 +95,23 @@ public:
 
   ///@{
   /// The GUI's manual move: the control point the 3-D handle moves ("" for none) and the
-  /// handle's position, projected onto the point's carrier on Apply.
+  /// handle's position. An update with a newly chosen point only locates it
+  /// (GetHandleControlPointPosition, where the handle is reset to); once the handle is
+  /// dragged away from there, Apply projects its position onto the point's carrier and
+  /// applies that as a manual move (held by the automatic run). One handle move at a
+  /// time: ControlPointMoves keeps several.
   vtkSetStringMacro(HandleControlPoint);
   vtkGetStringMacro(HandleControlPoint);
   vtkSetVector3Macro(HandlePosition, double);
   vtkGetVector3Macro(HandlePosition, double);
+  ///@}
+
+  ///@{
+  /// After an update: the control points a manual move can take (vertices with free
+  /// carrier parameters), for the GUI's list, and the position of HandleControlPoint in
+  /// the output model (where the handle starts; (0, 0, 0) when none).
+  vtkStringArray* GetControlPointNames() { return this->ControlPointNames; }
+  vtkGetVector3Macro(HandleControlPointPosition, double);
   ///@}
 
   ///@{
@@ -124,6 +138,10 @@ protected:
   char* HandleControlPoint = nullptr;
   double HandlePosition[3] = { 0.0, 0.0, 0.0 };
   int PreviewCells = 8;
+  vtkStringArray* ControlPointNames;
+  double HandleControlPointPosition[3] = { 0.0, 0.0, 0.0 };
+  /// The handle's control point as of the last update (its position is reported above).
+  std::string LocatedControlPoint;
 
 private:
   vtkBlockOptimizer(const vtkBlockOptimizer&) = delete;

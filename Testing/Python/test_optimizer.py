@@ -86,15 +86,29 @@ class OptimizerProxyTest(unittest.TestCase):
         model = servermanager.Fetch(optimizer)
         self.assertAlmostEqual(field_values(model, "MinAngleAfter")[0], corner_angle(0.16),
                                places=9)
-        # the handle: its position is projected onto the carrier (the line y = z = 0)
+        # the handle: a newly chosen point is located first (nothing moves) ...
         optimizer.ControlPointMoves = []
         optimizer.Automatic = 0
         optimizer.HandleControlPoint = "m0"
         optimizer.HandlePosition = [0.7, 0.3, -0.2]
         optimizer.UpdatePipeline()
+        optimizer.UpdatePropertyInformation()
+        names = optimizer.GetProperty("ControlPointNamesInfo")
+        self.assertEqual(sorted(names[i] for i in range(len(names))), ["a0", "b1", "m0"])
+        located = optimizer.GetProperty("HandleControlPointPositionInfo")
+        np.testing.assert_allclose([located[i] for i in range(3)], [0.6, 0.0, 0.0], atol=1e-12)
+        model = servermanager.Fetch(optimizer)
+        self.assertAlmostEqual(field_values(model, "MinAngleAfter")[0], corner_angle(0.4),
+                               places=9)
+        # ... then dragged: its position is projected onto the carrier (y = z = 0)
+        optimizer.HandlePosition = [0.7, 0.3, -0.25]
+        optimizer.UpdatePipeline()
         model = servermanager.Fetch(optimizer)
         self.assertAlmostEqual(field_values(model, "MinAngleAfter")[0], corner_angle(0.3),
                                places=9)
+        optimizer.UpdatePropertyInformation()
+        located = optimizer.GetProperty("HandleControlPointPositionInfo")
+        np.testing.assert_allclose([located[i] for i in range(3)], [0.7, 0.0, 0.0], atol=1e-12)
         Delete(optimizer)
         Delete(source)
 

@@ -106,6 +106,88 @@ struct SearchState
   }
 };
 
+/**
+ * Compass search (Torczon's coordinate pattern search): each variable in turn tries a step
+ * up and down (the direction that last succeeded first); a step that lowers the objective
+ * is taken and grows by half, one that does not halves. Stops when every step is below
+ * 1e-7 of its range, or when a whole pass gained less than `tolerance` with every step
+ * below 1e-3 of its range.
+ */
+void compassSearch(SearchState& state, const std::vector<double>& start,
+  const std::vector<double>& low, const std::vector<double>& high,
+  const SearchSettings& settings, SearchResult& result)
+{
+  const std::size_t n = start.size();
+  std::vector<double> x = start, step(n), direction(n, 1.0);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    step[i] = settings.initialStep * (high[i] - low[i]);
+  }
+  double value = result.history.front().objective;
+  auto largestStep = [&] {
+    double largest = 0.0;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      if (high[i] > low[i])
+      {
+        largest = std::max(largest, step[i] / (high[i] - low[i]));
+      }
+    }
+    return largest;
+  };
+  while (true)
+  {
+    const double passStart = value;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      if (!(high[i] > low[i]) || step[i] < 1.0e-7 * (high[i] - low[i]))
+      {
+        continue;
+      }
+      bool improved = false;
+      for (double sign : { direction[i], -direction[i] })
+      {
+        if (result.evaluations >= state.maxEvaluations)
+        {
+          result.stopReason = "evaluation limit reached";
+          return;
+        }
+        std::vector<double> y = x;
+        y[i] = std::min(high[i], std::max(low[i], x[i] + sign * step[i]));
+        if (y[i] == x[i])
+        {
+          continue;
+        }
+        const double trial = state.record(y).objective;
+        if (trial < value)
+        {
+          x = y;
+          value = trial;
+          direction[i] = sign;
+          step[i] *= 1.5;
+          improved = true;
+          break;
+        }
+      }
+      if (!improved)
+      {
+        step[i] *= 0.5;
+      }
+    }
+    const double largest = largestStep();
+    if (largest < 1.0e-7)
+    {
+      result.stopReason = "step tolerance reached";
+      return;
+    }
+    if (passStart - value < settings.tolerance && largest < 1.0e-3)
+    {
+      result.stopReason = "objective tolerance reached";
+      return;
+    }
+  }
+}
+
 double nloptObjective(unsigned n, const double* u, double* gradient, void* data)
 {
   (void)gradient; // derivative-free algorithms only
@@ -161,6 +243,13 @@ SearchResult search(const std::vector<double>& start, const std::vector<double>&
   {
     result.stopReason = "nothing to move";
     result.seconds = result.history.back().seconds;
+    return result;
+  }
+  if (settings.algorithm == SearchAlgorithm::Compass)
+  {
+    compassSearch(state, start, low, high, settings, result);
+    result.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - state.begin).count();
     return result;
   }
   nlopt::srand(20031139); // only stochastic algorithms use it; fixed for determinism

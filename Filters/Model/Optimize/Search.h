@@ -16,12 +16,15 @@ namespace blockforge
 {
 namespace optimize
 {
-/// The NLopt algorithms the search offers (all local, derivative-free, deterministic).
+/// The algorithms the search offers (all local, derivative-free, deterministic).
 enum class SearchAlgorithm
 {
-  Bobyqa, ///< bound-constrained quadratic models (Powell): few evaluations on smooth objectives
-  Cobyla, ///< linear models (Powell)
-  Subplex ///< Nelder-Mead on subspaces (Rowan): robust on kinks and penalties
+  Bobyqa,  ///< NLopt: bound-constrained quadratic models (Powell), all variables at once
+  Cobyla,  ///< NLopt: linear models (Powell)
+  Subplex, ///< NLopt: Nelder-Mead on subspaces (Rowan): robust on kinks and penalties
+  Compass  ///< coordinate (compass) search: one variable per step, so a mesh plan
+           ///< recomputes only that control point's neighbourhood; robust on the kinks
+           ///< of a max-min objective and on infeasible penalties
 };
 
 struct SearchSettings
