@@ -181,6 +181,14 @@ int vtkBlockOptimizer::RequestData(
     blockforge::model::CarrierGeometry geometry(model);
     optimize::OptimizerSettings settings;
     settings.objective.kind = static_cast<optimize::ObjectiveKind>(this->Objective);
+    const optimize::SearchAlgorithm algorithms[] = { optimize::SearchAlgorithm::Compass,
+      optimize::SearchAlgorithm::Bobyqa, optimize::SearchAlgorithm::Cobyla,
+      optimize::SearchAlgorithm::Subplex };
+    settings.search.algorithm = algorithms[this->Algorithm];
+    if (settings.search.algorithm != optimize::SearchAlgorithm::Compass)
+    {
+      settings.search.initialStep = 0.02; // NLopt's models do better with smaller first steps
+    }
     settings.search.maxEvaluations = this->MaximumEvaluations;
     settings.search.tolerance = this->Tolerance;
     settings.densityMultiplier = this->DensityMultiplier;
@@ -302,6 +310,7 @@ void vtkBlockOptimizer::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "Objective: " << this->Objective << "\n";
+  os << indent << "Algorithm: " << this->Algorithm << "\n";
   os << indent << "MaximumEvaluations: " << this->MaximumEvaluations << "\n";
   os << indent << "Tolerance: " << this->Tolerance << "\n";
   os << indent << "DensityMultiplier: " << this->DensityMultiplier << "\n";

@@ -53,8 +53,22 @@ public:
   vtkGetMacro(Objective, int);
   ///@}
 
+  enum SearchAlgorithm
+  {
+    COMPASS = 0, ///< one control point parameter per step (cheap mesh-plan updates)
+    BOBYQA = 1,  ///< NLopt BOBYQA: quadratic models of all parameters
+    COBYLA = 2,  ///< NLopt COBYLA
+    SUBPLEX = 3  ///< NLopt Sbplx
+  };
+
   ///@{
-  /// Largest number of grid evaluations of the automatic run (default 300).
+  /// The search of the automatic run (default COMPASS).
+  vtkSetClampMacro(Algorithm, int, COMPASS, SUBPLEX);
+  vtkGetMacro(Algorithm, int);
+  ///@}
+
+  ///@{
+  /// Largest number of grid evaluations of the automatic run (default 400).
   vtkSetClampMacro(MaximumEvaluations, int, 1, 1000000);
   vtkGetMacro(MaximumEvaluations, int);
   ///@}
@@ -129,7 +143,8 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   int Objective = MIN_ANGLE;
-  int MaximumEvaluations = 300;
+  int Algorithm = COMPASS;
+  int MaximumEvaluations = 400;
   double Tolerance = 1.0e-3;
   double DensityMultiplier = 1.0;
   bool Automatic = true;

@@ -257,7 +257,8 @@ TEST(Search, DeterministicBitForBit)
       settings);
   };
   for (SearchAlgorithm algorithm :
-    { SearchAlgorithm::Bobyqa, SearchAlgorithm::Cobyla, SearchAlgorithm::Subplex })
+    { SearchAlgorithm::Bobyqa, SearchAlgorithm::Cobyla, SearchAlgorithm::Subplex,
+      SearchAlgorithm::Compass })
   {
     const SearchResult a = run(algorithm), b = run(algorithm);
     ASSERT_EQ(a.history.size(), b.history.size());

@@ -37,7 +37,8 @@ class OptimizerProxyTest(unittest.TestCase):
         source = BlockTemplateSource(TemplateFile=SYMMETRIC)
         optimizer = BlockOptimizer(Input=source, Tolerance=1e-12)
         self.assertEqual(optimizer.Objective, "MinAngle")
-        self.assertEqual(optimizer.MaximumEvaluations, 300)
+        self.assertEqual(optimizer.MaximumEvaluations, 400)
+        self.assertEqual(optimizer.Algorithm, "Compass")
         optimizer.UpdatePipeline()
         model = servermanager.Fetch(optimizer)
         self.assertAlmostEqual(field_values(model, "MinAngleBefore")[0], corner_angle(0.4),

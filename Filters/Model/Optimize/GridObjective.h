@@ -40,7 +40,7 @@ struct ObjectiveSettings
   ObjectiveKind kind = ObjectiveKind::MinAngle;
   /// Sharpness of the smooth minimum of the cell angles, per degree: cells more than a
   /// few 1/sharpness degrees above the worst hardly count.
-  double angleSharpness = 0.3;
+  double angleSharpness = 1.0;
   /// MinAngleAndSizeRatio: degrees of smallest angle worth one unit of neighbour size
   /// ratio above 1 (a ratio of 1.5 costs 0.5 * weight degrees).
   double sizeRatioWeight = 10.0;

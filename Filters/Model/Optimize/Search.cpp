@@ -110,8 +110,7 @@ struct SearchState
  * Compass search (Torczon's coordinate pattern search): each variable in turn tries a step
  * up and down (the direction that last succeeded first); a step that lowers the objective
  * is taken and grows by half, one that does not halves. Stops when every step is below
- * 1e-7 of its range, or when a whole pass gained less than `tolerance` with every step
- * below 1e-3 of its range.
+ * 1e-7 of its range, or when a pass that took steps gained less than `tolerance`.
  */
 void compassSearch(SearchState& state, const std::vector<double>& start,
   const std::vector<double>& low, const std::vector<double>& high,
@@ -138,6 +137,7 @@ void compassSearch(SearchState& state, const std::vector<double>& start,
   while (true)
   {
     const double passStart = value;
+    bool moved = false;
     for (std::size_t i = 0; i < n; ++i)
     {
       if (!(high[i] > low[i]) || step[i] < 1.0e-7 * (high[i] - low[i]))
@@ -166,6 +166,7 @@ void compassSearch(SearchState& state, const std::vector<double>& start,
           direction[i] = sign;
           step[i] *= 1.5;
           improved = true;
+          moved = true;
           break;
         }
       }
@@ -180,7 +181,7 @@ void compassSearch(SearchState& state, const std::vector<double>& start,
       result.stopReason = "step tolerance reached";
       return;
     }
-    if (passStart - value < settings.tolerance && largest < 1.0e-3)
+    if (moved && passStart - value < settings.tolerance)
     {
       result.stopReason = "objective tolerance reached";
       return;
