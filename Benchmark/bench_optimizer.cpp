@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <cstring>
 #include <set>
@@ -171,7 +172,8 @@ struct Row
   std::string name;
   GridMeasures before, after, laplace, classy;
   std::size_t variables = 0;
-  double seconds = 0.0, searchSeconds = 0.0, laplaceSeconds = 0.0, classySeconds = 0.0;
+  double seconds = 0.0, cpuSeconds = 0.0, searchSeconds = 0.0, laplaceSeconds = 0.0,
+         classySeconds = 0.0;
   int evaluations = 0;
   std::string stop;
 };
@@ -263,15 +265,18 @@ int main(int argc, char** argv)
       std::fprintf(stderr, "%s: evaluation with one parameter moved %.2f ms, all %.2f ms\n",
         row.name.c_str(), 1e3 * median(one), 1e3 * median(all));
     }
-    std::vector<double> times;
+    std::vector<double> times, cpuTimes;
     OptimizerResult result;
     for (int r = 0; r < repetitions; ++r)
     {
       model::CarrierGeometry copy = geometry;
       const auto begin = std::chrono::steady_clock::now();
+      const std::clock_t cpuBegin = std::clock();
       result = optimizeModel(model, copy, settings);
       times.push_back(seconds(begin));
+      cpuTimes.push_back(static_cast<double>(std::clock() - cpuBegin) / CLOCKS_PER_SEC);
     }
+    row.cpuSeconds = median(cpuTimes);
     row.before = result.before;
     row.after = result.after;
     row.variables = result.variables.size();
@@ -298,9 +303,10 @@ int main(int argc, char** argv)
       row.classy = problem.evaluate(scored.best);
       row.classySeconds = seconds(begin);
     }
-    std::fprintf(stderr, "%s: %zu variables, %.2f -> %.2f deg, %d evaluations, %.3f s (%s)\n",
+    std::fprintf(stderr,
+      "%s: %zu variables, %.2f -> %.2f deg, %d evaluations, %.3f s (CPU %.3f s) (%s)\n",
       row.name.c_str(), row.variables, row.before.minAngle, row.after.minAngle,
-      row.evaluations, row.seconds, row.stop.c_str());
+      row.evaluations, row.seconds, row.cpuSeconds, row.stop.c_str());
     if (blocks)
     {
       const model::CarrierGeometry built(result.model);
@@ -321,16 +327,18 @@ int main(int argc, char** argv)
     rows.push_back(row);
   }
   std::printf("| case | variables | before: min angle, classes 0-20 / 20-40 / 40-60 / 60-80 / "
-              "80-90 | optimizer: min angle, classes | time (median of %d) | evaluations, "
-              "per s | Laplacian: min angle, time | block score: min angle, time |\n",
+              "80-90 | optimizer: min angle, classes | time, CPU time (medians of %d) | "
+              "evaluations, per s | Laplacian: min angle, time | block score: min angle, "
+              "time |\n",
     repetitions);
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (const Row& row : rows)
   {
-    std::printf("| %s | %zu | %.1f, %s | %.1f, %s | %.2f s | %d, %.0f/s | %s, %.2f s | %s, "
-                "%.2f s |\n",
+    std::printf("| %s | %zu | %.1f, %s | %.1f, %s | %.2f s, %.2f s | %d, %.0f/s | %s, %.2f s | "
+                "%s, %.2f s |\n",
       row.name.c_str(), row.variables, row.before.minAngle, classes(row.before).c_str(),
-      row.after.minAngle, classes(row.after).c_str(), row.seconds, row.evaluations,
+      row.after.minAngle, classes(row.after).c_str(), row.seconds, row.cpuSeconds,
+      row.evaluations,
       row.evaluations / row.searchSeconds, angleText(row.laplace).c_str(), row.laplaceSeconds,
       angleText(row.classy).c_str(), row.classySeconds);
   }
