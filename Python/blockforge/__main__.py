@@ -26,6 +26,25 @@ def _parse_parameter(text):
     return name.strip(), value.strip()
 
 
+def optimizer_lines(quality):
+    """What the BlockOptimizer upstream of *quality* did, if there is one."""
+    algorithm = quality
+    while algorithm is not None and algorithm.GetClassName() != "vtkBlockOptimizer":
+        algorithm = (algorithm.GetInputAlgorithm()
+                     if algorithm.GetNumberOfInputConnections(0) else None)
+    if algorithm is None:
+        return []
+    fields = algorithm.GetOutputDataObject(0).GetFieldData()
+    before = fields.GetArray("MinAngleBefore")
+    if before is None:
+        return []
+    after = fields.GetArray("MinAngleAfter").GetValue(0)
+    evaluations = fields.GetArray("OptimizerEvaluations").GetValue(0)
+    moved = fields.GetAbstractArray("ControlPointNames").GetNumberOfValues()
+    return [f"optimizer: smallest element angle {before.GetValue(0):.2f} -> {after:.2f} deg "
+            f"({moved} control point parameters, {evaluations} evaluations)"]
+
+
 def summary_lines(quality):
     """Human-readable quality summary of a vtkGridQuality after its update."""
     classes = quality.GetOutputDataObject(1)
@@ -48,6 +67,7 @@ def summary_lines(quality):
         count = classes.GetValue(row, 1).ToInt()
         percent = classes.GetValue(row, 2).ToDouble()
         lines.append(f"  {label:>8}              {count:8d}   {percent:6.2f}")
+    lines.extend(optimizer_lines(quality))
     lines.append("measure                 min        mean         max")
     for row in range(statistics.GetNumberOfRows()):
         name = statistics.GetValue(row, 0).ToString()

@@ -478,8 +478,11 @@ class OptimizerTest(unittest.TestCase):
             self.assertEqual(len(timing), 1)
             if expected:
                 self.assertIn(expected, timing[0])
+                self.assertIn("optimizer: smallest element angle 68.20 -> 89.9", out.getvalue())
+                self.assertIn("(1 control point parameters", out.getvalue())
             else:
                 self.assertNotIn("optimize", timing[0])
+                self.assertNotIn("optimizer:", out.getvalue())
 
 
 if __name__ == "__main__":
