@@ -22,7 +22,7 @@
 #include "Mesher.h"
 #include "Quality.h"
 #include "Template.h"
-#include "TurboPointSets.h"
+#include "TestTurboInputs.h"
 #if __has_include("MeshPlan.h")
 #include "MeshPlan.h"
 #include "Placement.h"
@@ -48,37 +48,8 @@ const std::string Source = BLOCKFORGE_SOURCE_DIR;
 /// The reader's point sets as vtkBlockTemplate hands them to the template (metres).
 const model::TemplateInputs& rotor37Inputs()
 {
-  static const model::TemplateInputs inputs = [] {
-    const io::TurboPointSets sets =
-      io::readTurboPointSets(Source + "/Data/rotor37/turbogrid/BladeGen.inf");
-    model::TemplateInputs result;
-    auto curve = [&](const io::PointSet& set) {
-      model::InputCurve c;
-      c.name = set.name;
-      for (const Eigen::Vector3d& p : set.points)
-      {
-        c.points.push_back(p * sets.scale);
-      }
-      return c;
-    };
-    model::InputPointSet hub, shroud, profiles;
-    hub.name = "Hub";
-    hub.curves.push_back(curve(sets.hub));
-    shroud.name = "Shroud";
-    shroud.curves.push_back(curve(sets.shroud));
-    profiles.name = "Profiles";
-    profiles.isList = true;
-    for (const io::ProfileSection& section : sets.profiles)
-    {
-      profiles.curves.push_back(curve(section));
-      profiles.curves.back().span = section.spanPercent / 100.0;
-    }
-    result.pointSets = { hub, shroud, profiles };
-    result.hasMachine = true;
-    result.axis = sets.axis;
-    result.bladeCount = sets.bladeCount;
-    return result;
-  }();
+  static const model::TemplateInputs inputs =
+    test::readTemplateInputs(Source + "/Data/rotor37/turbogrid/BladeGen.inf");
   return inputs;
 }
 

@@ -1,6 +1,9 @@
 #include "BlockForgeModelIO.h"
 
+#include "BlockForgeParallel.h"
+
 #include "../Model/ModelDocument.h"
+#include "../Model/Partition.h"
 #include "../Model/Template.h"
 
 #include <vtkCellArray.h>
@@ -189,8 +192,10 @@ std::string findModelDocument(vtkDataObject* object)
 } // namespace blockforge
 
 #include "../Core/Quality.h"
+#include "../Model/MemoryBudget.h"
 #include "../Model/GridCheck.h"
 #include "../Model/Mesher.h"
+#include "../Model/PrintableText.h"
 
 #include <deque>
 #include <mutex>
@@ -215,11 +220,17 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
 {
   const int blockCount = mesher.blockCount();
   output->SetNumberOfBlocks(static_cast<unsigned int>(blockCount));
+  std::vector<std::array<int, 3>> nodeCounts;
+  for (int b = 0; b < blockCount; ++b)
+  {
+    nodeCounts.push_back(mesher.nodeCounts(b));
+  }
+  const std::vector<int> pieceOf = model::balancedPieces(nodeCounts, pieceCount);
   for (int b = 0; b < blockCount; ++b)
   {
     output->GetMetaData(static_cast<unsigned int>(b))
       ->Set(vtkCompositeDataSet::NAME(), blockModel.blocks[b].name.c_str());
-    if (pieceCount > 1 && b % pieceCount != piece)
+    if (pieceCount > 1 && pieceOf[b] != piece)
     {
       continue;
     }
@@ -227,6 +238,12 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
     const vtkIdType nodeCount = static_cast<vtkIdType>(nodes[0]) * nodes[1] * nodes[2];
     vtkNew<vtkDoubleArray> coordinates;
     coordinates->SetNumberOfComponents(3);
+    if (!coordinates->Resize(nodeCount) || coordinates->GetPointer(0) == nullptr)
+    {
+      throw model::ResourceError("block '" + blockModel.blocks[b].name + "': cannot allocate " +
+        model::formatBytes(24.0 * static_cast<double>(nodeCount)) + " for " +
+        std::to_string(nodeCount) + " nodes");
+    }
     coordinates->SetNumberOfTuples(nodeCount);
     // Fresh memory faulted in one go is much cheaper than page by page on some VMs.
     prepareOutputMemory(coordinates->GetPointer(0), sizeof(double) * 3 * nodeCount);
@@ -321,8 +338,9 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
   double densityMultiplier, int cellCap, int piece, int pieceCount,
   vtkMultiBlockDataSet* output, const std::function<void(double)>& progress,
   const model::CarrierGeometry* carriers, InvertedCellPolicy policy,
-  std::vector<model::InvertedCellReport>* reports)
+  std::vector<model::InvertedCellReport>* reports, double maximumMemoryGigabytes)
 {
+  useSMPTools();
   model::CarrierGeometry known;
   bool haveCarriers = false;
   if (carriers)
@@ -342,6 +360,18 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
     CarrierCache::instance().store(document, mesher.carriers());
   }
   mesher.setCellCap(cellCap);
+  model::BlockNodeCounts nodes;
+  for (int b = 0; b < mesher.blockCount(); ++b)
+  {
+    if (pieceCount <= 1 || b % pieceCount == piece)
+    {
+      nodes.push_back(mesher.nodeCounts(b));
+    }
+  }
+  model::checkGridMemory(nodes, maximumMemoryGigabytes,
+    cellCap > 0 || policy == InvertedCellPolicy::Skip // the template's preview
+      ? "lower PreviewCells or the cell counts"
+                : "lower the density multiplier or the cell counts");
   mesher.computeBoundaries();
   if (progress)
   {
@@ -359,6 +389,11 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
     policy, reports);
   attachModel(grid->GetFieldData(), document);
   output->ShallowCopy(grid);
+}
+
+std::string printable(const char* text)
+{
+  return printableText(text ? text : "");
 }
 } // namespace vtkglue
 } // namespace blockforge

@@ -64,7 +64,7 @@ enum class InvertedCellPolicy
 /**
  * Fills `output` with one named vtkStructuredGrid per model block (the points written
  * by the mesher directly into the VTK array, no second copy) and a BlockId cell array.
- * Blocks not assigned to this piece (block index modulo pieceCount != piece) are left
+ * Blocks not assigned to this piece (model::balancedPieces: shared out by cells) are left
  * empty so every MPI rank has the same structure. `progress` gets a fraction in [0, 1].
  */
 void fillMultiBlock(const model::BlockModel& model, const model::MultiBlockMesher& mesher,
@@ -75,9 +75,12 @@ void fillMultiBlock(const model::BlockModel& model, const model::MultiBlockMeshe
 
 /**
  * Meshes `model` (density multiplier, optional cell cap for previews) into `output`
- * through fillMultiBlock and attaches `document` to the output's field data. Throws
- * (TemplateError, GeometryError) on any problem, inverted cells included unless `policy`
- * says otherwise (then each block's message goes to `reports`); `output` is only touched
+ * through fillMultiBlock and attaches `document` to the output's field data. Before any
+ * grid memory is allocated, the memory this piece's grid needs is checked against the
+ * available memory and `maximumMemoryGigabytes` (<= 0: no user limit). Throws
+ * (TemplateError, GeometryError, ResourceError) on any problem, inverted cells included
+ * unless `policy` says otherwise (then each block's message goes to `reports`); `output`
+ * is only touched
  * on success.
  */
 void meshModel(const model::BlockModel& model, const std::string& document,
@@ -85,6 +88,11 @@ void meshModel(const model::BlockModel& model, const std::string& document,
   vtkMultiBlockDataSet* output, const std::function<void(double)>& progress,
   const model::CarrierGeometry* carriers = nullptr,
   InvertedCellPolicy policy = InvertedCellPolicy::Refuse,
-  std::vector<model::InvertedCellReport>* reports = nullptr);
+  std::vector<model::InvertedCellReport>* reports = nullptr,
+  double maximumMemoryGigabytes = 0.0);
+
+/// `text` with bytes that are not UTF-8 escaped (\xNN), for vtkErrorMacro: Python's error
+/// observers and ParaView's Output Messages get a readable message whatever the input.
+std::string printable(const char* text);
 } // namespace vtkglue
 } // namespace blockforge

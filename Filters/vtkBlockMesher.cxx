@@ -59,14 +59,14 @@ int vtkBlockMesher::RequestData(
       nullptr,
       this->AllowInvertedCells ? blockforge::vtkglue::InvertedCellPolicy::Report
                                : blockforge::vtkglue::InvertedCellPolicy::Refuse,
-      &folds);
+      &folds, this->MaximumMemory);
     if (this->AllowInvertedCells)
     {
       vtkIdType inverted = 0;
       for (const auto& fold : folds)
       {
         vtkWarningMacro(<< "AllowInvertedCells is on, the grid is output anyway: "
-                        << fold.message);
+                        << blockforge::vtkglue::printable(fold.message.c_str()));
         inverted += fold.cells;
       }
       vtkNew<vtkIdTypeArray> count;
@@ -77,7 +77,7 @@ int vtkBlockMesher::RequestData(
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro(<< error.what());
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
     output->Initialize();
     return 0;
   }
@@ -89,5 +89,6 @@ void vtkBlockMesher::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "DensityMultiplier: " << this->DensityMultiplier << "\n";
+  os << indent << "MaximumMemory: " << this->MaximumMemory << " GB\n";
   os << indent << "AllowInvertedCells: " << this->AllowInvertedCells << "\n";
 }

@@ -16,6 +16,8 @@
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkStringArray.h>
+#include <vtkFieldData.h>
 #include <vtkStructuredGrid.h>
 
 #include <iterator>
@@ -179,16 +181,26 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
       pieceCount, output, [this](double fraction) { this->UpdateProgress(0.4 + 0.55 * fraction); },
       &geometry,
       // The preview's capped cell counts are not the grid: BlockMesher checks the cells.
-      blockforge::vtkglue::InvertedCellPolicy::Skip);
+      blockforge::vtkglue::InvertedCellPolicy::Skip, nullptr, this->MaximumMemory);
     if (carriers && piece == 0)
     {
       fillCarriers(blockModel, geometry, carriers);
     }
+    // What the template chose (its notes): a warning each, and the field data
+    // TemplateNotes, so that the choice is seen in the GUI, in scripts and on the command line.
+    vtkNew<vtkStringArray> notes;
+    notes->SetName("TemplateNotes");
+    for (const std::string& note : blockModel.notes)
+    {
+      vtkWarningMacro(<< this->TemplateFile << ": " << note);
+      notes->InsertNextValue(note);
+    }
+    output->GetFieldData()->AddArray(notes);
     this->ModelDocument = document;
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro(<< error.what());
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
     output->Initialize();
     if (carriers)
     {
@@ -206,6 +218,7 @@ void vtkBlockTemplateAlgorithm::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "TemplateFile: " << (this->TemplateFile ? this->TemplateFile : "(none)")
      << "\n";
   os << indent << "PreviewCells: " << this->PreviewCells << "\n";
+  os << indent << "MaximumMemory: " << this->MaximumMemory << " GB\n";
   for (const auto& parameter : this->Parameters)
   {
     os << indent << "Parameter " << parameter.first << " = " << parameter.second << "\n";

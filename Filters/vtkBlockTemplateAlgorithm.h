@@ -49,6 +49,13 @@ public:
   vtkGetMacro(PreviewCells, int);
   ///@}
 
+  ///@{
+  /// Largest memory the preview grid may take, in GB (2^30 bytes); 0 (default) = only
+  /// what the machine has available (see vtkBlockMesher::SetMaximumMemory).
+  vtkSetMacro(MaximumMemory, double);
+  vtkGetMacro(MaximumMemory, double);
+  ///@}
+
   /// The model document of the last successful run ("" before or after a failure).
   const char* GetModelDocument() const { return this->ModelDocument.c_str(); }
 
@@ -68,6 +75,7 @@ protected:
 
   char* TemplateFile = nullptr;
   int PreviewCells = 8;
+  double MaximumMemory = 0.0;
   std::map<std::string, std::string> Parameters;
   std::string ModelDocument;
 

@@ -1,9 +1,11 @@
 #include "vtkGridQuality.h"
 
 #include "../Core/Quality.h"
+#include "../Model/MemoryBudget.h"
 #include "../Model/ModelDocument.h"
 #include "../Model/Topology.h"
 #include "BlockForgeModelIO.h"
+#include "BlockForgeParallel.h"
 
 #include <vtkCellData.h>
 #include <vtkCompositeDataSet.h>
@@ -26,6 +28,7 @@
 #include <vtkTable.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <array>
 #include <limits>
 #include <map>
@@ -40,60 +43,12 @@ const char* const MeasureNames[6] = { "MinAngle", "MaxAngle", "NonOrthogonality"
   "AspectRatio", "ScaledJacobian" };
 const char* const ClassLabels[5] = { "0-20", "20-40", "40-60", "60-80", "80-90" };
 
-/**
- * The periodic pairs of the block model carried by `input` (none without a model), as
- * links between the measured grids: model blocks are found by name among `names` (the
- * grids' block names). Pairs with a block that is not here (another MPI rank) are left
- * out; pairs that do not fit the grid (it was changed after meshing) are left out and
- * counted in `unfit`.
- */
-std::vector<blockforge::PeriodicSideLink> periodicLinks(vtkDataObject* input,
-  const std::vector<std::string>& names, const std::vector<blockforge::StructuredBlock>& blocks,
-  int& unfit)
-{
-  unfit = 0;
-  std::vector<blockforge::PeriodicSideLink> links;
-  const std::string document = blockforge::vtkglue::findModelDocument(input);
-  if (document.empty())
-  {
-    return links;
-  }
-  const blockforge::model::BlockModel model = blockforge::model::readModelDocument(document);
-  std::map<std::string, int> gridOf;
-  for (std::size_t g = 0; g < names.size(); ++g)
-  {
-    if (!names[g].empty() && !gridOf.emplace(names[g], static_cast<int>(g)).second)
-    {
-      return links; // two grids of one name: no safe mapping
-    }
-  }
-  const blockforge::model::Topology topology = blockforge::model::buildTopology(model);
-  for (blockforge::PeriodicSideLink link : topology.periodicSideLinks())
-  {
-    const auto source = gridOf.find(model.blocks[link.sourceBlock].name);
-    const auto image = gridOf.find(model.blocks[link.imageBlock].name);
-    if (source == gridOf.end() || image == gridOf.end())
-    {
-      continue;
-    }
-    link.sourceBlock = source->second;
-    link.imageBlock = image->second;
-    if (blockforge::periodicSidesMatch(blocks, link))
-    {
-      links.push_back(link);
-    }
-    else
-    {
-      ++unfit;
-    }
-  }
-  return links;
-}
 } // namespace
 
 vtkGridQuality::vtkGridQuality()
 {
   this->SetNumberOfOutputPorts(3);
+  blockforge::vtkglue::useSMPTools();
 }
 
 int vtkGridQuality::FillInputPortInformation(int, vtkInformation* info)
@@ -122,6 +77,18 @@ int vtkGridQuality::RequestData(
   output->CopyStructure(input);
   this->UpdateProgress(0.0);
 
+  // Under MPI, when the pipeline runs in pieces, the ranks exchange the cells beside
+  // interfaces and periodic faces between them, and reduce the statistics. A plain serial
+  // pipeline inside an MPI program (e.g. on one rank of pvbatch) must not wait for ranks
+  // that never join.
+  const int pieceCount = outputVector->GetInformationObject(0)->Get(
+    vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  if (!controller || pieceCount <= 1 || controller->GetNumberOfProcesses() <= 1)
+  {
+    controller = nullptr;
+  }
+
   // Gather the structured blocks; float coordinates are converted once to double.
   std::vector<vtkStructuredGrid*> grids;
   std::vector<std::vector<double>> convertedPoints;
@@ -147,6 +114,8 @@ int vtkGridQuality::RequestData(
       vtkErrorMacro("Block " << iterator->GetCurrentFlatIndex()
                              << " is not a 3-D hexahedral grid (dimensions " << dims[0] << " x "
                              << dims[1] << " x " << dims[2] << ").");
+      // The other ranks wait for this one in the exchange: tell them it failed.
+      blockforge::vtkglue::findQualityNeighbours(input, {}, {}, controller, false);
       return 0;
     }
     blockforge::StructuredBlock block;
@@ -176,6 +145,25 @@ int vtkGridQuality::RequestData(
     names.push_back(metaData && metaData->Has(vtkCompositeDataSet::NAME())
         ? metaData->Get(vtkCompositeDataSet::NAME())
         : "");
+  }
+
+  try
+  {
+    double cellTotal = 0.0;
+    for (vtkStructuredGrid* grid : grids)
+    {
+      cellTotal += static_cast<double>(grid->GetNumberOfCells());
+    }
+    char count[64];
+    std::snprintf(count, sizeof(count), "%.2g cells", cellTotal);
+    blockforge::model::checkMemory(blockforge::model::qualityMemoryBytes(cellTotal),
+      this->MaximumMemory, "the quality measures", count,
+      "lower the density multiplier or the cell counts");
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
+    return 0;
   }
 
   // The measures are written straight into the output arrays: no copy, and the fresh
@@ -213,21 +201,30 @@ int vtkGridQuality::RequestData(
   }
   try
   {
-    int unfit = 0;
-    const std::vector<blockforge::PeriodicSideLink> links =
-      periodicLinks(input, names, blocks, unfit);
-    if (unfit > 0)
+    const blockforge::vtkglue::QualityNeighbourhood neighbours =
+      blockforge::vtkglue::findQualityNeighbours(input, names, blocks, controller);
+    if (neighbours.peerFailed)
     {
-      vtkWarningMacro(<< unfit
+      vtkErrorMacro("Another MPI rank failed to measure its blocks (see its messages).");
+      return 0;
+    }
+    if (neighbours.unfit > 0)
+    {
+      vtkWarningMacro(<< neighbours.unfit
                       << " periodic face pair(s) of the input's block model do not fit its "
                          "grid (changed after meshing?); they are measured as boundaries.");
     }
-    blockforge::computeGridQuality(blocks, links, outputs,
+    if (neighbours.missingModel)
+    {
+      vtkWarningMacro("The input carries no BlockForge model naming its blocks: faces between "
+                      "blocks on different MPI ranks are measured as boundaries.");
+    }
+    blockforge::computeGridQuality(blocks, neighbours.links, neighbours.layers, outputs,
       [this](double fraction) { this->UpdateProgress(0.9 * fraction); });
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro(<< error.what());
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
     return 0;
   }
 
@@ -271,13 +268,8 @@ int vtkGridQuality::RequestData(
     }
   }
 
-  // Reduce only when the pipeline runs in pieces: a plain serial pipeline inside an MPI
-  // program (e.g. on one rank of pvbatch) must not wait for ranks that never join.
-  const int pieceCount = outputVector->GetInformationObject(0)->Get(
-    vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
-  if (auto* controller = vtkMultiProcessController::GetGlobalController())
+  if (controller)
   {
-    if (pieceCount > 1 && controller->GetNumberOfProcesses() > 1)
     {
       std::array<double, 5> classTotal{};
       std::array<double, 6> minTotal{}, maxTotal{}, sumTotal{};
@@ -358,4 +350,5 @@ int vtkGridQuality::RequestData(
 void vtkGridQuality::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
+  os << indent << "MaximumMemory: " << this->MaximumMemory << " GB\n";
 }

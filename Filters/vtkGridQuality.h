@@ -24,8 +24,10 @@
  * Periodic faces are paired when the input carries its block model (the mesher's output
  * does): the model's topology names the periodic pairs and their rotation, and across a
  * periodic face the partner cell's centre is rotated into place, as OpenFOAM's cyclic
- * patches do. Under MPI only pairs whose two blocks are on the same rank are paired so
- * far; the others count as boundary faces.
+ * patches do. Under MPI (the pipeline in pieces on several ranks) the ranks exchange the
+ * two node layers beside every interface and periodic face between their blocks, so
+ * every measure equals the serial run's bit for bit. Large blocks are measured on
+ * threads (vtkSMPTools), with the same bits.
  *
  * @sa vtkBlockMesher
  */
@@ -42,6 +44,13 @@ public:
   vtkTypeMacro(vtkGridQuality, vtkMultiBlockDataSetAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
+  ///@{
+  /// Largest memory the quality arrays may take, in GB (2^30 bytes); 0 (default) = only
+  /// what the machine has available. Checked before anything is allocated.
+  vtkSetMacro(MaximumMemory, double);
+  vtkGetMacro(MaximumMemory, double);
+  ///@}
+
 protected:
   vtkGridQuality();
   ~vtkGridQuality() override = default;
@@ -49,6 +58,8 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int FillOutputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  double MaximumMemory = 0.0;
 
 private:
   vtkGridQuality(const vtkGridQuality&) = delete;

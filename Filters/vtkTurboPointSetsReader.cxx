@@ -2,6 +2,8 @@
 
 #include "TurboPointSets.h"
 
+#include "BlockForgeModelIO.h"
+
 #include <vtkCellArray.h>
 #include <vtkCompositeDataSet.h>
 #include <vtkDoubleArray.h>
@@ -31,6 +33,23 @@ void addString(vtkFieldData* fields, const char* name, const std::string& value)
   array->SetName(name);
   array->InsertNextValue(value);
   fields->AddArray(array);
+}
+
+std::string closureName(blockforge::io::Closure closure, blockforge::io::EdgeCap cap)
+{
+  switch (closure)
+  {
+    case blockforge::io::Closure::Open:
+      return "open";
+    case blockforge::io::Closure::Joined:
+      return "joined";
+    case blockforge::io::Closure::Segment:
+      return "segment";
+    case blockforge::io::Closure::Capped:
+      return cap == blockforge::io::EdgeCap::Rounded ? "capped rounded" : "capped straight";
+    default:
+      return "closed";
+  }
 }
 
 void addInt(vtkFieldData* fields, const char* name, int value)
@@ -131,6 +150,8 @@ int vtkTurboPointSetsReader::RequestData(
   options.bladeCount = this->BladeCount;
   options.axis = text(this->Axis);
   options.units = text(this->Units);
+  options.cap = this->TrailingEdgeCap == Rounded ? blockforge::io::EdgeCap::Rounded
+                                                 : blockforge::io::EdgeCap::Straight;
   if (text(this->FileName).empty() && options.hubFile.empty() && options.shroudFile.empty() &&
     options.profileFile.empty())
   {
@@ -149,7 +170,7 @@ int vtkTurboPointSetsReader::RequestData(
         [this](double fraction) { this->UpdateProgress(0.8 * fraction); });
     for (const auto& warning : sets.warnings)
     {
-      vtkWarningMacro(<< warning);
+      vtkWarningMacro(<< blockforge::vtkglue::printable(warning.c_str()));
     }
 
     const bool holdsData = piece == 0;
@@ -178,6 +199,8 @@ int vtkTurboPointSetsReader::RequestData(
         addDoubles(curve->GetFieldData(), "SpanFraction", &fraction, 1);
         addInt(curve->GetFieldData(), "SpanGiven", section.spanGiven ? 1 : 0);
         addInt(curve->GetFieldData(), "ProfileNumber", section.number);
+        addString(curve->GetFieldData(), "Closure", closureName(section.closure, options.cap));
+        addDoubles(curve->GetFieldData(), "GapFraction", &section.gapFraction, 1);
         if (!section.blade.empty())
         {
           addString(curve->GetFieldData(), "BladeName", section.blade);
@@ -204,7 +227,7 @@ int vtkTurboPointSetsReader::RequestData(
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro(<< error.what());
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
     output->Initialize();
     return 0;
   }
@@ -223,5 +246,6 @@ void vtkTurboPointSetsReader::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ProfileFile: " << show(this->ProfileFile) << "\n";
   os << indent << "BladeCount: " << this->BladeCount << "\n";
   os << indent << "Axis: " << show(this->Axis) << "\n";
+  os << indent << "TrailingEdgeCap: " << this->TrailingEdgeCap << "\n";
   os << indent << "Units: " << show(this->Units) << "\n";
 }

@@ -25,7 +25,11 @@
  * - block 2 "Profiles": a vtkMultiBlockDataSet of one vtkPolyData polyline per blade
  *   section, named "Profile k (s%)" (prefixed by the blade name when a `## name` line
  *   tells several blades apart), with field data "SpanFraction" (s / 100; spread evenly
- *   when the file gives no spans, then "SpanGiven" is 0), "SpanGiven", "ProfileNumber".
+ *   when the file gives no spans, then "SpanGiven" is 0), "SpanGiven", "ProfileNumber",
+ *   "Closure" ("closed", "joined", "segment" (first point repeated), "capped straight",
+ *   "capped rounded" or "open": what
+ *   was done to a section whose first and last points differ) and "GapFraction" (that
+ *   gap over the chord, 0 when the file closed the section).
  * Every curve also carries "SourceFile" and "FirstLine" in its field data.
  *
  * Units: point coordinates are converted to metres, so that every later stage works in
@@ -36,10 +40,15 @@
  * through the origin of the file's coordinates) and "AxisName" ("X", "-Z", ...).
  * Coordinates are not rotated: the axis is wherever the export put it.
  *
+ * Sections: every comment or blank line between point rows starts a new section. Open
+ * sections are closed (TrailingEdgeCap), sections are put in span order, and contours or
+ * sections that turn back or cross themselves are refused (see Filters/IO/SectionChecks.h).
+ *
  * Errors (missing or malformed file, malformed row, NaN, a section with fewer than 4
- * points, unknown unit or axis) are reported with vtkErrorMacro as "file:line: what"
- * and leave the output empty. Non-fatal remarks (a part missing from the .inf, spans
- * guessed) are warnings. In parallel, piece 0 holds the curves; the other pieces have the
+ * points, unknown unit or axis, sections whose header spans contradict their place between
+ * hub and shroud, kinked or self-crossing curves) are reported with vtkErrorMacro as
+ * "file:line: what" and leave the output empty. Non-fatal remarks (a part missing from
+ * the .inf, spans guessed, sections closed or sorted) are warnings. In parallel, piece 0 holds the curves; the other pieces have the
  * same block structure with null leaves.
  *
  * @sa vtkBlockTemplateSource vtkBlockMesher
@@ -94,6 +103,19 @@ public:
   vtkGetStringMacro(Units);
   ///@}
 
+  ///@{
+  /// How a blade section left open at a blunt trailing edge (a gap between 0.2 % and 5 %
+  /// of the chord) is closed: Straight (0, default) or Rounded (1, a half circle across
+  /// the gap). Gaps up to 0.2 % are joined, larger than 5 % left open.
+  enum TrailingEdgeCaps
+  {
+    Straight = 0,
+    Rounded = 1
+  };
+  vtkSetClampMacro(TrailingEdgeCap, int, Straight, Rounded);
+  vtkGetMacro(TrailingEdgeCap, int);
+  ///@}
+
   /// 1 if the file looks like one this reader reads (a description file with a known key,
   /// or X Y Z rows), judged from its first 64 kB. Lets ParaView choose between readers
   /// that share an extension (.dat is also Tecplot's).
@@ -113,6 +135,7 @@ protected:
   int BladeCount = 0;
   char* Axis = nullptr;
   char* Units = nullptr;
+  int TrailingEdgeCap = Straight;
 
 private:
   vtkTurboPointSetsReader(const vtkTurboPointSetsReader&) = delete;

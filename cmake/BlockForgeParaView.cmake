@@ -37,7 +37,7 @@ vtk_module_wrap_python(
   INSTALL_EXPORT    BlockForgePython)
 
 # The pure-Python part of the package (imports the wrapped classes, adds helpers).
-set(blockforge_python_files __init__.py __main__.py)
+set(blockforge_python_files __init__.py __main__.py output.py writers.py)
 foreach(file IN LISTS blockforge_python_files)
   configure_file("${PROJECT_SOURCE_DIR}/Python/blockforge/${file}"
     "${CMAKE_BINARY_DIR}/${BLOCKFORGE_PYTHON_DESTINATION}/blockforge/${file}" COPYONLY)

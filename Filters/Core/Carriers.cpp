@@ -390,53 +390,51 @@ Vec3 SurfaceOfRevolution::point(double s, double t) const
     rotateVector(Contour->point(s) - AxisPoint, AxisDirection, std::cos(angle), std::sin(angle));
 }
 
-void SurfaceOfRevolution::derivatives(double s, double t, SurfaceDerivatives& out) const
+void SurfaceOfRevolution::contourJet(double s, int order, Vec3 (&c)[3]) const
 {
-  Vec3 c[3];
   if (const auto* spline = dynamic_cast<const BSplineCurve*>(Contour.get()))
   {
-    spline->derivatives(s, 2, c);
+    spline->derivatives(s, order, c);
+    return;
   }
-  else
-  {
-    c[0] = Contour->point(s);
-    c[1] = Contour->derivative(s, 1);
-    c[2] = Contour->derivative(s, 2);
-  }
+  c[0] = Contour->point(s);
+  c[1] = Contour->derivative(s, 1);
+  c[2] = order >= 2 ? Contour->derivative(s, 2) : Vec3::Zero();
+}
+
+void SurfaceOfRevolution::derivatives(double s, double t, SurfaceDerivatives& out) const
+{
+  Vec3 c[3], arm;
+  contourJet(s, 2, c);
+  double cs = 0.0, sn = 0.0;
+  firstOrder(c, t, out.P, out.Ps, out.Pt, cs, sn, arm);
   const double sweep = AngleEnd - AngleStart;
-  const double angle = AngleStart + t * sweep;
-  const double cs = std::cos(angle), sn = std::sin(angle);
   const Vec3& k = AxisDirection;
-  const Vec3 arm = angle == 0.0 ? Vec3(c[0] - AxisPoint) : rotateVector(c[0] - AxisPoint, k, cs, sn);
-  out.P = angle == 0.0 ? c[0] : Vec3(AxisPoint + arm);
-  out.Ps = rotateVector(c[1], k, cs, sn);
   out.Pss = rotateVector(c[2], k, cs, sn);
-  // d/dangle of a rotation is k x (rotated vector).
-  out.Pt = sweep * k.cross(arm);
   out.Ptt = sweep * sweep * k.cross(k.cross(arm));
   out.Pst = sweep * k.cross(out.Ps);
 }
 
-// The same as derivatives() without the second-order terms.
 void SurfaceOfRevolution::firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const
 {
-  Vec3 c[3];
-  if (const auto* spline = dynamic_cast<const BSplineCurve*>(Contour.get()))
-  {
-    spline->derivatives(s, 1, c);
-  }
-  else
-  {
-    c[0] = Contour->point(s);
-    c[1] = Contour->derivative(s, 1);
-  }
+  Vec3 c[3], arm;
+  contourJet(s, 1, c);
+  double cs = 0.0, sn = 0.0;
+  firstOrder(c, t, P, Ps, Pt, cs, sn, arm);
+}
+
+void SurfaceOfRevolution::firstOrder(const Vec3 (&c)[3], double t, Vec3& P, Vec3& Ps, Vec3& Pt,
+  double& cs, double& sn, Vec3& arm) const
+{
   const double sweep = AngleEnd - AngleStart;
   const double angle = AngleStart + t * sweep;
-  const double cs = std::cos(angle), sn = std::sin(angle);
+  cs = std::cos(angle);
+  sn = std::sin(angle);
   const Vec3& k = AxisDirection;
-  const Vec3 arm = angle == 0.0 ? Vec3(c[0] - AxisPoint) : rotateVector(c[0] - AxisPoint, k, cs, sn);
+  arm = angle == 0.0 ? Vec3(c[0] - AxisPoint) : rotateVector(c[0] - AxisPoint, k, cs, sn);
   P = angle == 0.0 ? c[0] : Vec3(AxisPoint + arm);
   Ps = rotateVector(c[1], k, cs, sn);
+  // d/dangle of a rotation is k x (rotated vector).
   Pt = sweep * k.cross(arm);
 }
 
@@ -950,6 +948,7 @@ public:
 
   double f(double s, double t) const
   {
+    WorkBudget::charge();
     return Revolution.signedMeridionalDistance(Surface.point(s, t));
   }
 
@@ -1060,8 +1059,12 @@ private:
 } // namespace
 
 std::shared_ptr<SurfaceCurve> intersectWithRevolution(std::shared_ptr<const GordonSurface> surface,
-  const SurfaceOfRevolution& revolution, double tMin, double tMax, int samples)
+  const SurfaceOfRevolution& revolution, double tMin, double tMax, int samples,
+  WorkBudget* budget)
 {
+  WorkBudget ownBudget(IntersectionWorkLimit, "intersection with a surface of revolution");
+  WorkBudget& work = budget ? *budget : ownBudget;
+  const WorkBudget::Scope scope(work);
   if (!surface)
   {
     throw GeometryError("intersection with a surface of revolution: no surface given");
@@ -1216,11 +1219,13 @@ struct OffsetSample
 {
   double u;
   Vec3 point;
-  Vec3 normal; // unit normal of the curve within the surface
+  Vec3 normal;        // unit normal of the curve within the surface
+  Vec3 surfaceNormal; // unit normal of the surface there
 };
 
 Vec3 inSurfaceNormal(const Curve& curve, const Surface& surface,
-  const SurfaceParameterFunction& toParameters, double u, const Vec3& point)
+  const SurfaceParameterFunction& toParameters, double u, const Vec3& point,
+  Vec3& unitSurfaceNormal)
 {
   Vec3 tangent = curve.derivative(u);
   if (!(tangent.norm() > 0.0) || !tangent.allFinite())
@@ -1241,9 +1246,126 @@ Vec3 inSurfaceNormal(const Curve& curve, const Surface& surface,
             << u;
     throw GeometryError(message.str());
   }
+  unitSurfaceNormal = surfaceNormal.normalized();
   return normal.normalized();
 }
+/// Where segment a0-a1 crosses segment b0-b1 in the plane (e1, e2): true and the point.
+bool crossing(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1, const Vec3& e1,
+  const Vec3& e2, Vec3& at)
+{
+  auto flat = [&](const Vec3& p) { return Eigen::Vector2d(p.dot(e1), p.dot(e2)); };
+  const Eigen::Vector2d p = flat(a0), r = flat(a1) - p, q = flat(b0), w = flat(b1) - q;
+  const double denominator = r.x() * w.y() - r.y() * w.x();
+  if (denominator == 0.0)
+  {
+    return false;
+  }
+  const Eigen::Vector2d d = q - p;
+  const double ta = (d.x() * w.y() - d.y() * w.x()) / denominator;
+  const double tb = (d.x() * r.y() - d.y() * r.x()) / denominator;
+  if (ta < 0.0 || ta > 1.0 || tb < 0.0 || tb > 1.0)
+  {
+    return false;
+  }
+  at = a0 + ta * (a1 - a0);
+  return true;
+}
+
+/**
+ * Removes the swallowtails of an offset: where the curve bends with a radius of curvature
+ * below the distance on the side it is offset to (a sharp or spline-wiggled leading edge,
+ * the corners of a capped trailing edge), consecutive offset points run backwards and the
+ * offset crosses itself. The loop between the two crossing segments is cut out and
+ * replaced by the crossing point, as the boundary of the region within `distance` of the
+ * curve has it. Elsewhere the offset points stay at their normals, so the O-grid's
+ * first layer stays orthogonal to the curve. Throws GeometryError when a fold has no
+ * crossing nearby (the offset folds globally: the distance exceeds the curve's size).
+ */
+void trimOffsetFolds(std::vector<OffsetSample>& samples, std::vector<Vec3>& offset,
+  double distance, double side, bool closed)
+{
+  // Backwards offset steps only where the curve turns towards the offset side: across a
+  // sharp convex corner (its normals turn away from that side) the curve's own step is no
+  // guide to the offset's direction, and the offset is a fan, not a fold.
+  auto folds = [&](std::size_t k) {
+    const Vec3 along = samples[k].point - samples[k - 1].point;
+    const double turn = side * distance *
+      samples[k - 1].normal.cross(samples[k].normal).dot(samples[k].surfaceNormal);
+    return along.norm() > 0.0 && (offset[k] - offset[k - 1]).dot(along) <= 0.0 &&
+      turn >= 0.0;
+  };
+  auto fail = [&](std::size_t k) {
+    std::ostringstream message;
+    message << "offset on a surface: the offset by " << distance << " folds back near u = "
+            << samples[k].u
+            << " and does not cross itself nearby (the distance is larger than the curve "
+               "is wide there); use a smaller distance";
+    throw GeometryError(message.str());
+  };
+  std::size_t k = 1;
+  int cuts = 0;
+  while (k < offset.size())
+  {
+    if (!folds(k))
+    {
+      ++k;
+      continue;
+    }
+    if (++cuts > 10000)
+    {
+      fail(k);
+    }
+    // The backward run [k, end): the loop's crossing lies before k and at or after end.
+    std::size_t end = k + 1;
+    while (end < offset.size() && folds(end))
+    {
+      ++end;
+    }
+    // The plane of the fold: the curve's tangent there and the in-surface normal.
+    const Vec3 e2 = samples[k].normal;
+    const Vec3 e1 = e2.cross(samples[k].surfaceNormal).normalized();
+    bool found = false;
+    std::size_t first = 0, last = 0;
+    Vec3 point;
+    const std::size_t widest = std::min<std::size_t>(offset.size(), 4096);
+    for (std::size_t width = 8; !found && width <= widest; width *= 2)
+    {
+      const std::size_t low = k > width ? k - width : 1;
+      const std::size_t high = std::min(offset.size() - 1, end + width);
+      // The tightest loop around the run: the latest start, then the earliest end.
+      for (std::size_t i = k - 1; i >= low && !found; --i)
+      {
+        for (std::size_t j = end; j <= high && !found; ++j)
+        {
+          // (A closed loop's first and last segments meet at the seam: not a crossing.)
+          found = j > i + 1 && !(closed && i == 1 && j == offset.size() - 1) &&
+            crossing(offset[i - 1], offset[i], offset[j - 1], offset[j], e1, e2, point);
+          first = i;
+          last = j;
+        }
+      }
+    }
+    if (!found)
+    {
+      // A fold too small to cross itself between samples (a zig-zag of a few samples at a
+      // wiggle of the curve): drop the points that run backwards.
+      if (end - k > 16)
+      {
+        fail(k);
+      }
+      offset.erase(offset.begin() + k, offset.begin() + end);
+      samples.erase(samples.begin() + k, samples.begin() + end);
+      continue;
+    }
+    // Keep offset[0 .. first - 1], the crossing, offset[last ..].
+    offset[first] = point;
+    offset.erase(offset.begin() + first + 1, offset.begin() + last);
+    samples.erase(samples.begin() + first + 1, samples.begin() + last);
+    k = std::max<std::size_t>(first, 1);
+  }
+}
 } // namespace
+
 
 std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
   const Surface& surface, const SurfaceParameterFunction& toParameters, double distance)
@@ -1258,12 +1380,15 @@ std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
     throw GeometryError("offset on a surface: the curve is said to be closed but its ends "
                         "do not meet");
   }
+  WorkBudget work(OffsetWorkLimit, "offset on a surface");
+  const WorkBudget::Scope scope(work);
   constexpr int InitialSteps = 512;
   constexpr std::size_t MaxSamples = 65536;
   const double turnLimit = std::cos(3.0 * std::acos(-1.0) / 180.0);
   auto sampleAt = [&](double u) {
-    OffsetSample sample{ u, curve.point(u), Vec3::Zero() };
-    sample.normal = inSurfaceNormal(curve, surface, toParameters, u, sample.point);
+    OffsetSample sample{ u, curve.point(u), Vec3::Zero(), Vec3::Zero() };
+    sample.normal =
+      inSurfaceNormal(curve, surface, toParameters, u, sample.point, sample.surfaceNormal);
     return sample;
   };
 
@@ -1312,15 +1437,17 @@ std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
       centroid += samples[k].point;
     }
     centroid /= static_cast<double>(samples.size() - 1);
-    std::size_t farthest = 0;
-    for (std::size_t k = 1; k + 1 < samples.size(); ++k)
+    // Outward normals give a positive flux of (p - centroid) through the loop (twice its
+    // area, by the divergence theorem); one point's normal (the farthest, say) is not
+    // enough at a sharp edge, where it may point either way.
+    double flux = 0.0;
+    for (std::size_t k = 1; k < samples.size(); ++k)
     {
-      if ((samples[k].point - centroid).norm() > (samples[farthest].point - centroid).norm())
-      {
-        farthest = k;
-      }
+      const double length = (samples[k].point - samples[k - 1].point).norm();
+      const Vec3 middle = 0.5 * (samples[k].point + samples[k - 1].point) - centroid;
+      flux += length * middle.dot(samples[k].normal + samples[k - 1].normal);
     }
-    if (samples[farthest].normal.dot(samples[farthest].point - centroid) < 0.0)
+    if (flux < 0.0)
     {
       side = -1.0;
     }
@@ -1331,16 +1458,27 @@ std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
   {
     offset[k] = samples[k].point + side * distance * samples[k].normal;
   }
-  for (std::size_t k = 1; k < samples.size(); ++k)
+  const std::vector<OffsetSample> curveSamples = samples;
+  trimOffsetFolds(samples, offset, distance, side, closed);
+  // What is left must keep its distance from the whole curve: cutting loops cannot mend
+  // an offset that turns inside out (inwards past the middle of a closed curve).
+  const std::size_t stride =
+    std::max<std::size_t>(1, offset.size() * curveSamples.size() / 4000000);
+  for (std::size_t k = 0; k < offset.size(); k += stride)
   {
-    const Vec3 along = samples[k].point - samples[k - 1].point;
-    if (along.norm() > 0.0 && (offset[k] - offset[k - 1]).dot(along) <= 0.0)
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const OffsetSample& c : curveSamples)
+    {
+      nearest = std::min(nearest, (offset[k] - c.point).norm());
+    }
+    if (nearest < 0.9 * std::abs(distance))
     {
       std::ostringstream message;
-      message << "offset on a surface: the offset by " << distance
-              << " folds back near u = " << samples[k].u
-              << " (the curve bends there with a radius of curvature smaller than the "
-                 "distance); use a smaller distance";
+      message << "offset on a surface: the offset by " << distance << " folds back near u = "
+              << samples[k].u
+              << " and comes within " << nearest
+              << " of the curve (the distance is larger than the curve is wide there); use a "
+                 "smaller distance";
       throw GeometryError(message.str());
     }
   }

@@ -13,6 +13,7 @@
 #include "BSpline.h"
 #include "Projection.h"
 #include "Surface.h"
+#include "WorkBudget.h"
 
 #include <Eigen/Core>
 
@@ -65,6 +66,11 @@ public:
   double contourParameter(const Vec3& p) const;
 
 private:
+  /// Point and derivatives of the contour at s up to `order` (1 or 2).
+  void contourJet(double s, int order, Vec3 (&c)[3]) const;
+  /// Point and first derivatives from the contour's jet, with the rotation at t.
+  void firstOrder(const Vec3 (&c)[3], double t, Vec3& P, Vec3& Ps, Vec3& Pt, double& cs,
+    double& sn, Vec3& arm) const;
   CurvePtr Contour;
   Vec3 AxisPoint, AxisDirection;
   double AngleStart, AngleEnd;
@@ -207,10 +213,19 @@ private:
  * Closed sections (P(0, t) == P(1, t)) get the same t at s = 0 and s = 1, so the curve
  * closes exactly. Throws GeometryError naming the s where no intersection exists in the
  * range.
+ *
+ * The whole search is bounded: every curve evaluation of the meridional projections and
+ * every evaluation of the distance is charged to `budget` (default: a fresh one of
+ * IntersectionWorkLimit units, over 6 times what the Rotor 37 and distributor blades
+ * need), and a GeometryError ends it when the budget is spent, so kinked or spiky input
+ * fails in a fraction of a second.
  */
 std::shared_ptr<SurfaceCurve> intersectWithRevolution(std::shared_ptr<const GordonSurface> surface,
   const SurfaceOfRevolution& revolution, double tMin = -0.5, double tMax = 1.5,
-  int samples = 64);
+  int samples = 64, WorkBudget* budget = nullptr);
+
+/// Work units intersectWithRevolution may spend by default (see there).
+constexpr std::size_t IntersectionWorkLimit = 1000000;
 
 /// Closest point of a surface to p, as its parameters (s, t): how offsetOnSurface maps the
 /// offset points back onto the surface.
@@ -228,9 +243,15 @@ using SurfaceParameterFunction = std::function<Eigen::Vector2d(const Vec3& p)>;
  * the surface, in the order of u, to be interpolated (SurfaceCurve).
  *
  * `closed` curves (P(0) == P(1)) are offset outwards for distance > 0, whatever their
- * orientation (the side n points to at the curve point farthest from the centroid of the
- * samples decides), and the returned loop closes exactly (the seam normal is the mean of
- * the normals at u = 0 and 1). Open curves are offset towards +n.
+ * orientation (the sign of the flux of p - centroid through the loop along n decides, which
+ * a sharp edge cannot fool), and the returned loop closes exactly (the seam normal is the
+ * mean of the normals at u = 0 and 1). Open curves are offset towards +n.
+ *
+ * Where the curve bends with a radius of curvature below |distance| on the side it is
+ * offset to (a sharp leading edge, the wiggles of a spline through a capped trailing
+ * edge), the raw offset folds back in a swallowtail; the loop is cut out at the offset's
+ * crossing, as the boundary of the region within the distance has it. Everywhere else
+ * the offset points stay on the curve's normals.
  *
  * Sampling starts with 512 equal steps of u and halves every step across which the normal
  * turns by more than 3 degrees, so a leading edge whose radius is 1e-3 of the curve's
@@ -238,11 +259,15 @@ using SurfaceParameterFunction = std::function<Eigen::Vector2d(const Vec3& p)>;
  * past that the remaining steps are not refined). Deterministic.
  *
  * Throws GeometryError when |distance| is zero or not finite, when a `closed` curve's ends
- * do not meet, when the offset folds back between two samples (|distance| above the
- * radius of curvature on the side it is offset to: consecutive offset points run against
- * the curve), naming the parameter u where it folds, and when the tangent or the surface
- * normal vanish.
+ * do not meet, when the offset folds back without crossing itself nearby (the distance
+ * is larger than the curve is wide: an inward offset past the middle), naming the
+ * parameter u where it folds, when the tangent or the surface normal vanish, and when
+ * the projections of the samples (`toParameters`, charged to the current WorkBudget)
+ * need more than OffsetWorkLimit curve evaluations in all.
  */
 std::vector<Eigen::Vector2d> offsetOnSurface(const Curve& curve, bool closed,
   const Surface& surface, const SurfaceParameterFunction& toParameters, double distance);
+
+/// Work units offsetOnSurface may spend (see there).
+constexpr std::size_t OffsetWorkLimit = 500000;
 } // namespace blockforge

@@ -1,5 +1,7 @@
 #include "Projection.h"
 
+#include "WorkBudget.h"
+
 #include "BSpline.h"
 
 #include <algorithm>
@@ -35,6 +37,7 @@ public:
 
   void evaluate(double t, CurveJet& jet) const
   {
+    WorkBudget::charge();
     if (Spline)
     {
       Vec3 values[3];
@@ -177,6 +180,7 @@ struct SurfaceState
 
 void evaluateState(const Surface& surface, const Vec3& p, SurfaceState& state)
 {
+  WorkBudget::charge();
   surface.derivatives(state.s, state.t, state.d);
   state.residual = state.d.P - p;
   state.f = 0.5 * state.residual.squaredNorm();

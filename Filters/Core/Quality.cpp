@@ -12,6 +12,9 @@
  * degenerate cells) take the literal formulas, for that lane only.
  */
 #include "Quality.h"
+#include "QualityKernels.h"
+
+#include "Parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,793 +28,10 @@
 
 namespace blockforge
 {
+using namespace quality;
+
 namespace
 {
-// OpenFOAM's guards (rootVSmall, vSmall) and Verdict's clamp values.
-constexpr double rootVSmall = 1.0e-150;
-constexpr double vSmall = 1.0e-300;
-constexpr double verdictMin = 1.0e-30;
-constexpr double verdictMax = 1.0e30;
-constexpr double radiansToDegrees = 57.295779513082320876798;
-/// An edge shorter than this fraction of the cell's longest edge is collapsed.
-constexpr double collapsedEdgeFraction = 1.0e-14;
-/// A face whose area is below this fraction of its squared diagonals has no normal.
-constexpr double collapsedFaceFraction = 1.0e-12;
-/// Aspect ratio reported for a cell with a zero mean width (Verdict's "infinite").
-constexpr double degenerateAspectRatio = verdictMax;
-
-// ---------------------------------------------------------------------------------------
-// Lane arithmetic: the kernels are templates on T = double (one cell) or Lanes (several).
-
-/**
- * Several cells processed together in one SIMD register: Eigen's packet of doubles for
- * the build's instruction set (2 lanes with SSE2, which every x86-64 CPU has; 1 lane
- * when Eigen does not vectorise). A thin wrapper over Eigen's packet primitives rather
- * than Eigen::Array2d, whose expression templates were not always inlined here.
- */
-namespace packet = Eigen::internal;
-using Packet = packet::packet_traits<double>::type;
-constexpr int packetLanes = packet::packet_traits<double>::size;
-
-struct Lanes
-{
-  Packet v;
-
-  static Lanes load(const double* p) { return { packet::ploadu<Packet>(p) }; }
-  static Lanes splat(double s) { return { packet::pset1<Packet>(s) }; }
-  void store(double* p) const { packet::pstoreu(p, v); }
-  void extract(double (&out)[packetLanes]) const { packet::pstoreu(out, v); }
-  void set(int l, double value)
-  {
-    double out[packetLanes];
-    extract(out);
-    out[l] = value;
-    v = packet::ploadu<Packet>(out);
-  }
-  friend Lanes operator+(const Lanes& a, const Lanes& b) { return { packet::padd(a.v, b.v) }; }
-  friend Lanes operator-(const Lanes& a, const Lanes& b) { return { packet::psub(a.v, b.v) }; }
-  friend Lanes operator*(const Lanes& a, const Lanes& b) { return { packet::pmul(a.v, b.v) }; }
-  friend Lanes operator/(const Lanes& a, const Lanes& b) { return { packet::pdiv(a.v, b.v) }; }
-  friend Lanes operator*(double s, const Lanes& a) { return splat(s) * a; }
-  friend Lanes operator/(double s, const Lanes& a) { return splat(s) / a; }
-  friend Lanes operator+(const Lanes& a, double s) { return a + splat(s); }
-  friend Lanes vmin(const Lanes& a, const Lanes& b) { return { packet::pmin(a.v, b.v) }; }
-  friend Lanes vmax(const Lanes& a, const Lanes& b) { return { packet::pmax(a.v, b.v) }; }
-  friend Lanes vsqrt(const Lanes& a) { return { packet::psqrt(a.v) }; }
-  friend Lanes vabs(const Lanes& a) { return { packet::pabs(a.v) }; }
-};
-
-inline double vmin(double a, double b)
-{
-  return std::min(a, b);
-}
-inline double vmax(double a, double b)
-{
-  return std::max(a, b);
-}
-inline double vabs(double a)
-{
-  return std::abs(a);
-}
-inline double vsqrt(double a)
-{
-  return std::sqrt(a);
-}
-
-template <typename T>
-constexpr int laneCount = 1;
-template <>
-constexpr int laneCount<Lanes> = packetLanes;
-
-template <typename T>
-T splat(double value);
-template <>
-inline double splat<double>(double value)
-{
-  return value;
-}
-template <>
-inline Lanes splat<Lanes>(double value)
-{
-  return Lanes::splat(value);
-}
-
-template <typename T>
-T loadLanes(const double* p);
-template <>
-inline double loadLanes<double>(const double* p)
-{
-  return *p;
-}
-template <>
-inline Lanes loadLanes<Lanes>(const double* p)
-{
-  return Lanes::load(p);
-}
-inline void storeLanes(double* p, double v)
-{
-  *p = v;
-}
-inline void storeLanes(double* p, const Lanes& v)
-{
-  v.store(p);
-}
-/// All lanes of a value as plain doubles.
-inline void extractLanes(double v, double (&out)[1])
-{
-  out[0] = v;
-}
-inline void extractLanes(const Lanes& v, double (&out)[packetLanes])
-{
-  v.extract(out);
-}
-inline void setLane(double& v, int, double value)
-{
-  v = value;
-}
-inline void setLane(Lanes& v, int l, double value)
-{
-  v.set(l, value);
-}
-
-template <typename T>
-struct V3
-{
-  T x, y, z;
-};
-using P3 = V3<double>;
-
-template <typename T>
-inline V3<T> operator-(const V3<T>& a, const V3<T>& b)
-{
-  return { a.x - b.x, a.y - b.y, a.z - b.z };
-}
-template <typename T>
-inline V3<T> operator+(const V3<T>& a, const V3<T>& b)
-{
-  return { a.x + b.x, a.y + b.y, a.z + b.z };
-}
-template <typename T>
-inline V3<T> operator*(const T& s, const V3<T>& a)
-{
-  return { s * a.x, s * a.y, s * a.z };
-}
-template <typename T>
-inline V3<T> operator*(double s, const V3<T>& a)
-{
-  return { s * a.x, s * a.y, s * a.z };
-}
-inline P3 operator*(double s, const P3& a)
-{
-  return { s * a.x, s * a.y, s * a.z };
-}
-template <typename T>
-inline T dot(const V3<T>& a, const V3<T>& b)
-{
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-template <typename T>
-inline V3<T> cross(const V3<T>& a, const V3<T>& b)
-{
-  return { a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x };
-}
-template <typename T>
-inline V3<T> loadV3(const double* x, const double* y, const double* z)
-{
-  return { loadLanes<T>(x), loadLanes<T>(y), loadLanes<T>(z) };
-}
-template <typename T>
-inline P3 laneOf(const V3<T>& v, int l)
-{
-  double x[laneCount<T>], y[laneCount<T>], z[laneCount<T>];
-  extractLanes(v.x, x);
-  extractLanes(v.y, y);
-  extractLanes(v.z, z);
-  return { x[l], y[l], z[l] };
-}
-inline P3 load(const double* p)
-{
-  return { p[0], p[1], p[2] };
-}
-inline P3 toP3(const Vec3& v)
-{
-  return { v.x(), v.y(), v.z() };
-}
-inline Vec3 toVec3(const P3& p)
-{
-  return Vec3(p.x, p.y, p.z);
-}
-inline double clampCosine(double c)
-{
-  return std::min(1.0, std::max(-1.0, c));
-}
-inline double angleFromCosine(double c)
-{
-  return std::acos(clampCosine(c)) * radiansToDegrees;
-}
-
-// ---------------------------------------------------------------------------------------
-// Cell shape: angles, scaled Jacobian, aspect ratio
-
-// Hexahedron topology in VTK order. Edges are directed along increasing s, t or u, as in
-// the block notation of Transfinite.h, so a grid edge has the same vector in all cells.
-constexpr int edgeEnds[12][2] = { { 0, 1 }, { 1, 2 }, { 3, 2 }, { 0, 3 }, { 4, 5 }, { 5, 6 },
-  { 7, 6 }, { 4, 7 }, { 0, 4 }, { 1, 5 }, { 2, 6 }, { 3, 7 } };
-// vtkHexahedron's faces.
-constexpr int hexFaces[6][4] = { { 0, 4, 7, 3 }, { 1, 2, 6, 5 }, { 0, 1, 5, 4 }, { 3, 7, 6, 2 },
-  { 0, 3, 2, 1 }, { 4, 5, 6, 7 } };
-
-struct CellShape
-{
-  double minAngle, maxAngle, scaledJacobian, aspectRatio;
-};
-
-/// What the branch-free kernel leaves for the per-lane finish.
-template <typename T>
-struct ShapeSums
-{
-  T minCos, maxCos;      ///< over the 24 face corners (valid without collapsed edges)
-  T minCornerJacobian;   ///< scaled, over the 8 corners
-  T centreJacobian;      ///< scaled (NaN for a degenerate centre, not used then)
-  T shortest2, longest2; ///< squared edge lengths
-  T shortestAxis2;       ///< smallest squared efg vector
-  T narrowest, widest;   ///< mean widths
-};
-
-template <typename T>
-inline void edgeVectors(const V3<T> (&c)[8], V3<T> (&e)[12])
-{
-  for (int n = 0; n < 12; ++n)
-  {
-    e[n] = c[edgeEnds[n][1]] - c[edgeEnds[n][0]];
-  }
-}
-
-/// Accumulates one hexahedron corner: the vectors to its three neighbours are
-/// sa*E[ea], sb*E[eb], sw*E[ew] (Verdict's xi, eta, zeta there). Its three face angles
-/// are the angles between pairs of them; its Jacobian is their triple product.
-template <typename T>
-struct CornerAccumulator
-{
-  const V3<T>* e;
-  const T* inverseLength;
-  T minCos, maxCos, minJacobian;
-
-  template <int ea, int eb, int ew, int sa, int sb, int sw>
-  inline void corner()
-  {
-    const T ia = inverseLength[ea], ib = inverseLength[eb], iw = inverseLength[ew];
-    const T cab = double(sa * sb) * dot(e[ea], e[eb]) * (ia * ib);
-    const T caw = double(sa * sw) * dot(e[ea], e[ew]) * (ia * iw);
-    const T cbw = double(sb * sw) * dot(e[eb], e[ew]) * (ib * iw);
-    minCos = vmin(minCos, vmin(cab, vmin(caw, cbw)));
-    maxCos = vmax(maxCos, vmax(cab, vmax(caw, cbw)));
-    const T jacobian = double(sa * sb * sw) * dot(e[ea], cross(e[eb], e[ew])) * (ia * ib * iw);
-    minJacobian = vmin(minJacobian, jacobian);
-  }
-};
-
-/**
- * Branch-free part of the shape measures, from the edge vectors, squared lengths and
- * inverse lengths (0 for zero length). Angles and the Verdict clamp are finished per
- * lane by finishShape.
- */
-template <typename T>
-inline ShapeSums<T> shapeKernel(
-  const V3<T> (&e)[12], const T (&length2)[12], const T (&inverseLength)[12])
-{
-  ShapeSums<T> sums;
-  CornerAccumulator<T> corners{ e, inverseLength, splat<T>(1.0), splat<T>(-1.0),
-    splat<T>(verdictMax) };
-  corners.template corner<0, 3, 8, 1, 1, 1>();     // V0: V1, V3, V4
-  corners.template corner<1, 0, 9, 1, -1, 1>();    // V1: V2, V0, V5
-  corners.template corner<2, 1, 10, -1, -1, 1>();  // V2: V3, V1, V6
-  corners.template corner<3, 2, 11, -1, 1, 1>();   // V3: V0, V2, V7
-  corners.template corner<7, 4, 8, 1, 1, -1>();    // V4: V7, V5, V0
-  corners.template corner<4, 5, 9, -1, 1, -1>();   // V5: V4, V6, V1
-  corners.template corner<5, 6, 10, -1, -1, -1>(); // V6: V5, V7, V2
-  corners.template corner<6, 7, 11, 1, -1, -1>();  // V7: V6, V4, V3
-  sums.minCos = corners.minCos;
-  sums.maxCos = corners.maxCos;
-  sums.minCornerJacobian = corners.minJacobian;
-
-  // Centre Jacobian from the efg (principal axis) vectors: sums of the 4 parallel edges.
-  const V3<T> xi = (e[0] + e[2]) + (e[4] + e[6]);
-  const V3<T> eta = (e[3] + e[1]) + (e[7] + e[5]);
-  const V3<T> zeta = (e[8] + e[9]) + (e[10] + e[11]);
-  const T xi2 = dot(xi, xi), eta2 = dot(eta, eta), zeta2 = dot(zeta, zeta);
-  sums.centreJacobian = dot(xi, cross(eta, zeta)) / vsqrt(xi2 * eta2 * zeta2);
-  sums.shortestAxis2 = vmin(xi2, vmin(eta2, zeta2));
-
-  T shortest2 = length2[0], longest2 = length2[0];
-  T length[12];
-  for (int n = 0; n < 12; ++n)
-  {
-    shortest2 = vmin(shortest2, length2[n]);
-    longest2 = vmax(longest2, length2[n]);
-    length[n] = length2[n] * inverseLength[n];
-  }
-  sums.shortest2 = shortest2;
-  sums.longest2 = longest2;
-  const T widthS = 0.25 * ((length[0] + length[2]) + (length[4] + length[6]));
-  const T widthT = 0.25 * ((length[3] + length[1]) + (length[7] + length[5]));
-  const T widthU = 0.25 * ((length[8] + length[9]) + (length[10] + length[11]));
-  sums.narrowest = vmin(widthS, vmin(widthT, widthU));
-  sums.widest = vmax(widthS, vmax(widthT, widthU));
-  return sums;
-}
-
-/**
- * Scaled Jacobian of a cell with collapsed edges (a wedge or prism written as a hex).
- * Verdict gives such cells 1e30, which says nothing and ruins colour maps and means, so
- * the grid pass uses the Verdict corner formula on the corners whose three edges all
- * have length, plus the centre Jacobian when its vectors have length: a right wedge gets
- * 1, an inverted one a negative value. 0 when no corner is measurable.
- */
-double collapsedCellScaledJacobian(const P3 (&c)[8])
-{
-  // Verdict's corner order: the three neighbours of each corner, right-handed.
-  static const int neighbours[8][3] = { { 1, 3, 4 }, { 2, 0, 5 }, { 3, 1, 6 }, { 0, 2, 7 },
-    { 7, 5, 0 }, { 4, 6, 1 }, { 5, 7, 2 }, { 6, 4, 3 } };
-  double smallest = verdictMax;
-  bool measured = false;
-  for (int v = 0; v < 8; ++v)
-  {
-    const P3 a = c[neighbours[v][0]] - c[v];
-    const P3 b = c[neighbours[v][1]] - c[v];
-    const P3 d = c[neighbours[v][2]] - c[v];
-    const double a2 = dot(a, a), b2 = dot(b, b), d2 = dot(d, d);
-    if (a2 <= verdictMin || b2 <= verdictMin || d2 <= verdictMin)
-    {
-      continue;
-    }
-    smallest = std::min(smallest, dot(a, cross(b, d)) / std::sqrt(a2 * b2 * d2));
-    measured = true;
-  }
-  const P3 xi = (c[1] - c[0]) + (c[2] - c[3]) + (c[5] - c[4]) + (c[6] - c[7]);
-  const P3 eta = (c[3] - c[0]) + (c[2] - c[1]) + (c[7] - c[4]) + (c[6] - c[5]);
-  const P3 zeta = (c[4] - c[0]) + (c[5] - c[1]) + (c[6] - c[2]) + (c[7] - c[3]);
-  const double xi2 = dot(xi, xi), eta2 = dot(eta, eta), zeta2 = dot(zeta, zeta);
-  if (xi2 > verdictMin && eta2 > verdictMin && zeta2 > verdictMin)
-  {
-    smallest = std::min(smallest, dot(xi, cross(eta, zeta)) / std::sqrt(xi2 * eta2 * zeta2));
-    measured = true;
-  }
-  return measured ? smallest : 0.0;
-}
-
-/// Face angles of a cell with collapsed edges: each face loses its collapsed edges and
-/// the angles are taken between the remaining consecutive edges (a triangle for one
-/// collapsed edge); faces left with fewer than 3 edges have no angles.
-void collapsedCellAngles(
-  const P3 (&c)[8], double collapsedLength2, double& minAngle, double& maxAngle)
-{
-  double minCos = 2.0, maxCos = -2.0;
-  for (const auto& face : hexFaces)
-  {
-    P3 edge[4];
-    double length2[4];
-    int kept[4];
-    int keptCount = 0;
-    for (int m = 0; m < 4; ++m)
-    {
-      edge[m] = c[face[(m + 1) % 4]] - c[face[m]];
-      length2[m] = dot(edge[m], edge[m]);
-      if (length2[m] > collapsedLength2)
-      {
-        kept[keptCount++] = m;
-      }
-    }
-    if (keptCount < 3)
-    {
-      continue;
-    }
-    for (int q = 0; q < keptCount; ++q)
-    {
-      const int in = kept[q];
-      const int outgoing = kept[(q + 1) % keptCount];
-      const double cosine =
-        -dot(edge[in], edge[outgoing]) / std::sqrt(length2[in] * length2[outgoing]);
-      minCos = std::min(minCos, cosine);
-      maxCos = std::max(maxCos, cosine);
-    }
-  }
-  if (maxCos < -1.5)
-  {
-    // Every face collapsed: report the worst possible angles rather than nothing.
-    minAngle = 0.0;
-    maxAngle = 180.0;
-    return;
-  }
-  minAngle = angleFromCosine(maxCos);
-  maxAngle = angleFromCosine(minCos);
-}
-
-/// The kernel's sums as one ShapeSums<double> per lane.
-template <typename T>
-inline void splitLanes(const ShapeSums<T>& sums, ShapeSums<double> (&out)[laneCount<T>])
-{
-  double values[laneCount<T>];
-  auto split = [&](const T& value, double ShapeSums<double>::*member)
-  {
-    extractLanes(value, values);
-    for (int l = 0; l < laneCount<T>; ++l)
-    {
-      out[l].*member = values[l];
-    }
-  };
-  split(sums.minCos, &ShapeSums<double>::minCos);
-  split(sums.maxCos, &ShapeSums<double>::maxCos);
-  split(sums.minCornerJacobian, &ShapeSums<double>::minCornerJacobian);
-  split(sums.centreJacobian, &ShapeSums<double>::centreJacobian);
-  split(sums.shortest2, &ShapeSums<double>::shortest2);
-  split(sums.longest2, &ShapeSums<double>::longest2);
-  split(sums.shortestAxis2, &ShapeSums<double>::shortestAxis2);
-  split(sums.narrowest, &ShapeSums<double>::narrowest);
-  split(sums.widest, &ShapeSums<double>::widest);
-}
-
-/**
- * Finishes lane l. The scaled Jacobian is Verdict's hex_scaled_jacobian (VTK 9.2): the
- * minimum of the 8 corner Jacobians and the centre Jacobian, each divided by the lengths
- * of its three vectors; a squared length at or below 1e-30 (any edge or efg vector)
- * makes it 1e30, and it is clamped to +-1e30.
- */
-template <typename T>
-inline CellShape finishShape(const ShapeSums<double>& sums, const V3<T> (&c)[8], int l)
-{
-  CellShape shape;
-  const double collapsedLength2 = collapsedEdgeFraction * collapsedEdgeFraction * sums.longest2;
-  if (sums.shortest2 > collapsedLength2)
-  {
-    shape.minAngle = angleFromCosine(sums.maxCos);
-    shape.maxAngle = angleFromCosine(sums.minCos);
-  }
-  else
-  {
-    P3 corners[8];
-    for (int v = 0; v < 8; ++v)
-    {
-      corners[v] = laneOf(c[v], l);
-    }
-    collapsedCellAngles(corners, collapsedLength2, shape.minAngle, shape.maxAngle);
-  }
-  if (sums.shortest2 <= verdictMin || sums.shortestAxis2 <= verdictMin)
-  {
-    shape.scaledJacobian = verdictMax;
-  }
-  else
-  {
-    const double jacobian = std::min(sums.minCornerJacobian, sums.centreJacobian);
-    shape.scaledJacobian =
-      jacobian > 0 ? std::min(jacobian, verdictMax) : std::max(jacobian, -verdictMax);
-  }
-  shape.aspectRatio = sums.narrowest > 0.0 ? sums.widest / sums.narrowest : degenerateAspectRatio;
-  return shape;
-}
-
-CellShape evaluateCellShape(const P3 (&c)[8])
-{
-  P3 e[12];
-  edgeVectors(c, e);
-  double length2[12], inverseLength[12];
-  for (int n = 0; n < 12; ++n)
-  {
-    length2[n] = dot(e[n], e[n]);
-    inverseLength[n] = length2[n] > 0.0 ? 1.0 / std::sqrt(length2[n]) : 0.0;
-  }
-  return finishShape(shapeKernel(e, length2, inverseLength), c, 0);
-}
-
-// ---------------------------------------------------------------------------------------
-// Faces
-
-/// Face area vector and centre (OpenFOAM's face::areaAndCentre) with what the special
-/// cases need.
-template <typename T>
-struct FaceGeometry
-{
-  V3<T> area;
-  V3<T> centre;
-  T area2;       ///< |area|^2
-  T diagonals2;  ///< sum of the squared diagonals (the face's size)
-  T weightSum;   ///< sum of the projected triangle weights
-  V3<T> average; ///< point average (OpenFOAM's fallback centre)
-};
-
-/**
- * OpenFOAM (current -dev) face::areaAndCentre: triangle fan about the point average;
- * the centre weights each triangle centre by its area projected on the face normal.
- * Corners are taken relative to the average, q_k = p_k - average, where each fan
- * triangle's area vector is simply q_k x q_k+1; the projection weights are kept
- * unnormalised (n_k . sum n), which divides out. Branch-free: see scalarFace and
- * usableLanes for the degenerate cases.
- */
-template <typename T>
-inline FaceGeometry<T> quadFace(const V3<T> (&p)[4])
-{
-  FaceGeometry<T> face;
-  face.average = 0.25 * ((p[0] + p[1]) + (p[2] + p[3]));
-  const V3<T> q0 = p[0] - face.average, q1 = p[1] - face.average, q2 = p[2] - face.average,
-              q3 = p[3] - face.average;
-  const V3<T> n0 = cross(q0, q1), n1 = cross(q1, q2), n2 = cross(q2, q3), n3 = cross(q3, q0);
-  const V3<T> sumN = (n0 + n1) + (n2 + n3);
-  face.area = 0.5 * sumN;
-  face.area2 = dot(face.area, face.area);
-  const T w0 = dot(n0, sumN), w1 = dot(n1, sumN), w2 = dot(n2, sumN), w3 = dot(n3, sumN);
-  face.weightSum = (w0 + w1) + (w2 + w3);
-  const V3<T> weighted = (w0 * (q0 + q1) + w1 * (q1 + q2)) + (w2 * (q2 + q3) + w3 * (q3 + q0));
-  const T scale = 1.0 / (3.0 * face.weightSum);
-  face.centre = face.average + scale * weighted;
-  const V3<T> diagonal0 = q2 - q0, diagonal1 = q3 - q1;
-  face.diagonals2 = dot(diagonal0, diagonal0) + dot(diagonal1, diagonal1);
-  return face;
-}
-
-/// No usable normal: zero area up to round-off (collapsed edges of wedges and prisms).
-inline bool faceCollapsed(double area2, double diagonals2)
-{
-  return area2 <= collapsedFaceFraction * collapsedFaceFraction * diagonals2 * diagonals2;
-}
-
-/// Scalar face with OpenFOAM's guard for the centre: "sumAn > vSmall", where
-/// sumAn = weightSum / |sum n| = weightSum / (2 |area|).
-FaceGeometry<double> scalarFace(const P3 (&p)[4])
-{
-  FaceGeometry<double> face = quadFace(p);
-  if (!(face.weightSum > 0.0 &&
-        face.weightSum * face.weightSum > 4.0 * vSmall * vSmall * face.area2))
-  {
-    face.centre = face.average;
-  }
-  return face;
-}
-
-/// Cosine of the non-orthogonality angle (OpenFOAM's faceOrthogonality).
-inline double orthogonalityCosine(const P3& ownerToNeighbour, const P3& area)
-{
-  return dot(ownerToNeighbour, area) /
-    (std::sqrt(dot(ownerToNeighbour, ownerToNeighbour) * dot(area, area)) + rootVSmall);
-}
-
-/// OpenFOAM's skewness of a face with the given owner-to-neighbour vector `d`
-/// (meshCheck::faceSkewness; boundaryFaceSkewness passes the projected d and 0.4).
-inline double skewness(const P3& ownerCentre, const P3& d, double distanceFactor, const P3& area,
-  const P3& centre, const P3 (&corners)[4])
-{
-  const P3 ownerToFace = centre - ownerCentre;
-  const double along = dot(area, ownerToFace) / (dot(area, d) + rootVSmall);
-  const P3 sv = ownerToFace - along * d;
-  const double svLength = std::sqrt(dot(sv, sv));
-  const P3 svHat = (1.0 / (svLength + rootVSmall)) * sv;
-  double normalisation = distanceFactor * std::sqrt(dot(d, d)) + rootVSmall;
-  for (const P3& corner : corners)
-  {
-    normalisation = std::max(normalisation, std::abs(dot(svHat, corner - centre)));
-  }
-  return svLength / normalisation;
-}
-
-inline double boundarySkewness(
-  const P3& ownerCentre, const P3& area, const P3& centre, const P3 (&corners)[4])
-{
-  const P3 normal = (1.0 / (std::sqrt(dot(area, area)) + rootVSmall)) * area;
-  const P3 d = dot(normal, centre - ownerCentre) * normal;
-  return skewness(ownerCentre, d, 0.4, area, centre, corners);
-}
-
-/// cos * |cos|: ordered like the cosine, and needs no square root per face.
-inline double signedSquare(double cosine)
-{
-  return cosine * std::abs(cosine);
-}
-
-/// Face measures before the per-lane checks.
-template <typename T>
-struct FaceMeasures
-{
-  T cosine2; ///< signed squared cosine of the non-orthogonality
-  T skew;
-  T areaDotD; ///< S . d, the denominator OpenFOAM guards
-  T sv2;
-};
-
-/**
- * Non-orthogonality (as signed squared cosine) and skewness of an internal face whose
- * area vector points from owner to neighbour, with one root and three divisions.
- * Skewness is OpenFOAM's |sv| / fd rewritten with sv' = (S.d) sv, which avoids forming
- * sv and its unit vector:
- *   |sv| / max(0.2 |d|, max_k |sv^.r_k|) = |sv'|^2 / (|S.d| max(0.2 |d||sv'|, max_k |sv'.r_k|)).
- * Branch-free; usableLanes says which lanes need the literal formulas.
- */
-template <typename T>
-inline FaceMeasures<T> internalFaceKernel(const V3<T> (&q)[4], const FaceGeometry<T>& face,
-  const V3<T>& ownerCentre, const V3<T>& neighbourCentre)
-{
-  FaceMeasures<T> m;
-  const V3<T> d = neighbourCentre - ownerCentre;
-  const T dd = dot(d, d);
-  const T g = dot(face.area, d);
-  m.areaDotD = g;
-  m.cosine2 = g * vabs(g) / (dd * face.area2 + rootVSmall * rootVSmall);
-  const V3<T> ownerToFace = face.centre - ownerCentre;
-  const V3<T> svScaled = g * ownerToFace - dot(face.area, ownerToFace) * d;
-  m.sv2 = dot(svScaled, svScaled);
-  T largestProjection = vabs(dot(svScaled, q[0] - face.centre));
-  for (int k = 1; k < 4; ++k)
-  {
-    largestProjection = vmax(largestProjection, vabs(dot(svScaled, q[k] - face.centre)));
-  }
-  m.skew = m.sv2 / (vabs(g) * vmax(0.2 * vsqrt(dd * m.sv2), largestProjection));
-  return m;
-}
-
-/// The literal formulas for the lanes the kernel cannot handle; true if the face counts.
-bool internalFaceSpecialCase(
-  const P3 (&q)[4], const P3& ownerCentre, const P3& neighbourCentre, double& cosine2, double& skew)
-{
-  const FaceGeometry<double> face = scalarFace(q);
-  if (faceCollapsed(face.area2, face.diagonals2))
-  {
-    return false;
-  }
-  const P3 d = neighbourCentre - ownerCentre;
-  cosine2 = signedSquare(orthogonalityCosine(d, face.area));
-  skew = skewness(ownerCentre, d, 0.2, face.area, face.centre, q);
-  return true;
-}
-
-/// Lanes (bits) where the kernel's result holds: a usable face with S.d and sv' away
-/// from 0 and a regular centre; the others take internalFaceSpecialCase.
-template <typename T>
-inline int usableLanes(const FaceGeometry<T>& face, const FaceMeasures<T>& m)
-{
-  constexpr int lanes = laneCount<T>;
-  double area2[lanes], diagonals2[lanes], weightSum[lanes], areaDotD[lanes], sv2[lanes];
-  extractLanes(face.area2, area2);
-  extractLanes(face.diagonals2, diagonals2);
-  extractLanes(face.weightSum, weightSum);
-  extractLanes(m.areaDotD, areaDotD);
-  extractLanes(m.sv2, sv2);
-  int usable = 0;
-  for (int l = 0; l < lanes; ++l)
-  {
-    if (!faceCollapsed(area2[l], diagonals2[l]) && std::abs(areaDotD[l]) >= 1e-100 &&
-      sv2[l] > 0.0 && weightSum[l] > 0.0 &&
-      weightSum[l] * weightSum[l] > 4.0 * vSmall * vSmall * area2[l])
-    {
-      usable |= 1 << l;
-    }
-  }
-  return usable;
-}
-
-// ---------------------------------------------------------------------------------------
-// Cell centres
-
-/// The six faces of a hexahedron (outward area vectors for a right-handed cell).
-template <typename T>
-inline void hexFaceGeometry(const V3<T> (&c)[8], FaceGeometry<T> (&faces)[6])
-{
-  for (int f = 0; f < 6; ++f)
-  {
-    const V3<T> p[4] = { c[hexFaces[f][0]], c[hexFaces[f][1]], c[hexFaces[f][2]],
-      c[hexFaces[f][3]] };
-    faces[f] = quadFace(p);
-  }
-}
-
-/**
- * OpenFOAM's cell centre (primitiveMesh::makeCellCentresAndVols): the volume-weighted
- * centre of the pyramids from each face to the mean of the face centres, which is the
- * cell's volume centroid (the mean of the corners is not, unless the cell is a
- * parallelepiped). Branch-free; `usable` gets the lanes (bits) where the result holds:
- * every face has a regular centre and no face is collapsed, and the volume is not zero.
- * The others take cellCentroidSpecialCase.
- */
-template <typename T>
-inline V3<T> cellCentroidKernel(const V3<T> (&c)[8], int& usable)
-{
-  FaceGeometry<T> faces[6];
-  hexFaceGeometry(c, faces);
-  const V3<T> estimate = (1.0 / 6.0) *
-    (((faces[0].centre + faces[1].centre) + (faces[2].centre + faces[3].centre)) +
-      (faces[4].centre + faces[5].centre));
-  V3<T> weighted = { splat<T>(0.0), splat<T>(0.0), splat<T>(0.0) };
-  T volume = splat<T>(0.0);
-  for (const FaceGeometry<T>& face : faces)
-  {
-    const T pyramid3 = dot(face.area, face.centre - estimate);
-    weighted = weighted + pyramid3 * (0.75 * face.centre + 0.25 * estimate);
-    volume = volume + pyramid3;
-  }
-  constexpr int lanes = laneCount<T>;
-  double volumes[lanes];
-  extractLanes(volume, volumes);
-  usable = 0;
-  for (int l = 0; l < lanes; ++l)
-  {
-    usable |= (std::abs(volumes[l]) > vSmall) << l;
-  }
-  for (const FaceGeometry<T>& face : faces)
-  {
-    double area2[lanes], diagonals2[lanes], weightSum[lanes];
-    extractLanes(face.area2, area2);
-    extractLanes(face.diagonals2, diagonals2);
-    extractLanes(face.weightSum, weightSum);
-    for (int l = 0; l < lanes; ++l)
-    {
-      const bool regular = !faceCollapsed(area2[l], diagonals2[l]) && weightSum[l] > 0.0 &&
-        weightSum[l] * weightSum[l] > 4.0 * vSmall * vSmall * area2[l];
-      usable &= ~(static_cast<int>(!regular) << l);
-    }
-  }
-  return (1.0 / volume) * weighted;
-}
-
-/// The centre of a cell with collapsed faces or edges, or no volume: as OpenFOAM's mesh
-/// of it would have it (blockMesh drops collapsed faces), the estimate alone when the
-/// volume is zero, the mean of the corners when no face is left.
-P3 cellCentroidSpecialCase(const P3 (&c)[8])
-{
-  FaceGeometry<double> faces[6];
-  bool kept[6];
-  P3 estimate = { 0.0, 0.0, 0.0 };
-  int count = 0;
-  for (int f = 0; f < 6; ++f)
-  {
-    const P3 p[4] = { c[hexFaces[f][0]], c[hexFaces[f][1]], c[hexFaces[f][2]], c[hexFaces[f][3]] };
-    faces[f] = scalarFace(p);
-    kept[f] = !faceCollapsed(faces[f].area2, faces[f].diagonals2);
-    if (kept[f])
-    {
-      estimate = estimate + faces[f].centre;
-      ++count;
-    }
-  }
-  if (count == 0)
-  {
-    return 0.125 * (((c[0] + c[1]) + (c[2] + c[3])) + ((c[4] + c[5]) + (c[6] + c[7])));
-  }
-  estimate = (1.0 / count) * estimate;
-  P3 weighted = { 0.0, 0.0, 0.0 };
-  double volume = 0.0;
-  for (int f = 0; f < 6; ++f)
-  {
-    if (kept[f])
-    {
-      const double pyramid3 = dot(faces[f].area, faces[f].centre - estimate);
-      weighted = weighted + pyramid3 * (0.75 * faces[f].centre + 0.25 * estimate);
-      volume += pyramid3;
-    }
-  }
-  return std::abs(volume) > vSmall ? (1.0 / volume) * weighted : estimate;
-}
-
-/// OpenFOAM's cell centre of every lane.
-template <typename T>
-inline V3<T> cellCentroid(const V3<T> (&c)[8])
-{
-  int usable = 0;
-  V3<T> centre = cellCentroidKernel(c, usable);
-  for (int l = 0; usable != (1 << laneCount<T>)-1 && l < laneCount<T>; ++l)
-  {
-    if (!(usable & (1 << l)))
-    {
-      P3 corners[8];
-      for (int v = 0; v < 8; ++v)
-      {
-        corners[v] = laneOf(c[v], l);
-      }
-      const P3 special = cellCentroidSpecialCase(corners);
-      setLane(centre.x, l, special.x);
-      setLane(centre.y, l, special.y);
-      setLane(centre.z, l, special.z);
-    }
-  }
-  return centre;
-}
-
 // ---------------------------------------------------------------------------------------
 // Memory
 
@@ -869,6 +89,8 @@ struct BlockView
   int ni, nj, nk; // nodes
   int ci, cj, ck; // cells
   long cellCount;
+  /// A neighbour layer (another rank's cells) takes part with this side only; -1: all.
+  int onlySide = -1;
 
   explicit BlockView(const StructuredBlock& b)
     : xyz(b.xyz)
@@ -1081,7 +303,7 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     for (int side = 0; side < 6; ++side)
     {
       table.sideOffset[6 * blockIndex + side] = count;
-      if (view.cellCount > 0)
+      if (view.cellCount > 0 && (view.onlySide < 0 || view.onlySide == side))
       {
         count += static_cast<long>(view.sideWidth(side)) * view.sideHeight(side);
       }
@@ -1101,6 +323,10 @@ InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
     }
     for (int side = 0; side < 6; ++side)
     {
+      if (view.onlySide >= 0 && view.onlySide != side)
+      {
+        continue;
+      }
       for (int b = 0; b < view.sideHeight(side); ++b)
       {
         for (int a = 0; a < view.sideWidth(side); ++a)
@@ -1189,7 +415,9 @@ bool linkMatches(const std::vector<BlockView>& views, const PeriodicSideLink& li
   }
   const BlockView& source = views[link.sourceBlock];
   const BlockView& image = views[link.imageBlock];
-  if (source.cellCount == 0 || image.cellCount == 0)
+  if (source.cellCount == 0 || image.cellCount == 0 ||
+    (source.onlySide >= 0 && source.onlySide != link.sourceSide) ||
+    (image.onlySide >= 0 && image.onlySide != link.imageSide))
   {
     return false;
   }
@@ -1410,6 +638,40 @@ void edgeLengths(
   invertLengths(edges, count);
 }
 
+/// Face geometry in structure-of-arrays form: the upper faces of a row (i), of the
+/// previous row (j) or of the previous layer (k), each read by the next cell as its lower
+/// face, so that every face is computed once.
+struct FaceArrays
+{
+  double *ax, *ay, *az, *cx, *cy, *cz, *area2, *diagonals2, *weightSum;
+
+  template <typename T>
+  void store(long n, const FaceGeometry<T>& f) const
+  {
+    storeLanes(ax + n, f.area.x);
+    storeLanes(ay + n, f.area.y);
+    storeLanes(az + n, f.area.z);
+    storeLanes(cx + n, f.centre.x);
+    storeLanes(cy + n, f.centre.y);
+    storeLanes(cz + n, f.centre.z);
+    storeLanes(area2 + n, f.area2);
+    storeLanes(diagonals2 + n, f.diagonals2);
+    storeLanes(weightSum + n, f.weightSum);
+  }
+  template <typename T>
+  FaceGeometry<T> load(long n) const
+  {
+    FaceGeometry<T> f;
+    f.area = loadV3<T>(ax + n, ay + n, az + n);
+    f.centre = loadV3<T>(cx + n, cy + n, cz + n);
+    f.area2 = loadLanes<T>(area2 + n);
+    f.diagonals2 = loadLanes<T>(diagonals2 + n);
+    f.weightSum = loadLanes<T>(weightSum + n);
+    f.average = f.centre; // not used by the kernels
+    return f;
+  }
+};
+
 /// Rolling per-block buffers of the grid pass.
 class BlockPass
 {
@@ -1422,7 +684,9 @@ public:
   {
     // 2 node planes (x, y, z), i- and j-edges of both (length2, inverse), k-edges
     // between them, 2 layers of cell centres (x, y, z).
-    const long size = 2 * 3 * plane_ + 2 * 2 * 2 * plane_ + 2 * plane_ + 2 * 3 * layerCells_;
+    // Upper faces: of a row (i), of the previous row (j), of the previous layer (k).
+    const long size = 2 * 3 * plane_ + 2 * 2 * 2 * plane_ + 2 * plane_ + 2 * 3 * layerCells_ +
+      9 * (2 * static_cast<long>(view.ci) + layerCells_);
     if (scratch.capacity() < static_cast<std::size_t>(size))
     {
       scratch = std::vector<double>();
@@ -1450,17 +714,26 @@ public:
     {
       centres_[n] = { take(layerCells_), take(layerCells_), take(layerCells_) };
     }
+    auto faceArrays = [&take](long count) {
+      return FaceArrays{ take(count), take(count), take(count), take(count), take(count),
+        take(count), take(count), take(count), take(count) };
+    };
+    iFaces_ = faceArrays(view.ci);
+    jFaces_ = faceArrays(view.ci);
+    kFaces_ = faceArrays(layerCells_);
     minCosine2_ = quality.nonOrthogonality;
     maxSkewness_ = quality.skewness;
   }
 
-  /// Shape measures of every cell of layer k and the faces below and beside them.
+  /// Shape measures of every cell of layer k and the faces below and beside them. The
+  /// first layer passed starts the pass: its faces below are left to the layer under it.
   void layer(int k)
   {
-    if (k == 0)
+    if (first_ < 0)
     {
-      loadPlane(view_, 0, planes_[0]);
-      planeEdges(0);
+      first_ = k;
+      loadPlane(view_, k, planes_[k % 2]);
+      planeEdges(k % 2);
     }
     lower_ = k % 2;
     upper_ = 1 - lower_;
@@ -1541,8 +814,30 @@ private:
       quality_.aspectRatio[cell + l] = shape.aspectRatio;
     }
 
-    const V3<T> centre = cellCentroid(c);
+    // Each face once, in its canonical corner order (hexFaceGeometry): the upper faces
+    // here, the lower ones from the cells below (the upper face of lane l is the lower
+    // face of lane l + 1: stored before loaded), or computed where there is none below in
+    // this pass (the same bits as the cell below would give: chunks and neighbour layers
+    // agree with one whole pass).
     const long inLayer = i + static_cast<long>(view_.ci) * j_;
+    FaceGeometry<T> faces[6];
+    for (const int f : { 1, 3, 5 })
+    {
+      faces[f] = hexFace(c, f);
+    }
+    iFaces_.store(i, faces[1]);
+    FaceGeometry<T> below[3]; // lower i, j, k faces with area vectors into these cells
+    const bool hasBelow[3] = { i > 0, j_ > 0, k_ > first_ };
+    below[0] = hasBelow[0] ? iFaces_.load<T>(i - 1) : lowerHexFace(c, 0);
+    below[1] = hasBelow[1] ? jFaces_.load<T>(i) : lowerHexFace(c, 1);
+    below[2] = hasBelow[2] ? kFaces_.load<T>(inLayer) : lowerHexFace(c, 2);
+    jFaces_.store(i, faces[3]);
+    kFaces_.store(inLayer, faces[5]);
+    for (int d = 0; d < 3; ++d)
+    {
+      faces[2 * d] = reversed(below[d]);
+    }
+    const V3<T> centre = cellCentroidFromFaces(c, faces);
     const CoordinateArrays& centres = centres_[k_ % 2];
     storeLanes(centres.x + inLayer, centre.x);
     storeLanes(centres.y + inLayer, centre.y);
@@ -1552,27 +847,27 @@ private:
     if (i > 0)
     {
       const V3<T> q[4] = { c[0], c[3], c[7], c[4] };
-      lowerFace<T>(q, centres, inLayer - 1, cell - 1, centre, cell);
+      lowerFace<T>(q, below[0], centres, inLayer - 1, cell - 1, centre, cell);
     }
     if (j_ > 0)
     {
       const V3<T> q[4] = { c[0], c[4], c[5], c[1] };
-      lowerFace<T>(q, centres, inLayer - view_.ci, cell - view_.ci, centre, cell);
+      lowerFace<T>(q, below[1], centres, inLayer - view_.ci, cell - view_.ci, centre, cell);
     }
-    if (k_ > 0)
+    if (k_ > first_)
     {
       const V3<T> q[4] = { c[0], c[1], c[2], c[3] };
-      lowerFace<T>(q, centres_[1 - k_ % 2], inLayer, cell - layerCells_, centre, cell);
+      lowerFace<T>(q, below[2], centres_[1 - k_ % 2], inLayer, cell - layerCells_, centre, cell);
     }
   }
 
   template <typename T>
-  void lowerFace(const V3<T> (&q)[4], const CoordinateArrays& neighbourCentres,
-    long neighbourInLayer, long neighbour, const V3<T>& centre, long cell)
+  void lowerFace(const V3<T> (&q)[4], const FaceGeometry<T>& face,
+    const CoordinateArrays& neighbourCentres, long neighbourInLayer, long neighbour,
+    const V3<T>& centre, long cell)
   {
     const V3<T> neighbourCentre = loadV3<T>(neighbourCentres.x + neighbourInLayer,
       neighbourCentres.y + neighbourInLayer, neighbourCentres.z + neighbourInLayer);
-    const FaceGeometry<T> face = quadFace(q);
     FaceMeasures<T> m = internalFaceKernel(q, face, neighbourCentre, centre);
     const int usable = usableLanes(face, m);
     for (int l = 0; usable != (1 << laneCount<T>)-1 && l < laneCount<T>; ++l)
@@ -1605,9 +900,11 @@ private:
   CoordinateArrays planes_[2];
   EdgeLengths iEdges_[2], jEdges_[2], kEdges_;
   CoordinateArrays centres_[2];
+  FaceArrays iFaces_, jFaces_, kFaces_;
   double* minCosine2_;
   double* maxSkewness_;
   int lower_ = 0, upper_ = 1, j_ = 0, k_ = 0;
+  int first_ = -1;
 };
 
 /// Block-boundary faces: interfaces are measured with the other cell's centre, true
@@ -1687,11 +984,43 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
   std::fill_n(quality.skewness, cellCount, 0.0);
   std::fill_n(quality.aspectRatio, cellCount, 0.0);
   std::fill_n(quality.scaledJacobian, cellCount, 0.0);
-  BlockPass pass(view, quality, scratch);
-  for (int k = 0; k < view.ck; ++k)
+  // Layers in chunks of at least two, on threads when a runner is installed. A chunk
+  // [k0, k1) first re-evaluates layer k0 - 1 (the same values again: idempotent writes and
+  // min/max updates), whose centres its lowest faces need, and updates cells of layers
+  // k0 - 1 .. k1 - 1 only. Even chunks run first, then odd ones, so no two chunks that
+  // touch the same layer run at once; min and max do not depend on the order, so every
+  // chunking gives the same bits.
+  const long layerCells = static_cast<long>(view.ci) * view.cj;
+  const int chunks =
+    static_cast<int>(chunkCount(cellCount, 1L << 16, std::max(1, view.ck / 2)));
+  if (chunks == 1)
   {
-    pass.layer(k);
-    progress.advance(static_cast<double>(view.ci) * view.cj);
+    BlockPass pass(view, quality, scratch);
+    for (int k = 0; k < view.ck; ++k)
+    {
+      pass.layer(k);
+      progress.advance(static_cast<double>(layerCells));
+    }
+  }
+  else
+  {
+    auto runChunk = [&](long chunk)
+    {
+      const int k0 = static_cast<int>(view.ck * chunk / chunks);
+      const int k1 = static_cast<int>(view.ck * (chunk + 1) / chunks);
+      std::vector<double> chunkScratch;
+      BlockPass pass(view, quality, chunkScratch);
+      for (int k = std::max(k0 - 1, 0); k < k1; ++k)
+      {
+        pass.layer(k);
+      }
+    };
+    for (int parity = 0; parity < 2; ++parity)
+    {
+      const long count = (chunks - parity + 1) / 2;
+      forEachChunk(count, [&](long n) { runChunk(2 * n + parity); });
+      progress.advance(static_cast<double>(layerCells) * view.ck * 0.5);
+    }
   }
   boundaryFaces(views, blockIndex, interfaces, quality);
   for (long cell = 0; cell < cellCount; ++cell)
@@ -1824,7 +1153,27 @@ std::vector<BlockView> blockViews(const std::vector<StructuredBlock>& blocks, do
   return views;
 }
 
-void evaluateBlocks(const std::vector<BlockView>& views, double totalCells,
+/// Appends the views of neighbour layers (one side each) after the measured blocks'.
+void addNeighbourViews(std::vector<BlockView>& views, const std::vector<NeighbourLayer>& neighbours)
+{
+  for (std::size_t n = 0; n < neighbours.size(); ++n)
+  {
+    const NeighbourLayer& neighbour = neighbours[n];
+    const StructuredBlock& cells = neighbour.cells;
+    const int across[3] = { cells.ni, cells.nj, cells.nk };
+    if (neighbour.side < 0 || neighbour.side > 5 || across[neighbour.side / 2] != 2 ||
+      cells.ni < 2 || cells.nj < 2 || cells.nk < 2 || !cells.xyz)
+    {
+      throw GeometryError("grid quality: neighbour layer " + std::to_string(n) +
+        " is not two node layers at a block side");
+    }
+    views.emplace_back(cells);
+    views.back().onlySide = neighbour.side;
+  }
+}
+
+/// Measures the first `measured` views; the views after them are neighbour layers.
+void evaluateBlocks(const std::vector<BlockView>& views, std::size_t measured, double totalCells,
   const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
   const std::function<void(double)>& progress)
 {
@@ -1833,7 +1182,7 @@ void evaluateBlocks(const std::vector<BlockView>& views, double totalCells,
   InterfaceTable interfaces = matchBlockInterfaces(views);
   addPeriodicLinks(interfaces, views, periodic);
   std::vector<double> scratch;
-  for (std::size_t n = 0; n < views.size(); ++n)
+  for (std::size_t n = 0; n < measured; ++n)
   {
     evaluateBlock(views, static_cast<int>(n), interfaces, outputs[n], scratch, reporter);
   }
@@ -1861,7 +1210,7 @@ std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBl
     outputs[n] = { q.minAngle.data(), q.maxAngle.data(), q.nonOrthogonality.data(),
       q.skewness.data(), q.aspectRatio.data(), q.scaledJacobian.data() };
   }
-  evaluateBlocks(views, totalCells, periodic, outputs, progress);
+  evaluateBlocks(views, views.size(), totalCells, periodic, outputs, progress);
   return quality;
 }
 
@@ -1881,14 +1230,53 @@ void computeGridQuality(const std::vector<StructuredBlock>& blocks,
   const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
   const std::function<void(double)>& progress)
 {
+  computeGridQuality(blocks, periodic, std::vector<NeighbourLayer>(), outputs, progress);
+}
+
+void computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::vector<NeighbourLayer>& neighbours,
+  const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress)
+{
   if (outputs.size() != blocks.size())
   {
     throw GeometryError("grid quality: " + std::to_string(outputs.size()) +
       " output buffers for " + std::to_string(blocks.size()) + " blocks");
   }
   double totalCells = 0.0;
-  const std::vector<BlockView> views = blockViews(blocks, totalCells);
-  evaluateBlocks(views, totalCells, periodic, outputs, progress);
+  std::vector<BlockView> views = blockViews(blocks, totalCells);
+  addNeighbourViews(views, neighbours);
+  evaluateBlocks(views, blocks.size(), totalCells, periodic, outputs, progress);
+}
+
+StructuredBlock sideLayer(const StructuredBlock& block, int side, std::vector<double>& nodes)
+{
+  if (side < 0 || side > 5 || block.ni < 2 || block.nj < 2 || block.nk < 2 || !block.xyz)
+  {
+    throw GeometryError("grid quality: no side " + std::to_string(side) + " to take a layer of");
+  }
+  int begin[3] = { 0, 0, 0 };
+  int count[3] = { block.ni, block.nj, block.nk };
+  const int axis = side / 2;
+  begin[axis] = side % 2 == 0 ? 0 : count[axis] - 2;
+  count[axis] = 2;
+  nodes.resize(3 * static_cast<std::size_t>(count[0]) * count[1] * count[2]);
+  double* out = nodes.data();
+  for (int k = 0; k < count[2]; ++k)
+  {
+    for (int j = 0; j < count[1]; ++j)
+    {
+      const double* row = block.xyz +
+        3 * (begin[0] + static_cast<long>(block.ni) * (begin[1] + j + static_cast<long>(block.nj) * (begin[2] + k)));
+      std::copy_n(row, 3 * static_cast<std::size_t>(count[0]), out);
+      out += 3 * count[0];
+    }
+  }
+  StructuredBlock layer;
+  layer.xyz = nodes.data();
+  layer.ni = count[0];
+  layer.nj = count[1];
+  layer.nk = count[2];
+  return layer;
 }
 
 void prepareOutputMemory(void* begin, std::size_t bytes)

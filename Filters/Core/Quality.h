@@ -158,6 +158,32 @@ void computeGridQuality(const std::vector<StructuredBlock>& blocks,
   const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
   const std::function<void(double)>& progress = {});
 
+/**
+ * Cells of a block that is measured elsewhere (on another MPI rank), next to its side
+ * `side` (0..5 = i0 i1 j0 j1 k0 k1): the block's two node layers at that side, in the
+ * block's own index order (sideLayer() copies them out). The measured blocks see that
+ * side as they would see the whole block's: a face coinciding with one of theirs is an
+ * interface, and a periodic link may name the layer. Cell centres next to the side are
+ * the whole block's bit for bit, so the measures equal those of a run with every block.
+ */
+struct NeighbourLayer
+{
+  StructuredBlock cells;
+  int side = -1;
+};
+
+/// The two node layers of `block` at `side` (see NeighbourLayer), copied into `nodes`.
+StructuredBlock sideLayer(const StructuredBlock& block, int side, std::vector<double>& nodes);
+
+/**
+ * With neighbour layers of blocks measured elsewhere: only `blocks` are measured (one
+ * output per block); periodic link block indices from blocks.size() on name
+ * neighbours[index - blocks.size()].
+ */
+void computeGridQuality(const std::vector<StructuredBlock>& blocks,
+  const std::vector<PeriodicSideLink>& periodic, const std::vector<NeighbourLayer>& neighbours,
+  const std::vector<CellQualityPointers>& outputs, const std::function<void(double)>& progress = {});
+
 /// Advisory: asks the system to back a large fresh output buffer with huge pages and to
 /// fault it in at once. On virtual machines where a first-touch page fault costs ~10 us,
 /// this makes filling a fresh array several times cheaper. Contents are unchanged.

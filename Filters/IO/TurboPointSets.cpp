@@ -1,5 +1,7 @@
 #include "TurboPointSets.h"
 
+#include "SectionChecks.h"
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -147,12 +149,17 @@ bool parseNumber(const std::string& token, double& value)
   return result.ec == std::errc() && result.ptr == end;
 }
 
+} // namespace
+
 std::string formatNumber(double value)
 {
   std::ostringstream stream;
   stream << value;
   return stream.str();
 }
+
+namespace
+{
 
 /// The lines of a file without their line ends (LF, CRLF or lone CR) and without a UTF-8
 /// byte order mark. @p maxBytes limits how much is read (0: all).
@@ -227,10 +234,12 @@ struct ClassifiedLine
   bool spanGiven = false;
 };
 
-/// Recognises "# Profile k at s%" (also "Section", any case, tabs, "s %", no span).
-/// A `#` line whose first words are not "profile <integer>" is an ordinary comment; one
-/// that is but has a malformed span is an error, since a silently dropped header would
-/// merge two sections.
+/// Recognises section headers: a `#` line with the words "Profile k" or "Section k"
+/// anywhere ("# Profile 3 at 16.6667%", "# IGV Profile 1", "# Rotor1 Profile 2", any
+/// case, tabs), optionally followed by "at s%" or "s%" (the span). Any other `#` or `!`
+/// line is an ordinary comment (which still starts a new section in a profile file). A
+/// header whose span is malformed is an error, since a silently dropped span would put
+/// the section at a guessed place.
 ClassifiedLine classify(const std::string& raw, const std::string& file, int lineNumber)
 {
   ClassifiedLine result;
@@ -260,47 +269,59 @@ ClassifiedLine classify(const std::string& raw, const std::string& file, int lin
     {
       tokens.push_back(word);
     }
-    if (tokens.size() < 2)
-    {
-      return result;
-    }
-    const std::string keyword = lower(tokens[0]);
-    if (keyword != "profile" && keyword != "section")
-    {
-      return result;
-    }
+    std::size_t keywordAt = tokens.size();
     int number = 0;
-    const auto parsed =
-      std::from_chars(tokens[1].data(), tokens[1].data() + tokens[1].size(), number);
-    if (parsed.ec != std::errc() || parsed.ptr != tokens[1].data() + tokens[1].size())
+    for (std::size_t t = 0; t + 1 < tokens.size() && keywordAt == tokens.size(); ++t)
+    {
+      const std::string keyword = lower(tokens[t]);
+      const std::string& digits = tokens[t + 1];
+      const auto parsed = std::from_chars(digits.data(), digits.data() + digits.size(), number);
+      if ((keyword == "profile" || keyword == "section") && parsed.ec == std::errc() &&
+        parsed.ptr == digits.data() + digits.size())
+      {
+        keywordAt = t;
+      }
+    }
+    if (keywordAt == tokens.size())
     {
       return result;
     }
     result.kind = LineKind::Section;
     result.number = number;
-    if (tokens.size() == 2)
+    std::size_t next = keywordAt + 2;
+    if (next == tokens.size())
     {
       return result;
     }
-    std::size_t next = 2;
-    if (lower(tokens[next]) == "at")
-    {
-      ++next;
-    }
-    std::string spanText;
-    for (std::size_t i = next; i < tokens.size(); ++i)
-    {
-      spanText += tokens[i];
-    }
-    if (!spanText.empty() && spanText.back() == '%')
-    {
-      spanText.pop_back();
-    }
+    // The span: the first number after the keyword that follows "at" or carries a "%"
+    // ("at 16.6667%", "at 12.5 %", "at span 50", "50% span").
+    const bool at = lower(tokens[next]) == "at";
     double span = 0.0;
-    if (!parseNumber(spanText, span) || !std::isfinite(span))
+    bool found = false;
+    for (std::size_t i = next; i < tokens.size() && !found; ++i)
     {
+      std::string word = tokens[i];
+      const bool percent = !word.empty() && word.back() == '%';
+      if (percent)
+      {
+        word.pop_back();
+      }
+      const bool percentNext = i + 1 < tokens.size() && tokens[i + 1] == "%";
+      found = !word.empty() && parseNumber(word, span) && (at || percent || percentNext);
+    }
+    if (!found)
+    {
+      if (!at)
+      {
+        return result; // more words after "Profile k", but no span
+      }
       throw ReadError(file, lineNumber,
         "malformed section header '" + excerpt(text) + "' (expected '# Profile k at s%')");
+    }
+    if (!std::isfinite(span))
+    {
+      throw ReadError(file, lineNumber,
+        "malformed section header '" + excerpt(text) + "': the span is not a finite number");
     }
     result.span = span;
     result.spanGiven = true;
@@ -310,7 +331,9 @@ ClassifiedLine classify(const std::string& raw, const std::string& file, int lin
   return result;
 }
 
-std::string sectionName(const ProfileSection& section, bool withBlade)
+} // namespace
+
+std::string profileSectionName(const ProfileSection& section, bool withBlade)
 {
   std::ostringstream name;
   if (withBlade && !section.blade.empty())
@@ -320,6 +343,9 @@ std::string sectionName(const ProfileSection& section, bool withBlade)
   name << "Profile " << section.number << " (" << formatNumber(section.spanPercent) << "%)";
   return name.str();
 }
+
+namespace
+{
 
 void checkCount(const ProfileSection& section, const std::string& what)
 {
@@ -659,6 +685,7 @@ PointSet toPointSet(ProfileSection&& section)
   result.points = std::move(section.points);
   result.file = std::move(section.file);
   result.firstLine = section.firstLine;
+  result.lines = std::move(section.lines);
   return result;
 }
 } // namespace
@@ -766,9 +793,8 @@ std::vector<ProfileSection> readPointFile(const std::string& path, bool sections
 {
   const std::vector<std::string> lines = readLines(path);
 
-  // Headers, when present, delimit the sections and blank lines mean nothing; without
-  // them blank lines are the only separator there is.
-  bool anyHeader = false;
+  // Every comment or blank line between two point rows starts a new section; headers
+  // also number the section and may give its span.
   std::vector<ClassifiedLine> kinds;
   kinds.reserve(lines.size());
   for (std::size_t i = 0; i < lines.size(); ++i)
@@ -781,7 +807,6 @@ std::vector<ProfileSection> readPointFile(const std::string& path, bool sections
         throw ReadError(path, static_cast<int>(i) + 1,
           "section header in a contour file, which must hold a single curve");
       }
-      anyHeader = true;
     }
   }
 
@@ -814,9 +839,8 @@ std::vector<ProfileSection> readPointFile(const std::string& path, bool sections
     switch (kind.kind)
     {
       case LineKind::Comment:
-        break;
       case LineKind::Blank:
-        if (sections && !anyHeader && open && !current.points.empty())
+        if (sections && open && !current.points.empty())
         {
           close();
         }
@@ -877,6 +901,7 @@ std::vector<ProfileSection> readPointFile(const std::string& path, bool sections
           start(lineNumber);
         }
         current.points.emplace_back(xyz[0], xyz[1], xyz[2]);
+        current.lines.push_back(lineNumber);
         break;
       }
     }
@@ -895,6 +920,7 @@ std::vector<ProfileSection> readPointFile(const std::string& path, bool sections
         all.firstLine = section.firstLine;
       }
       all.points.insert(all.points.end(), section.points.begin(), section.points.end());
+      all.lines.insert(all.lines.end(), section.lines.begin(), section.lines.end());
     }
     if (all.points.empty())
     {
@@ -925,7 +951,7 @@ std::vector<ProfileSection> readPointFile(const std::string& path, bool sections
   }
   for (auto& section : result)
   {
-    section.name = sectionName(section, blades.size() > 1);
+    section.name = profileSectionName(section, blades.size() > 1);
     checkCount(section, "section '" + section.name + "'");
   }
   return result;
@@ -1241,6 +1267,26 @@ TurboPointSets readTurboPointSets(
     {
       sets.warnings.push_back(files[Profile]->string() +
         ": sections without '# Profile k at s%' headers; spans assumed evenly spread");
+    }
+  }
+  // What would fold a grid: open sections, sections out of span order, contours and
+  // sections that turn back or cross themselves.
+  if (!sets.hub.points.empty())
+  {
+    checkContourShape(sets.hub, sets.axis);
+  }
+  if (!sets.shroud.points.empty())
+  {
+    checkContourShape(sets.shroud, sets.axis);
+  }
+  if (!sets.profiles.empty())
+  {
+    closeSections(
+      sets.profiles, options.cap, files[Profile]->string(), sets.units, sets.warnings);
+    orderSections(sets.profiles, sets.hub, sets.shroud, sets.axis, sets.warnings);
+    for (const ProfileSection& section : sets.profiles)
+    {
+      checkSectionShape(section, sets.axis);
     }
   }
   if (descriptionIsInf)

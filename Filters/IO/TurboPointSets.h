@@ -14,11 +14,21 @@
  *
  * Point files hold one point per row, X Y Z separated by blanks, tabs, commas or
  * semicolons; CRLF, lone CR and LF line ends and a UTF-8 byte order mark are accepted.
- * Lines starting with `!` are comments; `## name` names the blade of the sections that
- * follow; `# Profile k at s%` starts section k at s % span; other `#` lines are comments.
- * A profile file without section headers is split into sections at blank lines. One
- * leading row of column names (`x,y,z`) is skipped.
+ * Lines starting with `!` or `#` are comments; `## name` names the blade of the sections
+ * that follow. In a profile file every comment or blank line between two point rows
+ * starts a new section, whatever its text (exports head sections with `# Profile 3 at
+ * 16.6667%`, `# IGV Profile 1`, `# Rotor1 Profile 2`, or nothing but a blank line); a
+ * comment with the words `Profile k` (or `Section k`) numbers the section, and `at s%`
+ * after them gives its span. One leading row of column names (`x,y,z`) is skipped.
  *
+ * readTurboPointSets then repairs and checks what would fold a grid (SectionChecks.h):
+ * blade sections left open are closed (a gap up to 0.2 % of the chord joined, up to 5 %
+ * capped as a blunt trailing edge, larger ones left open for the template to refuse),
+ * sections are put in span order (by the spans of their headers, or where they lie
+ * between hub and shroud) or refused when the headers contradict the geometry, and
+ * contours and sections that turn back on themselves or cross themselves are refused,
+ * naming the rows.
+
  * Coordinates are kept exactly as in the files; TurboPointSets::scale converts them to
  * metres (the VTK reader applies it).
  *
@@ -65,6 +75,27 @@ struct PointSet
   std::vector<Eigen::Vector3d> points;
   std::string file; ///< path the points were read from
   int firstLine = 0; ///< line of the first point (or of the section header), 1-based
+  /// Line of each point (1-based; points added to close a section carry the line of the
+  /// section's last point), so that messages can name the rows.
+  std::vector<int> lines;
+};
+
+/// How an open blade section was closed (see closeSections).
+enum class Closure
+{
+  Closed, ///< the file's section was already a closed loop
+  Open,   ///< a gap above 5 % of the chord, not a trailing edge: left as it is
+  Joined, ///< a small gap (rounding) closed by moving both ends to their midpoint
+  Segment, ///< the first point not repeated at the end (a gap of about one point
+           ///< spacing): closed by repeating it
+  Capped  ///< a blunt trailing edge closed by a cap (ReadOptions::cap)
+};
+
+/// Shape of the cap that closes a blunt trailing edge.
+enum class EdgeCap
+{
+  Straight, ///< points along the straight line between the two ends (default)
+  Rounded   ///< a half circle across the gap, bulging along the sides' end tangents
 };
 
 /// One blade section of the profile file.
@@ -76,6 +107,10 @@ struct ProfileSection : PointSet
   /// from 0 to 100 % in file order (a guess, recorded as such).
   bool spanGiven = false;
   std::string blade; ///< the `## name` in effect, empty if none
+  Closure closure = Closure::Closed;
+  /// Distance between the file's first and last point over the chord (largest distance
+  /// between two points of the section), before closing.
+  double gapFraction = 0.0;
 };
 
 /// Everything a blade-passage template needs from the input files.
@@ -114,6 +149,8 @@ struct ReadOptions
   int bladeCount = 0; ///< 0: unknown
   std::string axis = "Z";
   std::string units = "M";
+  /// Cap that closes a blunt trailing edge (a gap between 0.2 % and 5 % of the chord).
+  EdgeCap cap = EdgeCap::Straight;
 };
 
 /// Reports progress in [0, 1].
@@ -145,6 +182,12 @@ TurboPointSets readTurboPointSets(const std::string& fileName, const ReadOptions
  * sections (see the file comment). Every section must have at least 4 points.
  */
 std::vector<ProfileSection> readPointFile(const std::string& path, bool sections);
+
+/// "Profile k (s%)", prefixed by "blade: " when @p withBlade and the section has one.
+std::string profileSectionName(const ProfileSection& section, bool withBlade);
+
+/// A number in the short form messages use ("0.05", "1.5e-07").
+std::string formatNumber(double value);
 
 /// Metres per unit for M, CM, MM, IN, FT (any case; also METRE(S), METER(S), INCH(ES),
 /// FOOT, FEET, MILLIMETRE(S), ...). Sets @p canonical to the short upper-case name.

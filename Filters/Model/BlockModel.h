@@ -255,6 +255,9 @@ struct BlockModel
   Machine machine;
   std::vector<Carrier> carriers;
   std::vector<SurfaceFaces> surfaceFaces;
+  /// What applying the template chose for the user to know (its `notes:` whose `when`
+  /// held, e.g. "the inlet is at the start of the hub contour"). Not part of the document.
+  std::vector<std::string> notes;
 
   int findVertex(const std::string& name) const; ///< -1 if absent
   int findBlock(const std::string& name) const;  ///< -1 if absent

@@ -566,13 +566,17 @@ void CarrierGeometry::project(
     const Vec3 cp = c - c.dot(axis) * axis, qp = q - q.dot(axis) * axis;
     double angle = std::atan2(cp.cross(qp).dot(axis), cp.dot(qp));
     const double a0 = surface.angleStart(), a1 = surface.angleEnd();
-    while (angle < a0 && angle + 2.0 * Pi <= a1 + 1e-12)
+    // whole turns into [a0, a1] in one step (a loop of 2 pi steps never ends for a
+    // range far from 0)
+    if (angle < a0 && std::isfinite(a0))
     {
-      angle += 2.0 * Pi;
+      const double turns = std::floor((a1 + 1e-12 - angle) / (2.0 * Pi));
+      angle += 2.0 * Pi * std::max(0.0, std::min(turns, std::ceil((a0 - angle) / (2.0 * Pi))));
     }
-    while (angle > a1 && angle - 2.0 * Pi >= a0 - 1e-12)
+    if (angle > a1 && std::isfinite(a1))
     {
-      angle -= 2.0 * Pi;
+      const double turns = std::floor((angle - a0 + 1e-12) / (2.0 * Pi));
+      angle -= 2.0 * Pi * std::max(0.0, std::min(turns, std::ceil((angle - a1) / (2.0 * Pi))));
     }
     t = clampUnit((angle - a0) / (a1 - a0));
     distance = (surface.point(s, t) - p).norm();

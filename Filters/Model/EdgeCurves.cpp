@@ -154,7 +154,18 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
           "' is a curve; on_surface needs a surface");
       }
       const Eigen::Vector2d a = edgeEndParameters(model, geometry, edge, 0, size);
-      const Eigen::Vector2d b = edgeEndParameters(model, geometry, edge, 1, size);
+      Eigen::Vector2d b = edgeEndParameters(model, geometry, edge, 1, size);
+      // Straight in (s, t) the short way across the seam of a closed direction: a blade
+      // edge from s = 0.99 at the hub to s = 0.01 at the shroud (an export that starts
+      // its sections at the trailing edge) must not run round the whole blade.
+      if (geometry.closedS(edge.carrier))
+      {
+        b[0] -= std::round(b[0] - a[0]);
+      }
+      if (geometry.closedT(edge.carrier))
+      {
+        b[1] -= std::round(b[1] - a[1]);
+      }
       named.curve = std::make_shared<ParameterLineCurve>(geometry.surface(edge.carrier), a, b,
         geometry.closedS(edge.carrier), geometry.closedT(edge.carrier),
         geometry.extendsT(edge.carrier));
@@ -366,6 +377,46 @@ std::vector<double> lawParameters(
     }
   }
   return distributeNodes(DistributionLaw(), nodeCount, length);
+}
+
+DistributionLaw refinedLaw(const DistributionLaw& law, int templateCells, int cells)
+{
+  DistributionLaw refined = law;
+  if (cells == templateCells || templateCells < 1 || cells < 1)
+  {
+    return refined;
+  }
+  switch (law.kind)
+  {
+    case DistributionLaw::Kind::Geometric:
+      if (templateCells > 1 && cells > 1 && law.expansionRatio > 0.0)
+      {
+        refined.expansionRatio = std::pow(law.expansionRatio,
+          static_cast<double>(templateCells - 1) / static_cast<double>(cells - 1));
+      }
+      break;
+    case DistributionLaw::Kind::TwoSided:
+    {
+      const int from = (templateCells - 1) / 2, to = (cells - 1) / 2;
+      if (from > 0 && to > 0 && law.expansionRatio > 0.0)
+      {
+        refined.expansionRatio =
+          std::pow(law.expansionRatio, static_cast<double>(from) / static_cast<double>(to));
+      }
+      break;
+    }
+    case DistributionLaw::Kind::FirstCell:
+      refined.firstCellSize = law.firstCellSize * templateCells / cells;
+      if (law.expansionRatio > 1.0 && cells > 1 && templateCells > 1)
+      {
+        refined.expansionRatio = std::pow(law.expansionRatio,
+          static_cast<double>(templateCells - 1) / static_cast<double>(cells - 1));
+      }
+      break;
+    default:
+      break;
+  }
+  return refined;
 }
 
 std::vector<double> reversedParameters(const std::vector<double>& params)

@@ -25,8 +25,9 @@ std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int c
   std::array<int, 3> nodes{};
   for (int d = 0; d < 3; ++d)
   {
+    // validated by checkDensityMultiplier: at most MaxScaledCellsPerDirection
     const double scaled = std::round(block.cells[d] * multiplier);
-    int cells = static_cast<int>(std::max(1.0, std::min(scaled, 1.0e6)));
+    int cells = static_cast<int>(std::max(1.0, scaled));
     if (cap > 0)
     {
       cells = std::min(cells, cap);
@@ -90,7 +91,9 @@ void computeEdgeParameters(const BlockModel& model, MeshTopology& topology, int 
     std::vector<double> params;
     try
     {
-      params = lawParameters(block.laws[use.localEdge], edge.nodeCount, edge.length, allowFallback);
+      params = lawParameters(refinedLaw(block.laws[use.localEdge],
+                               block.cells[edgeDirection(use.localEdge)], edge.nodeCount - 1),
+        edge.nodeCount, edge.length, allowFallback);
     }
     catch (const GeometryError& error)
     {
@@ -149,7 +152,9 @@ void computeCollapsedParameters(const BlockModel& model, MeshTopology& topology,
       }
     }
     links.collapsedParams[e] = lawParameters(
-      model.blocks[b].laws[e], links.nodes[edgeDirection(e)], length > 0.0 ? length : 1.0, true);
+      refinedLaw(model.blocks[b].laws[e], model.blocks[b].cells[edgeDirection(e)],
+        links.nodes[edgeDirection(e)] - 1),
+      links.nodes[edgeDirection(e)], length > 0.0 ? length : 1.0, true);
   }
 }
 
@@ -466,6 +471,54 @@ std::size_t ProjectionCache::KeyHash::operator()(const Key& key) const
   return static_cast<std::size_t>(h);
 }
 
+/**
+ * The surface point closest to `target` near (s, t): Gauss-Newton from there on the
+ * surface's own parameters (derivatives by central differences through geometry.point,
+ * which wraps closed and extends Gordon carriers), steps limited so the node stays on
+ * the part of the surface it started on (a thin trailing edge has another side close by).
+ */
+void closestNear(const CarrierGeometry& geometry, int carrier, const Vec3& target, double& s,
+  double& t)
+{
+  const double h = 1e-6, largest = 0.02;
+  for (int iteration = 0; iteration < 8; ++iteration)
+  {
+    const Vec3 p = geometry.point(carrier, s, t);
+    const Vec3 ps = (geometry.point(carrier, s + h, t) - geometry.point(carrier, s - h, t)) / (2 * h);
+    const Vec3 pt = (geometry.point(carrier, s, t + h) - geometry.point(carrier, s, t - h)) / (2 * h);
+    const Vec3 r = target - p;
+    const double a = ps.dot(ps), b = ps.dot(pt), c = pt.dot(pt);
+    const double det = a * c - b * b;
+    if (!(det > 0.0) || !std::isfinite(det))
+    {
+      return;
+    }
+    double ds = (c * ps.dot(r) - b * pt.dot(r)) / det;
+    double dt = (a * pt.dot(r) - b * ps.dot(r)) / det;
+    const double step = std::max(std::abs(ds), std::abs(dt));
+    if (!std::isfinite(step))
+    {
+      return;
+    }
+    if (step > largest)
+    {
+      ds *= largest / step;
+      dt *= largest / step;
+    }
+    s += ds;
+    t = std::clamp(t + dt, geometry.tMin(carrier), geometry.tMax(carrier));
+    if (step < 1e-13)
+    {
+      return;
+    }
+  }
+}
+
+/// Grid of a face that lies on a surface: boundary nodes kept from the edges; each
+/// interior node is the surface point closest to the face's 3-D TFI node, searched from
+/// the TFI node in the surface's (s, t) space. TFI in (s, t) alone follows the
+/// parametrisation, which is far from even on a blade (aligned sections crowd the round
+/// edges into small s ranges): at high densities it put nodes behind their neighbours.
 void surfaceFace(const BlockModel& model, const MeshTopology& topology, const CarrierGeometry& geometry,
   int carrier, int block, int face, std::vector<double>& out, ProjectionCache* cache)
 {
@@ -538,13 +591,18 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
   transfiniteFace(EdgeNodes{ pb.data(), bottom.params(), na }, EdgeNodes{ pt.data(), top.params(), na },
     EdgeNodes{ pl.data(), left.params(), nb }, EdgeNodes{ pr.data(), right.params(), nb },
     parameters.data());
+  std::vector<double> targets(parameters.size());
+  transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), targets.data());
   out.resize(parameters.size());
   for (int b = 1; b + 1 < nb; ++b)
   {
     for (int a = 1; a + 1 < na; ++a)
     {
       const std::size_t i = static_cast<std::size_t>(b) * na + a;
-      const Vec3 p = geometry.point(carrier, parameters[3 * i], parameters[3 * i + 1]);
+      double s = parameters[3 * i], t = parameters[3 * i + 1];
+      closestNear(geometry, carrier, Vec3(targets[3 * i], targets[3 * i + 1], targets[3 * i + 2]),
+        s, t);
+      const Vec3 p = geometry.point(carrier, s, t);
       std::copy_n(p.data(), 3, &out[3 * i]);
     }
   }

@@ -76,6 +76,15 @@ void followEdgeEnds(
 std::vector<double> lawParameters(
   const DistributionLaw& law, int nodeCount, double length, bool allowFallback);
 std::vector<double> reversedParameters(const std::vector<double>& params);
+/**
+ * `law` as it applies to `cells` cells when the template gives `templateCells`: a density
+ * multiplier or a preview cap refines or coarsens the grid without changing its shape, so
+ * graded laws keep their overall expansion (geometric: last over first cell; two-sided:
+ * middle over end cell; first cell: its share of the edge). Without this a geometric
+ * ratio of 1.15 over 4 times the cells would make the first cell 1.15^18 times thinner
+ * (besides 4 times), and thin cells at a curved wall fold.
+ */
+DistributionLaw refinedLaw(const DistributionLaw& law, int templateCells, int cells);
 
 // -------------------------------------------------------------------- mesh topology
 /// A shared edge with its nodes: parameters in the canonical direction (from the first

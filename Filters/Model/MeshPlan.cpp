@@ -1,5 +1,6 @@
 #include "MeshPlan.h"
 
+#include "MemoryBudget.h"
 #include "MeshInternals.h"
 #include "Mesher.h"
 
@@ -127,12 +128,7 @@ void MeshPlan::Impl::buildDependencies()
 MeshPlan::MeshPlan(const BlockModel& model, const CarrierGeometry& carriers, double densityMultiplier)
   : P(new Impl)
 {
-  if (!std::isfinite(densityMultiplier) || !(densityMultiplier > 0.0))
-  {
-    throw TemplateError(model.sourceFile, 0, syntax::entity("model", model.name),
-      "the density multiplier must be a positive number, got " +
-        syntax::formatNumber(densityMultiplier));
-  }
+  checkDensityMultiplier(model, densityMultiplier);
   checkBasics(model);
   P->Model = model;
   P->Geometry = carriers;

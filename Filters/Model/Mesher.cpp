@@ -1,5 +1,6 @@
 #include "Mesher.h"
 
+#include "MemoryBudget.h"
 #include "MeshInternals.h"
 
 #include <algorithm>
@@ -44,12 +45,7 @@ MultiBlockMesher::MultiBlockMesher(
   const BlockModel& model, const CarrierGeometry* carriers, double densityMultiplier)
   : P(new Impl)
 {
-  if (!std::isfinite(densityMultiplier) || !(densityMultiplier > 0.0))
-  {
-    throw TemplateError(model.sourceFile, 0, entity("model", model.name),
-      "the density multiplier must be a positive number, got " +
-        formatNumber(densityMultiplier));
-  }
+  checkDensityMultiplier(model, densityMultiplier);
   checkBasics(model);
   P->Model = model;
   P->Multiplier = densityMultiplier;

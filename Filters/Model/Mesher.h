@@ -51,7 +51,10 @@ class MultiBlockMesher
 {
 public:
   /// `densityMultiplier` scales every cell count: cells = max(1, round(cells * m)).
-  /// Calls checkModel(); throws TemplateError on any problem.
+  /// Calls checkModel(); throws TemplateError on any problem, also when the multiplier is
+  /// not in (0, MaxDensityMultiplier] or a scaled count exceeds MaxScaledCellsPerDirection
+  /// (checkDensityMultiplier; errors, not clamps: the user asked for something else than
+  /// what would be meshed).
   MultiBlockMesher(const BlockModel& model, double densityMultiplier = 1.0);
   /// Same with the model's carriers already built (loadTemplate's `carriers`).
   MultiBlockMesher(const BlockModel& model, const CarrierGeometry& carriers,

@@ -28,10 +28,7 @@ int ruleSource(const Vertex& vertex)
   }
 }
 
-namespace
-{
-/// The diagonal of the bounding box of the vertices placed so far (finite positions).
-double vertexSpan(const BlockModel& model)
+double placedVertexSpan(const BlockModel& model)
 {
   Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
   bool any = false;
@@ -47,6 +44,8 @@ double vertexSpan(const BlockModel& model)
   return any ? (high - low).norm() : 0.0;
 }
 
+namespace
+{
 /// The paper's parameter offsets: the image of a point on a surface of revolution about
 /// the machine axis is on the same surface at t + angle / (a1 - a0), if that is on it.
 void periodicParameters(const BlockModel& model, const CarrierGeometry& geometry,
@@ -62,7 +61,7 @@ void periodicParameters(const BlockModel& model, const CarrierGeometry& geometry
   const Carrier& definition = model.carriers[carrier];
   if (definition.kind == Carrier::Kind::Revolve &&
     (definition.axis - machine.axis).norm() <= 1e-12 &&
-    (definition.axisPoint - machine.axisPoint).norm() <= 1e-12 * std::max(1.0, vertexSpan(model)))
+    (definition.axisPoint - machine.axisPoint).norm() <= 1e-12 * std::max(1.0, placedVertexSpan(model)))
   {
     double t = original.constraint.t + angle / (definition.angleEnd - definition.angleStart);
     if (geometry.closedT(carrier))

@@ -20,6 +20,10 @@ namespace blockforge
 {
 namespace model
 {
+/// The diagonal of the bounding box of the vertices with finite positions (those placed
+/// so far while a template is read), 0 when there are none.
+double placedVertexSpan(const BlockModel& model);
+
 /// The vertex whose position `vertex`'s rule follows, -1 when it follows none.
 int ruleSource(const Vertex& vertex);
 

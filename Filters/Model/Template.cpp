@@ -22,6 +22,8 @@
 #include <set>
 #include <sstream>
 
+#include <sys/stat.h>
+
 namespace blockforge
 {
 namespace model
@@ -37,6 +39,7 @@ constexpr int TemplateFormatVersion = 2;
 constexpr double Pi = 3.14159265358979323846;
 /// Cells per block direction; keeps node arrays well inside int range.
 constexpr double MaxCellsPerDirection = 1.0e6;
+constexpr double MaxBladeCount = 1.0e5;
 
 /// Failure of one expression, in user terms; the caller adds file, line and entity.
 struct ExpressionError
@@ -441,6 +444,7 @@ public:
     readBlocks();
     readFaces();
     readPatches();
+    readNotes();
     return std::move(Model);
   }
 
@@ -585,7 +589,13 @@ private:
     YAML::Node root;
     try
     {
-      root = YAML::Load(Text);
+      const std::vector<YAML::Node> documents = YAML::LoadAll(Text);
+      if (documents.size() > 1)
+      {
+        fail(documents[1].Mark().line >= 0 ? documents[1].Mark().line + 1 : 0, "",
+          "a second YAML document (after '---' or '...'): a template is one document");
+      }
+      root = documents.empty() ? YAML::Node() : documents.front();
     }
     catch (const YAML::Exception& error)
     {
@@ -602,7 +612,7 @@ private:
     Sections = syntax::mapEntries(root, 1, "", "the template", Report);
     syntax::checkKeys(Sections,
       { "blockforge", "name", "description", "inputs", "machine", "parameters", "definitions",
-        "carriers", "vertices", "edges", "blocks", "faces", "patches" },
+        "carriers", "vertices", "edges", "blocks", "faces", "patches", "notes" },
       "", Report);
     const MapEntry* version = syntax::findEntry(Sections, "blockforge");
     if (!version)
@@ -628,7 +638,7 @@ private:
     Version = static_cast<int>(versionNumber);
     if (Version < 2)
     {
-      for (const char* key : { "inputs", "machine", "definitions", "carriers", "faces" })
+      for (const char* key : { "inputs", "machine", "definitions", "carriers", "faces", "notes" })
       {
         if (const MapEntry* entry = syntax::findEntry(Sections, key))
         {
@@ -1091,6 +1101,57 @@ private:
     }
   }
 
+  /// Format 2 `notes`: `name: {when: <expression>, say: "text with {expression}s"}`; the
+  /// text of every note whose `when` is not 0 goes to Model.notes, each {expression}
+  /// replaced by its value (how a template says which of its choices it made).
+  void readNotes()
+  {
+    const MapEntry* notes = section("notes");
+    if (!notes || notes->value.IsNull())
+    {
+      return;
+    }
+    for (const MapEntry& entry :
+      syntax::mapEntries(notes->value, notes->line, "", "the notes section", Report, "note"))
+    {
+      const std::string entityText = entity("note", entry.key);
+      const auto keys =
+        syntax::mapEntries(entry.value, entry.line, entityText, "a note", Report);
+      syntax::checkKeys(keys, { "when", "say" }, entityText, Report);
+      const MapEntry* when = syntax::findEntry(keys, "when");
+      const MapEntry* say = syntax::findEntry(keys, "say");
+      if (!say || !say->value.IsScalar())
+      {
+        fail(entry.line, entityText, "a note needs 'say: <text>' (and 'when: <expression>')");
+      }
+      if (when && number(when->value, when->line, entityText, "when") == 0.0)
+      {
+        continue;
+      }
+      const std::string text = say->value.Scalar();
+      std::string said;
+      for (std::size_t at = 0; at < text.size();)
+      {
+        const std::size_t open = text.find('{', at);
+        if (open == std::string::npos)
+        {
+          said += text.substr(at);
+          break;
+        }
+        const std::size_t close = text.find('}', open);
+        if (close == std::string::npos)
+        {
+          fail(say->line, entityText, "'{' without '}' in the text");
+        }
+        said += text.substr(at, open - at);
+        YAML::Node expression(text.substr(open + 1, close - open - 1));
+        said += shortNumber(number(expression, say->line, entityText, "say"));
+        at = close + 1;
+      }
+      Model.notes.push_back(said);
+    }
+  }
+
   void readPatches()
   {
     const MapEntry* patches = section("patches");
@@ -1408,7 +1469,7 @@ private:
       if (const MapEntry* count = syntax::findEntry(keys, "blade_count"))
       {
         bladeCount = number(count->value, count->line, entityText, "blade_count");
-        if (bladeCount != std::floor(bladeCount) || bladeCount < 1 || bladeCount > 100000)
+        if (bladeCount != std::floor(bladeCount) || bladeCount < 1 || bladeCount > MaxBladeCount)
         {
           fail(count->line, entityText, "blade_count must be a whole number from 1 to 100000");
         }
@@ -1422,6 +1483,12 @@ private:
     if (Inputs && Inputs->bladeCount > 0)
     {
       bladeCount = Inputs->bladeCount;
+      if (bladeCount > MaxBladeCount)
+      {
+        fail(0, "machine",
+          Inputs->origin + " gives blade count " + std::to_string(Inputs->bladeCount) +
+            "; the blade count must be a whole number from 1 to 100000");
+      }
     }
     machine.bladeCount = static_cast<int>(bladeCount);
     Evaluator.define("axis_x", machine.axis.x());
@@ -1634,6 +1701,10 @@ private:
       {
         ensureVertex(index);
       }
+      else if (Model.findCarrier(referenced) >= 0)
+      {
+        ensureCarrier(Model.findCarrier(referenced)); // contour.axial_min, ...
+      }
     };
     for (std::size_t d = 0; d < DefinitionEntries.size(); ++d)
     {
@@ -1766,6 +1837,54 @@ private:
       Evaluator.Unavailable[n + ".s"] = why;
       Evaluator.Unavailable[n + ".t"] = why;
     }
+  }
+
+  /// `revolve: ..., extend: f`: the contour continues straight along its end tangents by
+  /// f times its length at both ends (short exports: inlet and outlet further out).
+  void extendContour(std::vector<Vec3>& points, double fraction, int line,
+    const std::string& entityText)
+  {
+    if (!(fraction >= 0.0) || fraction > 10.0)
+    {
+      fail(line, entityText, "extend: expected a fraction of the contour's length from 0 to "
+                             "10, got " + shortNumber(fraction));
+    }
+    if (fraction == 0.0 || points.size() < 2)
+    {
+      return;
+    }
+    double length = 0.0;
+    for (std::size_t k = 1; k < points.size(); ++k)
+    {
+      length += (points[k] - points[k - 1]).norm();
+    }
+    const Vec3 back = (points[0] - points[1]).normalized();
+    const Vec3 ahead = (points.back() - points[points.size() - 2]).normalized();
+    const Vec3 first = points.front(), last = points.back();
+    for (int step = 1; step <= 4; ++step)
+    {
+      points.insert(points.begin(), first + fraction * length * step / 4.0 * back);
+      points.push_back(last + fraction * length * step / 4.0 * ahead);
+    }
+  }
+
+  /// `<revolve carrier>.axial_min` and `.axial_max`: where its contour starts and ends
+  /// along the axis (an inlet or outlet plane must stay within them).
+  void defineContourQueries(const Carrier& carrier, const std::vector<Vec3>& points)
+  {
+    if (!syntax::isIdentifier(carrier.name) || points.empty())
+    {
+      return;
+    }
+    double low = std::numeric_limits<double>::infinity(), high = -low;
+    for (const Vec3& p : points)
+    {
+      const double axial = (p - carrier.axisPoint).dot(carrier.axis);
+      low = std::min(low, axial);
+      high = std::max(high, axial);
+    }
+    Evaluator.defineQuery(carrier.name + ".axial_min", low);
+    Evaluator.defineQuery(carrier.name + ".axial_max", high);
   }
 
   void ensureCarrier(int index)
@@ -2069,7 +2188,8 @@ private:
     if (kind->key == "revolve")
     {
       syntax::checkKeys(keys,
-        { "revolve", "axis", "origin", "angle", "meridional", "degree", "parameters" },
+        { "revolve", "axis", "origin", "angle", "meridional", "degree", "parameters",
+          "extend" },
         entityText, Report);
       carrier.kind = Carrier::Kind::Revolve;
       carrier.axis = Model.machine.axis;
@@ -2149,6 +2269,12 @@ private:
           point = meridional(point, carrier.axisPoint, carrier.axis);
         }
       }
+      if (const MapEntry* extend = syntax::findEntry(keys, "extend"))
+      {
+        extendContour(contour.points,
+          number(extend->value, extend->line, entityText, "extend"), extend->line, entityText);
+      }
+      defineContourQueries(carrier, contour.points);
       carrier.refs = { addHiddenCarrier(contour) };
       return;
     }
@@ -2567,8 +2693,10 @@ private:
     {
       fail(line, entityText,
         "closed: " + what + " is open: its first and last points are " + shortNumber(gap) +
-          " apart (relative " + shortNumber(gap / size) +
-          "); the blade surface must close around every section");
+          " apart (" + shortNumber(100.0 * gap / size) +
+          " % of its size); the blade surface must close around every section (the "
+          "TurboPointSetsReader joins gaps up to 0.2 % of the chord and caps blunt "
+          "trailing edges up to 5 %)");
     }
   }
 
@@ -2580,18 +2708,7 @@ private:
 
   double vertexSpan() const
   {
-    Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
-    bool any = false;
-    for (const Vertex& vertex : Model.vertices)
-    {
-      if (vertex.position.allFinite())
-      {
-        low = low.cwiseMin(vertex.position);
-        high = high.cwiseMax(vertex.position);
-        any = true;
-      }
-    }
-    return any ? (high - low).norm() : 0.0;
+    return placedVertexSpan(Model);
   }
 
   void checkOnCarrier(int vertex, int carrier, double distance, int line, const std::string& entityText)
@@ -2690,7 +2807,8 @@ private:
     const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
     double c = b - ratio * (b - a), d = a + ratio * (b - a);
     double fc = f(c), fd = f(d);
-    while (b - a > 1e-14)
+    // bounded: far from 0 the bracket stops shrinking at the spacing of doubles
+    for (int iteration = 0; b - a > 1e-14 && iteration < 200; ++iteration)
     {
       if (fc < fd)
       {
@@ -2799,7 +2917,7 @@ private:
       }
       double a = std::max(0.0, (best - 1.0) / samples), b = std::min(1.0, (best + 1.0) / samples);
       const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-      while (b - a > 1e-15)
+      for (int iteration = 0; b - a > 1e-15 && iteration < 200; ++iteration)
       {
         const double c = b - ratio * (b - a), d = a + ratio * (b - a);
         if (f(c) < f(d))
@@ -3458,8 +3576,19 @@ private:
   std::vector<ParameterInfo> Infos;
 };
 
+/// Templates are a few kilobytes; this bound keeps /dev/zero or a grid picked by mistake
+/// from being read until memory runs out.
+constexpr std::size_t MaxTemplateBytes = 16u << 20;
+
+/// The template's text with line ends made "\n" (Windows "\r\n" and old Mac lone "\r",
+/// which YAML would otherwise read as one long line).
 std::string readFile(const std::string& path)
 {
+  struct stat status;
+  if (::stat(path.c_str(), &status) == 0 && S_ISDIR(status.st_mode))
+  {
+    throw TemplateError(path, 0, "", "'" + path + "' is a folder, not a template file");
+  }
   std::ifstream stream(path, std::ios::binary);
   if (!stream)
   {
@@ -3468,9 +3597,38 @@ std::string readFile(const std::string& path)
       "cannot open template file '" + path + "'" +
         (error ? std::string(": ") + std::strerror(error) : std::string()));
   }
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
+  std::string text(MaxTemplateBytes + 1, '\0');
+  stream.read(&text[0], static_cast<std::streamsize>(text.size()));
+  if (stream.bad() || (stream.fail() && !stream.eof()))
+  {
+    const int error = errno;
+    throw TemplateError(path, 0, "",
+      "cannot read template file '" + path + "'" +
+        (error ? std::string(": ") + std::strerror(error) : std::string()));
+  }
+  text.resize(static_cast<std::size_t>(stream.gcount()));
+  if (text.size() > MaxTemplateBytes)
+  {
+    throw TemplateError(path, 0, "",
+      "'" + path + "' is larger than " + std::to_string(MaxTemplateBytes >> 20) +
+        " MB: not a template file");
+  }
+  std::string normalized;
+  normalized.reserve(text.size());
+  for (std::size_t i = 0; i < text.size(); ++i)
+  {
+    if (text[i] == '\r')
+    {
+      normalized += '\n';
+      if (i + 1 < text.size() && text[i + 1] == '\n')
+      {
+        ++i;
+      }
+      continue;
+    }
+    normalized += text[i];
+  }
+  return normalized;
 }
 } // namespace
 

@@ -9,11 +9,17 @@ and :func:`mesh_template` runs the whole pipeline in one call.
 """
 # The wrapped classes derive from these VTK modules; import them first so their
 # Python types are registered.
+import os
+
 from vtkmodules import vtkCommonCore, vtkCommonDataModel, vtkCommonExecutionModel  # noqa: F401
 
 from .BlockForgeFilters import (  # noqa: F401
+    vtkBlockCGNSWriter,
+    vtkBlockFoamWriter,
+    vtkBlockGridWriter,
     vtkBlockMesher,
     vtkBlockOptimizer,
+    vtkBlockPlot3DWriter,
     vtkBlockTemplate,
     vtkBlockTemplateAlgorithm,
     vtkBlockTemplateSource,
@@ -22,8 +28,12 @@ from .BlockForgeFilters import (  # noqa: F401
 )
 
 __all__ = [
+    "vtkBlockCGNSWriter",
+    "vtkBlockFoamWriter",
+    "vtkBlockGridWriter",
     "vtkBlockMesher",
     "vtkBlockOptimizer",
+    "vtkBlockPlot3DWriter",
     "vtkBlockTemplate",
     "vtkBlockTemplateAlgorithm",
     "vtkBlockTemplateSource",
@@ -37,10 +47,27 @@ __all__ = [
 MIN_ANGLE_CLASSES = ("0-20", "20-40", "40-60", "60-80", "80-90")
 
 
+def printable(text):
+    """*text* (str or bytes) as a str that can be printed anywhere: bytes that are not
+    UTF-8 (and the surrogate escapes Python uses for them in file names and argv) are
+    shown as \\xNN, like the C++ side does in its messages."""
+    if isinstance(text, bytes):
+        return text.decode("utf-8", "backslashreplace")
+    text = str(text)
+    try:
+        text.encode("utf-8")
+        return text
+    except UnicodeEncodeError:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+
+
 def _message(text):
     """The text of a VTK error or warning without VTK's "ERROR: In file, line N" and
-    "Class (0x...): " header."""
-    text = text.strip()
+    "Class (0x...): " header. VTK hands Python None for a message that is not valid
+    UTF-8 (BlockForge's own messages never are: they escape such bytes)."""
+    if text is None:
+        return "a message that is not valid UTF-8 text"
+    text = printable(text).strip()
     if text.startswith(("ERROR: In ", "Warning: In ")):
         text = text.partition("\n")[2]
     head, sep, rest = text.partition("): ")
@@ -49,8 +76,22 @@ def _message(text):
     return text.strip()
 
 
+def _path_argument(path):
+    """A file name for a VTK method: str, or bytes when it holds bytes that are not UTF-8
+    (surrogate escapes), which VTK passes on unchanged."""
+    path = os.fspath(path)
+    if isinstance(path, bytes):
+        return path
+    try:
+        path.encode("utf-8")
+        return path
+    except UnicodeEncodeError:
+        return os.fsencode(path)
+
+
 def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_file=None,
-                  timings=None, allow_inverted_cells=False, warnings=None, optimize=True):
+                  timings=None, allow_inverted_cells=False, warnings=None,
+                  maximum_memory=0.0, optimize=True):
     """:func:`mesh_template`; with a dict *timings*, also records the seconds of each
     stage under "read" (only with an input file), "template", "optimize" (unless
     *optimize* is false) and "mesh + quality"; with a list *warnings*, collects the stages'
@@ -64,15 +105,16 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     stages = []  # (timing key, the algorithm whose update runs that stage)
     if input_file is not None:
         reader = vtkTurboPointSetsReader()
-        reader.SetFileName(str(input_file))
+        reader.SetFileName(_path_argument(input_file))
         template = vtkBlockTemplate()
         template.SetInputConnection(reader.GetOutputPort())
         stages.append(("read", reader))
     else:
         template = vtkBlockTemplateSource()
-    template.SetTemplateFile(str(template_file))
+    template.SetTemplateFile(_path_argument(template_file))
+    template.SetMaximumMemory(float(maximum_memory))
     for name, value in (parameters or {}).items():
-        template.SetParameter(str(name), str(value))
+        template.SetParameter(_path_argument(str(name)), _path_argument(str(value)))
     stages.append(("template", template))
     model = template
     if optimize:
@@ -83,10 +125,12 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
         model = optimizer
     mesher = vtkBlockMesher()
     mesher.SetDensityMultiplier(float(density_multiplier))
+    mesher.SetMaximumMemory(float(maximum_memory))
     mesher.SetAllowInvertedCells(bool(allow_inverted_cells))
     mesher.SetInputConnection(model.GetOutputPort(0))
     quality = vtkGridQuality()
     quality.SetInputConnection(mesher.GetOutputPort())
+    quality.SetMaximumMemory(float(maximum_memory))
     stages.append(("mesh + quality", quality))
 
     errors = []
@@ -121,7 +165,7 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
 
 
 def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None,
-                  allow_inverted_cells=False, optimize=True):
+                  allow_inverted_cells=False, maximum_memory=0.0, optimize=True):
     """Applies a template, optimizes its control points, meshes it and measures the grid.
 
     Without *input_file* the pipeline is vtkBlockTemplateSource -> vtkBlockOptimizer ->
@@ -139,6 +183,10 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
     :param allow_inverted_cells: False (default): a grid with an inverted cell is an error
         naming the block and the cell range; True: the grid is returned anyway for
         inspection (field data ``InvertedCellCount``, a VTK warning per folded block)
+    :param maximum_memory: largest memory in GB (2^30 bytes) a stage may allocate; 0:
+        what the machine has available. A larger grid is refused before it is allocated
+        ("the grid would need 48 GB for 2e+09 nodes; this machine has 23 GB available;
+        lower the density multiplier or the cell counts").
     :param optimize: True (default): the vtkBlockOptimizer moves the control points along
         their carriers to maximise the smallest element angle (paper step 3); False: the
         template's vertices are meshed as placed
@@ -150,4 +198,5 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
         "<template>:<line>: ..." message). No later stage runs after a failing one.
     """
     return _run_pipeline(template_file, parameters, density_multiplier, input_file,
-                         allow_inverted_cells=allow_inverted_cells, optimize=optimize)
+                         allow_inverted_cells=allow_inverted_cells,
+                         maximum_memory=maximum_memory, optimize=optimize)

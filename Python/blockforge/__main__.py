@@ -1,28 +1,31 @@
 """Command line: ``python3 -m blockforge TEMPLATE [-i POINTS] [-o grid.vtm] [-p NAME=EXPR ...]
-[-d DENSITY] [--allow-inverted-cells] [--no-optimize]``.
+[-d DENSITY] [-m GB] [--allow-inverted-cells] [--no-optimize]``.
 
 Applies a template (to the point data of -i, read by the TurboPointSetsReader, for a
 template with inputs), optimizes its control points (the BlockOptimizer; --no-optimize
 skips it), meshes it, prints a quality summary (cell count, the paper's
 MinAngle classes, min/mean/max of every measure) and writes the grid with its quality
-arrays. The grid file (x.vtm and its directory of pieces x/) is written next to the
-target first and then moved into place, replacing older ones: a failing run leaves no
-partial grid and keeps an older one. Exit status 1 with the error message on failure.
+arrays. The grid (x.vtm and a fresh folder of pieces x.pieces-<id>/) is written beside the
+target, read back, and published by renaming x.vtm into place; the older grid's pieces are
+removed after. A failing or killed run leaves no partial grid and keeps an older one;
+leftovers of killed runs are removed by the next run. Exit status 1 with the error
+message on failure (also for a grid that would need more memory than available or than
+--max-memory).
 """
 import argparse
-import os
-import shutil
 import sys
-import tempfile
 import time
 
 import blockforge
+import blockforge.output
+from blockforge import printable
+from blockforge import writers
 
 
 def _parse_parameter(text):
     name, sep, value = text.partition("=")
     if not sep or not name.strip():
-        raise argparse.ArgumentTypeError(f"expected NAME=EXPRESSION, got '{text}'")
+        raise argparse.ArgumentTypeError(f"expected NAME=EXPRESSION, got '{printable(text)}'")
     return name.strip(), value.strip()
 
 
@@ -77,56 +80,11 @@ def summary_lines(quality):
 
 
 def write_grid(data_object, path):
-    """Writes *data_object* (a vtkMultiBlockDataSet) as the .vtm *path* plus the directory
-    of its pieces (``x.vtm`` -> ``x/``), atomically per file: both are written into a
-    temporary directory beside *path*, then moved into place, replacing older ones.
-    :raises RuntimeError: when the writer fails (nothing at *path* is touched then)."""
-    from vtkmodules.util.misc import calldata_type
-    from vtkmodules.util.vtkConstants import VTK_STRING
-    from vtkmodules.vtkCommonCore import vtkCommand
-    from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataWriter
-
-    path = os.path.abspath(path)
-    directory, name = os.path.split(path)
-    pieces = os.path.splitext(path)[0]  # the writer's directory of pieces
-    os.makedirs(directory, exist_ok=True)
-    staging = tempfile.mkdtemp(prefix=f".{name}.", suffix=".tmp", dir=directory)
-    try:
-        errors = []
-
-        @calldata_type(VTK_STRING)
-        def collect(_caller, _event, message):
-            errors.append(message)
-
-        writer = vtkXMLMultiBlockDataWriter()
-        writer.AddObserver(vtkCommand.ErrorEvent, collect)
-        writer.SetInputData(data_object)
-        writer.SetFileName(os.path.join(staging, name))
-        writer.SetDataModeToAppended()
-        writer.EncodeAppendedDataOff()
-        if not writer.Write() or errors:
-            detail = f": {blockforge._message(errors[0])}" if errors else ""
-            raise RuntimeError(f"could not write {path}{detail}")
-        staged_pieces = os.path.join(staging, os.path.basename(pieces))
-        # Pieces first, then the .vtm that references them; an older pieces directory is
-        # moved into the staging directory (removed with it on success, moved back if
-        # putting the new grid in place fails).
-        old_pieces = None
-        if os.path.lexists(pieces):
-            old_pieces = os.path.join(staging, ".old-pieces")
-            os.rename(pieces, old_pieces)
-        try:
-            if os.path.isdir(staged_pieces):
-                os.rename(staged_pieces, pieces)
-            os.replace(os.path.join(staging, name), path)
-        except OSError:
-            if old_pieces:
-                if os.path.isdir(pieces) and not os.path.islink(pieces):
-                    shutil.rmtree(pieces, ignore_errors=True)
-                os.rename(old_pieces, pieces)
-            raise
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+    """Writes *data_object* (a vtkMultiBlockDataSet) as the .vtm *path* plus a fresh folder
+    of its pieces beside it, checked after writing and published with one rename
+    (:func:`blockforge.output.write_vtm`); the older grid at *path* stays whole until then.
+    :raises RuntimeError: when writing fails or what was written is incomplete."""
+    blockforge.output.write_vtm(data_object, path)
 
 
 def main(argv=None):
@@ -136,11 +94,18 @@ def main(argv=None):
     parser.add_argument("-i", "--input", metavar="FILE",
                         help="point data for a template with inputs (BladeGen .inf, Info.txt "
                              "or point file, read by the TurboPointSetsReader)")
-    parser.add_argument("-o", "--output", help="grid file to write (.vtm)")
+    parser.add_argument("-o", "--output", help="grid file to write: .vtm, or DIR/NAME.foam "
+                        "(OpenFOAM case)")
+    parser.add_argument("--ascii", action="store_true",
+                        help="ASCII instead of binary where the format has both")
     parser.add_argument("-p", "--parameter", action="append", type=_parse_parameter,
                         default=[], metavar="NAME=EXPR", help="override a template parameter")
     parser.add_argument("-d", "--density", type=float, default=1.0,
-                        help="grid density multiplier (scales every cell count)")
+                        help="grid density multiplier (scales every cell count); above 0, at "
+                             "most 1000, at most 1,000,000 cells per block direction")
+    parser.add_argument("-m", "--max-memory", type=float, default=0.0, metavar="GB",
+                        help="refuse grids that would need more memory than this, in GB "
+                             "(2^30 bytes); default 0: what the machine has available")
     parser.add_argument("--allow-inverted-cells", action="store_true",
                         help="output a grid with inverted cells anyway, for inspection "
                              "(default: an error naming the block and the cell range)")
@@ -148,24 +113,29 @@ def main(argv=None):
                         help="mesh the template's vertices as placed (default: the "
                              "BlockOptimizer moves the control points first)")
     args = parser.parse_args(argv)
-    if args.output and not args.output.endswith(".vtm"):
-        parser.error(f"the output must be a .vtm file (a multiblock grid), got '{args.output}'")
+    if args.output and not (args.output.endswith(".vtm") or writers.is_solver_format(args.output)):
+        parser.error(f"the output must be .vtm or {', '.join(writers.SOLVER_WRITERS)}, "
+                     f"got '{printable(args.output)}'")
+    if not (args.max_memory >= 0.0) or args.max_memory == float("inf"):
+        parser.error(f"--max-memory must be a number of GB >= 0 (0: no limit), got "
+                     f"{args.max_memory}")
 
     timings = {}
     warnings = []
     try:
         quality = blockforge._run_pipeline(args.template, dict(args.parameter), args.density,
                                            args.input, timings, args.allow_inverted_cells,
-                                           warnings, optimize=not args.no_optimize)
-    except RuntimeError as error:
-        print(f"error: {error}", file=sys.stderr)
+                                           warnings, args.max_memory,
+                                           optimize=not args.no_optimize)
+    except (RuntimeError, MemoryError) as error:
+        print(f"error: {printable(error) if str(error) else 'out of memory'}", file=sys.stderr)
         return 1
     finally:
         for warning in warnings:
-            print(f"warning: {warning}", file=sys.stderr)
-    print(f"template: {args.template}")
+            print(f"warning: {printable(warning)}", file=sys.stderr)
+    print(f"template: {printable(args.template)}")
     if args.input:
-        print(f"input: {args.input}")
+        print(f"input: {printable(args.input)}")
     for line in summary_lines(quality):
         print(line)
     print("time [s]: " + ", ".join(f"{key} {seconds:.3f}" for key, seconds in timings.items())
@@ -173,11 +143,15 @@ def main(argv=None):
     if args.output:
         start = time.perf_counter()
         try:
-            write_grid(quality.GetOutputDataObject(0), args.output)
-        except (RuntimeError, OSError) as error:
-            print(f"error: {error}", file=sys.stderr)
+            if writers.is_solver_format(args.output):
+                writers.write_solver_grid(quality.GetOutputDataObject(0), args.output,
+                                          binary=not args.ascii)
+            else:
+                write_grid(quality.GetOutputDataObject(0), args.output)
+        except (RuntimeError, OSError, ValueError) as error:
+            print(f"error: {printable(error)}", file=sys.stderr)
             return 1
-        print(f"grid written to {args.output} ({time.perf_counter() - start:.3f} s)")
+        print(f"grid written to {printable(args.output)} ({time.perf_counter() - start:.3f} s)")
     return 0
 
 

@@ -66,13 +66,14 @@ machine: {theta_zero: sections}   # theta = 0 through the blade, so the passage 
 
 parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
-  o_corner: 50deg         # the O-grid corners' normals lean this far from the edge camber direction
+  o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
   probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
   follow_le: 0.7          # upstream H lines follow this fraction of the blade's leading-edge angle (0: axial)
   follow_te: 0.7          # downstream H lines follow this fraction of the trailing-edge angle
   upstream: 0.5           # inlet distance upstream of the first leading edge [blade axial lengths]
   downstream: 0.5         # outlet distance downstream of the last trailing edge [blade axial lengths]
+  extend: 0               # extend hub and shroud along their end tangents by this fraction of their length (0: inlet/outlet stop at the contour ends when those are nearer)
   n_up: 8                 # cells from inlet to the O-grid
   n_down: 8               # cells from the O-grid to the outlet
   n_pitch: 6              # cells across each H column beside the O-grid
@@ -112,6 +113,10 @@ patches:
   outlet: {type: outlet, faces: [D_L.j1, D_M.j1, D_R.j1]}
   periodic_low: {type: periodic, faces: [U_L.i0, M_L.i0, D_L.i0], partner: periodic_high, pitches: 1}
   periodic_high: {type: periodic, faces: [U_R.i1, M_R.i1, D_R.i1]}
+
+notes:
+  inlet: {when: "inlet_axial > inlet_wanted", say: "the inlet is where the hub and shroud contours start, {(min(le_h.axial, le_s.axial) - inlet_axial)/blade_axial} blade axial lengths upstream of the leading edge instead of {upstream} (set extend to continue the contours along their end tangents)"}
+  outlet: {when: "outlet_axial < outlet_wanted", say: "the outlet is where the hub and shroud contours end, {(outlet_axial - max(te_h.axial, te_s.axial))/blade_axial} blade axial lengths downstream of the trailing edge instead of {downstream} (set extend to continue the contours along their end tangents)"}
 """
 
 
@@ -122,8 +127,12 @@ def template_text():
     w('definitions:')
     w('  # axial extent of the blade (both layers) and the inlet and outlet planes')
     w('  blade_axial: "max(te_h.axial, te_s.axial) - min(le_h.axial, le_s.axial)"')
-    w('  inlet_axial: "min(le_h.axial, le_s.axial) - upstream*blade_axial"')
-    w('  outlet_axial: "max(te_h.axial, te_s.axial) + downstream*blade_axial"')
+    w('  inlet_wanted: "min(le_h.axial, le_s.axial) - upstream*blade_axial"')
+    w('  outlet_wanted: "max(te_h.axial, te_s.axial) + downstream*blade_axial"')
+    w('  # inlet and outlet planes: where asked, or where the hub and shroud contours start and')
+    w('  # end when they are nearer (a hair inside, so that both surfaces reach the plane)')
+    w('  inlet_axial: "max(inlet_wanted, max(hub.axial_min, shroud.axial_min) + 1e-9*blade_axial)"')
+    w('  outlet_axial: "min(outlet_wanted, min(hub.axial_max, shroud.axial_max) - 1e-9*blade_axial)"')
     for l, S in L.items():
         w(f'  # --- {S} (_{l}): lengths in the unrolled (axial, r*theta) plane at r = rm_{l}')
         w(f'  rm_{l}: le_{l}.radius')
@@ -152,8 +161,8 @@ def template_text():
         gap('ogap_le', 'ob_f', 'oa_f'); gap('ogap_a', 'oa_f', 'oa_r'); gap('ogap_te', 'oa_r', 'ob_r'); gap('ogap_b', 'ob_r', 'ob_f')
     w('')
     w('carriers:')
-    w('  hub: {revolve: hub, axis: machine}')
-    w('  shroud: {revolve: shroud, axis: machine}')
+    w('  hub: {revolve: hub, axis: machine, extend: extend}')
+    w('  shroud: {revolve: shroud, axis: machine, extend: extend}')
     w('  blade: {gordon: sections, blending: spline, closed: true, align: axial}   # every section: leading edge at s = 0.25, trailing edge at 0.75')
     for l, S in L.items():
         w(f'  blade_{l}: {{intersect: [blade, {S}]}}')

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,9 @@ protected:
     std::error_code ignored;
     fs::remove_all(this->Dir, ignored);
   }
+
+public:
+  /// Writes `text` to the file `name` of the folder (public: helpers take the fixture).
   std::string write(const std::string& name, const std::string& text)
   {
     const fs::path path = this->Dir / name;
@@ -447,7 +451,7 @@ TEST_F(TurboPointSetsVariations, SiblingsOfTheSameSetArePaired)
 {
   const std::string rows = "0 0 1\n1 0 1\n2 0 1\n3 0 1\n";
   write("hub_A.dat", rows);
-  write("hub_B.dat", rows + rows);
+  write("hub_B.dat", rows + "4 0 1\n5 0 1\n6 0 1\n7 0 1\n");
   write("shroud_B.dat", rows);
   const std::string profile = write("profile_B.dat", rows);
   write("Info.txt", "No of blades : 9\nAxis of rotation : -z\nCoordinates unit : FT\n");
@@ -598,4 +602,304 @@ TEST_F(TurboPointSetsErrors, OtherProblems)
   options.profileFile = (this->Dir / "absent.crv").string();
   EXPECT_TRUE(contains(expectReadError([&] { readTurboPointSets("", options); }).what(),
     "cannot open the profile file"));
+}
+
+//------------------------------------------------------------------------------------------
+// What real exports do: other section headers, open sections, sections out of span order,
+// kinked rows
+
+namespace
+{
+using blockforge::io::Closure;
+using blockforge::io::EdgeCap;
+
+class TurboPointSetsRepairs : public TempDir
+{
+};
+
+constexpr double Pi = 3.14159265358979323846;
+
+/// Rows "x y z" of a blade section about the z axis at radius r: an ellipse of chord 1
+/// and thickness `thickness` in the (axial z, r theta) plane centred at z = 0, from the
+/// trailing edge (z = 0.5) over the suction side, round the leading edge and back, left
+/// open at the trailing edge by `gap` (0: the first row repeated at the end). Rows
+/// `reverseFrom` .. `reverseFrom + reverseCount - 1` are written in reverse order.
+std::string sectionRows(double r, double thickness, double gap, int n = 40,
+  int reverseFrom = 0, int reverseCount = 0)
+{
+  const double start = gap > 0 ? std::asin(gap / thickness) : 0.0;
+  std::vector<std::string> rows;
+  for (int i = 0; i <= n; ++i)
+  {
+    const double phi = start + (2 * Pi - 2 * start) * i / n;
+    const double z = 0.5 * std::cos(phi), y = 0.5 * thickness * std::sin(phi);
+    std::ostringstream row;
+    row.precision(17);
+    row << r * std::cos(y / r) << " " << r * std::sin(y / r) << " " << z << "\n";
+    rows.push_back(row.str());
+  }
+  if (gap == 0)
+  {
+    rows.back() = rows.front();
+  }
+  std::reverse(rows.begin() + reverseFrom, rows.begin() + reverseFrom + reverseCount);
+  std::string text;
+  for (const auto& row : rows)
+  {
+    text += row;
+  }
+  return text;
+}
+
+/// A meridional contour at radius r from z = -1 to 1 (x = r, y = 0), 9 rows.
+std::string contourRows(double r)
+{
+  std::string text;
+  for (int i = 0; i <= 8; ++i)
+  {
+    text += std::to_string(r) + " 0 " + std::to_string(-1.0 + 0.25 * i) + "\n";
+  }
+  return text;
+}
+
+/// Reads `profile` with a hub at radius 0.9 and a shroud at 1.5 (axis Z).
+TurboPointSets readWithContours(TempDir& dir, const std::string& profile,
+  EdgeCap cap = EdgeCap::Straight, const std::string& hub = contourRows(0.9))
+{
+  ReadOptions options;
+  options.hubFile = dir.write("hub.curve", hub);
+  options.shroudFile = dir.write("shroud.curve", contourRows(1.5));
+  options.profileFile = dir.write("profile.curve", profile);
+  options.cap = cap;
+  return readTurboPointSets("", options);
+}
+} // namespace
+
+TEST_F(TurboPointSetsRepairs, EveryCommentOrBlankLineBetweenRowsStartsASection)
+{
+  const std::string rows = sectionRows(1.0, 0.1, 0.0, 8);
+  const std::string file = write("profile.curve",
+    "# exported by a design tool\n# units: mm\n"
+    "## Rotor1\n# Rotor1 Profile 1\n" + rows + "# Rotor1 Profile 2\n" + rows +
+    "# IGV Profile 5\n" + rows +
+    "# Profile 3 at 16.6667%\n" + rows +
+    "# pressure and suction side, whatever this says\n" + rows +
+    "\n\n" + rows +
+    "! a bang comment\n" + rows + "#\n" + rows);
+  const auto sections = readPointFile(file, true);
+  ASSERT_EQ(sections.size(), 8u);
+  EXPECT_EQ(sections[0].number, 1);
+  EXPECT_EQ(sections[0].blade, "Rotor1");
+  EXPECT_EQ(sections[0].firstLine, 4);
+  EXPECT_EQ(sections[1].number, 2);
+  EXPECT_EQ(sections[2].number, 5);
+  EXPECT_FALSE(sections[2].spanGiven);
+  EXPECT_EQ(sections[3].number, 3);
+  EXPECT_TRUE(sections[3].spanGiven);
+  EXPECT_DOUBLE_EQ(sections[3].spanPercent, 16.6667);
+  for (const auto& section : sections)
+  {
+    EXPECT_EQ(section.points.size(), 9u) << section.name;
+    ASSERT_EQ(section.lines.size(), 9u);
+    EXPECT_EQ(section.lines.back() - section.lines.front(), 8) << section.name;
+  }
+  // Spans: "at s %", "s% span", and "at" without a number is an error.
+  const std::string spans = write("spans.curve",
+    "# Section 1 at 12.5 %\n" + rows + "# Profile 2 50% span\n" + rows);
+  const auto two = readPointFile(spans, true);
+  EXPECT_DOUBLE_EQ(two[0].spanPercent, 12.5);
+  EXPECT_DOUBLE_EQ(two[1].spanPercent, 50.0);
+  const std::string bad = write("bad.curve", "# Profile 2 at the hub\n" + rows);
+  EXPECT_TRUE(contains(expectReadError([&] { readPointFile(bad, true); }).what(),
+    "bad.curve:1: malformed section header"));
+}
+
+TEST_F(TurboPointSetsRepairs, OpenSectionsAreJoinedCappedOrLeftOpen)
+{
+  const std::string profile = "# Profile 1 at 0%\n" + sectionRows(1.0, 0.1, 0.0) +
+    "# Profile 2 at 33%\n" + sectionRows(1.1, 0.1, 5e-4) + "# Profile 3 at 67%\n" +
+    sectionRows(1.2, 0.1, 0.015, 160) + "# Profile 4 at 100%\n" + sectionRows(1.3, 0.2, 0.08);
+  const TurboPointSets sets = readWithContours(*this, profile);
+  ASSERT_EQ(sets.profiles.size(), 4u);
+  const auto& closed = sets.profiles[0];
+  const auto& joined = sets.profiles[1];
+  const auto& capped = sets.profiles[2];
+  const auto& open = sets.profiles[3];
+  EXPECT_EQ(closed.closure, Closure::Closed);
+  EXPECT_EQ(closed.gapFraction, 0.0);
+  EXPECT_EQ(joined.closure, Closure::Joined);
+  EXPECT_EQ(capped.closure, Closure::Capped);
+  EXPECT_EQ(open.closure, Closure::Open);
+  // The chord is the largest distance between two points: a little below 1 here (from
+  // the leading edge to the ends; 0.959 for the widely open one).
+  EXPECT_NEAR(joined.gapFraction, 5e-4, 1e-5);
+  EXPECT_NEAR(capped.gapFraction, 0.015, 3e-4);
+  EXPECT_NEAR(open.gapFraction, 0.08 / 0.9591, 2e-4);
+  EXPECT_EQ(joined.points.size(), 41u);
+  EXPECT_EQ(joined.points.front(), joined.points.back());
+  // The midpoint of the two ends.
+  EXPECT_NEAR(joined.points.front().z(), 0.5 * std::cos(std::asin(5e-4 / 0.1)), 1e-12);
+  EXPECT_NEAR(joined.points.front().y(), 0.0, 1e-12);
+  EXPECT_EQ(capped.points.front(), capped.points.back());
+  EXPECT_NE(open.points.front(), open.points.back());
+  // A straight cap: points on the segment between the two ends, about as far apart as
+  // the last points of the sides (0.0034 here: 0.015 across gives 4 segments).
+  EXPECT_EQ(capped.points.size(), 161u + 4u);
+  for (std::size_t i = 161; i < capped.points.size(); ++i)
+  {
+    EXPECT_NEAR(capped.points[i].z(), capped.points[160].z(), 1e-12);
+  }
+  EXPECT_EQ(capped.lines.size(), capped.points.size());
+  EXPECT_EQ(capped.lines.back(), capped.lines[160]);
+  // Reported: one warning per kind of repair, with the gaps.
+  std::string all;
+  for (const auto& warning : sets.warnings)
+  {
+    all += warning + "\n";
+  }
+  EXPECT_TRUE(contains(all, "1 section was open by 0.05 % of the chord (0.0005 M), from "
+                            "rounding: their ends were joined (Profile 2 (33%))"))
+    << all;
+  EXPECT_TRUE(contains(all, "blunt trailing edge of 1.51 % of the chord (0.015 M)")) << all;
+  EXPECT_TRUE(contains(all, "straight cap (Profile 3 (67%))")) << all;
+  EXPECT_FALSE(contains(all, "Profile 4")) << all;
+
+  // A file that does not repeat the first point: closed by repeating it.
+  std::string rows = sectionRows(1.0, 0.1, 0.0);
+  rows.erase(rows.rfind('\n', rows.size() - 2) + 1);
+  const TurboPointSets unrepeated = readWithContours(*this,
+    "# Profile 1 at 0%\n" + rows + "# Profile 2 at 100%\n" + sectionRows(1.3, 0.1, 0));
+  const auto& linked = unrepeated.profiles[0];
+  EXPECT_EQ(linked.closure, Closure::Segment);
+  ASSERT_EQ(linked.points.size(), 41u);
+  EXPECT_EQ(linked.points.back(), linked.points.front());
+  EXPECT_TRUE(contains(unrepeated.warnings.back(), "1 section was open by about one point "
+                                                   "spacing (0.995 % of the chord"))
+    << unrepeated.warnings.back();
+}
+
+TEST_F(TurboPointSetsRepairs, RoundedCapBulgesPastTheTrailingEdge)
+{
+  // A thick blunt edge: 4 % of the chord across, points 0.08 apart on the sides.
+  const std::string profile = "# Profile 1 at 0%\n" + sectionRows(1.0, 0.2, 0.04, 40) +
+    "# Profile 2 at 100%\n" + sectionRows(1.3, 0.2, 0.04, 40);
+  const TurboPointSets sets = readWithContours(*this, profile, EdgeCap::Rounded);
+  const auto& section = sets.profiles[0];
+  EXPECT_EQ(section.closure, Closure::Capped);
+  ASSERT_GT(section.points.size(), 42u);
+  const Eigen::Vector3d first = section.points.front(), last = section.points[40];
+  const Eigen::Vector3d middle = 0.5 * (first + last);
+  const double radius = 0.5 * (first - last).norm();
+  for (std::size_t i = 41; i + 1 < section.points.size(); ++i)
+  {
+    EXPECT_NEAR((section.points[i] - middle).norm(), radius, 1e-12);
+    EXPECT_GT(section.points[i].z(), middle.z()); // beyond the edge, not into the blade
+  }
+  EXPECT_TRUE(contains(sets.warnings.back(), "rounded cap")) << sets.warnings.back();
+}
+
+TEST_F(TurboPointSetsRepairs, SectionsAreSortedByTheirHeaderSpans)
+{
+  const TurboPointSets sets = readWithContours(*this,
+    "# Profile 1 at 0%\n" + sectionRows(1.0, 0.1, 0) + "# Profile 3 at 100%\n" +
+      sectionRows(1.4, 0.1, 0) + "# Profile 2 at 50%\n" + sectionRows(1.2, 0.1, 0));
+  ASSERT_EQ(sets.profiles.size(), 3u);
+  EXPECT_EQ(sets.profiles[1].name, "Profile 2 (50%)");
+  EXPECT_NEAR(sets.profiles[1].points[0].norm(), std::hypot(1.2, 0.5), 1e-6);
+  ASSERT_EQ(sets.warnings.size(), 1u);
+  EXPECT_TRUE(contains(sets.warnings[0], "sorted by the spans of their headers (file order: "
+                                         "Profile 1 (0%), Profile 3 (100%), Profile 2 (50%))"))
+    << sets.warnings[0];
+}
+
+TEST_F(TurboPointSetsRepairs, HeaderSpansThatContradictTheGeometryAreRefused)
+{
+  const ReadError error = expectReadError([&] {
+    readWithContours(*this,
+      "# Profile 1 at 0%\n" + sectionRows(1.0, 0.1, 0) + "# Profile 2 at 50%\n" +
+        sectionRows(1.4, 0.1, 0) + "# Profile 3 at 100%\n" + sectionRows(1.2, 0.1, 0));
+  });
+  EXPECT_EQ(error.line(), 85); // the header of Profile 3
+  EXPECT_TRUE(contains(error.what(), "section 'Profile 3 (100%)' lies at 50 % of the span "
+                                     "measured between hub and shroud, not beyond section "
+                                     "'Profile 2 (50%)' (line 43) at 83.3 %"))
+    << error.what();
+  EXPECT_TRUE(contains(error.what(), "(measured order: Profile 1 (0%) at 16.7 %, Profile 3 "
+                                     "(100%) at 50 %, Profile 2 (50%) at 83.3 %)"))
+    << error.what();
+  const ReadError same = expectReadError([&] {
+    readWithContours(*this,
+      "# Profile 1 at 0%\n" + sectionRows(1.0, 0.1, 0) + "# Profile 2 at 0%\n" +
+        sectionRows(1.4, 0.1, 0));
+  });
+  EXPECT_TRUE(contains(same.what(), "profile.curve:43: section 'Profile 2 (0%)' is at the "
+                                    "same span as section 'Profile 1 (0%)' (line 1)"))
+    << same.what();
+}
+
+TEST_F(TurboPointSetsRepairs, SectionsWithoutSpansAreSortedFromHubToShroud)
+{
+  // Written from the shroud down, with one out of place: sorted by where they lie.
+  const TurboPointSets sets = readWithContours(*this,
+    sectionRows(1.4, 0.1, 0) + "\n" + sectionRows(1.0, 0.1, 0) + "\n" +
+      sectionRows(1.2, 0.1, 0));
+  ASSERT_EQ(sets.profiles.size(), 3u);
+  const double radii[3] = { 1.0, 1.2, 1.4 };
+  const double spans[3] = { 0.0, 50.0, 100.0 };
+  for (int k = 0; k < 3; ++k)
+  {
+    EXPECT_NEAR(std::hypot(sets.profiles[k].points[0].x(), sets.profiles[k].points[0].y()),
+      radii[k], 1e-12);
+    EXPECT_DOUBLE_EQ(sets.profiles[k].spanPercent, spans[k]);
+  }
+  EXPECT_EQ(sets.profiles[0].name, "Profile 2 (0%)"); // numbered by file position
+  EXPECT_TRUE(contains(sets.warnings.back(), "sorted by where they lie")) << sets.warnings.back();
+}
+
+TEST_F(TurboPointSetsRepairs, KinkedOrSelfCrossingCurvesAreRefusedNamingTheRows)
+{
+  // Hub contour with rows 4..6 written in reverse: z = -1, -0.75, -0.5, 0.25, 0, -0.25,
+  // 0.5, ...: it turns back at line 4.
+  std::string hub = contourRows(0.9);
+  {
+    std::istringstream stream(hub);
+    std::vector<std::string> rows;
+    for (std::string row; std::getline(stream, row);)
+    {
+      rows.push_back(row + "\n");
+    }
+    std::reverse(rows.begin() + 3, rows.begin() + 6);
+    hub.clear();
+    for (const auto& row : rows)
+    {
+      hub += row;
+    }
+  }
+  const std::string closed = "# Profile 1 at 0%\n" + sectionRows(1.0, 0.1, 0) +
+    "# Profile 2 at 100%\n" + sectionRows(1.4, 0.1, 0);
+  const ReadError kinked =
+    expectReadError([&] { readWithContours(*this, closed, EdgeCap::Straight, hub); });
+  EXPECT_TRUE(contains(kinked.what(), "hub.curve:4: the Hub contour turns back at this row: "
+                                      "by 180 degrees between lines 3 and 5"))
+    << kinked.what();
+
+  // Ten rows of a section reversed: the section crosses itself.
+  const ReadError reversed = expectReadError([&] {
+    readWithContours(*this,
+      "# Profile 1 at 0%\n" + sectionRows(1.0, 0.1, 0, 40, 5, 10) + "# Profile 2 at 100%\n" +
+        sectionRows(1.4, 0.1, 0));
+  });
+  EXPECT_TRUE(contains(reversed.what(), "profile.curve:")) << reversed.what();
+  EXPECT_TRUE(contains(reversed.what(), "section 'Profile 1 (0%)'")) << reversed.what();
+  EXPECT_TRUE(contains(reversed.what(), "crosses itself: the segment between lines 6 and 7 "
+                                        "crosses the one between lines 16 and 17"))
+    << reversed.what();
+
+  // Two neighbouring rows swapped: a small zig-zag that crosses itself.
+  const ReadError swapped = expectReadError([&] {
+    readWithContours(*this,
+      "# Profile 1 at 0%\n" + sectionRows(1.0, 0.1, 0, 40, 9, 2) + "# Profile 2 at 100%\n" +
+        sectionRows(1.4, 0.1, 0));
+  });
+  EXPECT_TRUE(contains(swapped.what(), "section 'Profile 1 (0%)'")) << swapped.what();
 }

@@ -106,3 +106,18 @@ def run_tests():
     result = unittest.main(module="__main__", verbosity=2, argv=[sys.argv[0]],
                            exit=False).result
     sys.exit(0 if result.wasSuccessful() else 1)
+
+
+def read_cgns_zones(path):
+    """{zone name: data set} of the first base of a CGNS file, as ParaView's CGNS reader
+    (vtkCGNSReader) reads it."""
+    from vtkmodules.vtkIOCGNSReader import vtkCGNSReader
+
+    reader = vtkCGNSReader()
+    reader.SetFileName(path)
+    reader.UpdateInformation()
+    reader.EnableAllBases()
+    reader.Update()
+    base = reader.GetOutput().GetBlock(0)
+    return {base.GetMetaData(z).Get(base.NAME()): base.GetBlock(z)
+            for z in range(base.GetNumberOfBlocks())}

@@ -10,6 +10,7 @@ import shutil
 import unittest
 
 import blockforge
+import blockforge.output
 from blockforge.__main__ import main as blockforge_main
 from vtkmodules.numpy_interface import dataset_adapter as dsa
 from vtkmodules.vtkFiltersVerdict import vtkMeshQuality
@@ -266,6 +267,15 @@ class CommandLineTest(unittest.TestCase):
         reader.Update()
         return reader.GetOutput()
 
+    def pieces(self, path):
+        """The pieces folder the .vtm *path* references (its base name) and its files."""
+        folders = blockforge.output.referenced_folders(path)
+        self.assertEqual(len(folders), 1, folders)
+        folder = folders.pop()
+        self.assertTrue(os.path.basename(folder).startswith(
+            os.path.splitext(os.path.basename(path))[0] + ".pieces-"), folder)
+        return os.path.basename(folder), sorted(os.listdir(folder))
+
     def test_input_writes_vtm_atomically(self):
         path = os.path.join(self.directory, "oh.vtm")
         status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-o", path)
@@ -273,8 +283,9 @@ class CommandLineTest(unittest.TestCase):
         self.assertIn("cells: 9600", out)
         self.assertIn("grid written to", out)
         # the .vtm and its pieces, nothing else (no temporary left behind)
-        self.assertEqual(sorted(os.listdir(self.directory)), ["oh", "oh.vtm"])
-        self.assertEqual(len(os.listdir(os.path.join(self.directory, "oh"))), 12)
+        folder, files = self.pieces(path)
+        self.assertEqual(sorted(os.listdir(self.directory)), [folder, "oh.vtm"])
+        self.assertEqual(len(files), 12)
         grid = self.read_grid(path)
         self.assertEqual(len(named_leaves(grid)), 12)
         self.assertEqual(sum(block.GetNumberOfCells() for _, block in named_leaves(grid)), 9600)
@@ -290,14 +301,17 @@ class CommandLineTest(unittest.TestCase):
         self.assertIn("nosuch", err)
         with open(path, "rb") as file:
             self.assertEqual(file.read(), before)
-        self.assertEqual(sorted(os.listdir(self.directory)), ["oh", "oh.vtm"])
-        self.assertEqual(len(os.listdir(os.path.join(self.directory, "oh"))), 12)
+        self.assertEqual(sorted(os.listdir(self.directory)), [folder, "oh.vtm"])
+        self.assertEqual(self.pieces(path), (folder, files))
 
-        # a successful run replaces the older grid with its pieces (4 blocks, not 12)
+        # a successful run replaces the older grid with its pieces (4 blocks, not 12), in a
+        # fresh folder; the older folder is gone
         status, _, err = self.run_main(CYLINDER, "-o", path)
         self.assertEqual(status, 0, err)
-        self.assertEqual(sorted(os.listdir(self.directory)), ["oh", "oh.vtm"])
-        self.assertEqual(len(os.listdir(os.path.join(self.directory, "oh"))), 4)
+        new_folder, new_files = self.pieces(path)
+        self.assertNotEqual(new_folder, folder)
+        self.assertEqual(sorted(os.listdir(self.directory)), [new_folder, "oh.vtm"])
+        self.assertEqual(len(new_files), 4)
         self.assertEqual(len(named_leaves(self.read_grid(path))), 4)
 
     def test_inverted_cells_refused_unless_allowed(self):
@@ -336,20 +350,22 @@ class CommandLineTest(unittest.TestCase):
         self.assertEqual(os.listdir(self.directory), [])
 
     def test_failed_move_keeps_the_older_grid(self):
-        """The new grid cannot be put in place (the .vtm path is a directory): the older
-        pieces go back where they were and the error is reported."""
+        """The new grid cannot be put in place (the .vtm path is a directory): the new
+        pieces are removed and the error is reported; the pieces nothing references any
+        more (their .vtm was removed) are cleaned up as leftovers."""
         path = os.path.join(self.directory, "kept.vtm")
         status, _, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-o", path)
         self.assertEqual(status, 0, err)
-        pieces = sorted(os.listdir(os.path.join(self.directory, "kept")))
+        folder, files = self.pieces(path)
         os.remove(path)
         os.makedirs(os.path.join(path, "occupied"))
         status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-o", path)
         self.assertEqual(status, 1)
         self.assertIn("error:", err)
         self.assertNotIn("grid written", out)
-        self.assertEqual(sorted(os.listdir(os.path.join(self.directory, "kept"))), pieces)
-        self.assertEqual(sorted(os.listdir(self.directory)), ["kept", "kept.vtm"])
+        self.assertEqual(len(files), 12)
+        self.assertEqual(sorted(os.listdir(self.directory)), ["kept.vtm"])
+        self.assertEqual(os.listdir(path), ["occupied"])
 
     def test_bad_input_path(self):
         path = os.path.join(self.directory, "bad_input.vtm")

@@ -152,6 +152,40 @@ class ReaderTest(unittest.TestCase):
         self.assertNotEqual(reader.GetXMLLabel(), "Turbo Point Sets Reader")
         Delete(reader)
 
+    def test_open_sections_of_the_turbine_are_capped_as_asked(self):
+        turbine = os.path.join(SOURCE, "Data", "turbine", "Info.txt")
+        reader = TurboPointSetsReader(FileName=turbine)  # noqa: F821
+        self.assertEqual(reader.TrailingEdgeCap, "Straight")
+        sections = named_blocks(named_blocks(read(reader))["Profiles"])
+        self.assertEqual(len(sections), 9)
+        for name, section in sections.items():
+            self.assertEqual(field(section, "Closure"), "capped straight", name)
+            self.assertAlmostEqual(field(section, "GapFraction"), 0.0146, delta=2e-4)
+            xyz = points(section)
+            np.testing.assert_array_equal(xyz[0], xyz[-1])
+        straight = points(sections["Profile 1 (0%)"])
+        reader.TrailingEdgeCap = "Rounded"
+        sections = named_blocks(named_blocks(read(reader))["Profiles"])
+        rounded = points(sections["Profile 1 (0%)"])
+        self.assertEqual(field(sections["Profile 1 (0%)"], "Closure"), "capped rounded")
+        # The same sides, another cap: the rounded one reaches further downstream (+x).
+        np.testing.assert_array_equal(rounded[:159], straight[:159])
+        self.assertGreater(rounded[:, 0].max(), straight[:, 0].max() + 5e-6)
+        Delete(reader)
+
+    def test_compressor_export_style(self):
+        compressor = os.path.join(SOURCE, "Data", "compressor", "rotor.inf")
+        data = read(TurboPointSetsReader(FileName=compressor))  # noqa: F821
+        self.assertEqual(field(data, "AxisName"), "Y")
+        self.assertEqual(field(data, "Units"), "IN")
+        self.assertEqual(field(data, "UnitScale"), 0.0254)
+        sections = named_blocks(named_blocks(data)["Profiles"])
+        self.assertEqual(len(sections), 25)
+        self.assertIn("Profile 3 (8.33333%)", sections)
+        for name, section in sections.items():
+            self.assertEqual(field(section, "Closure"), "joined", name)
+            self.assertAlmostEqual(field(section, "GapFraction"), 2e-4, delta=1e-6)
+
     def test_error_names_file_and_line_and_leaves_output_empty(self):
         from vtkmodules.vtkCommonCore import vtkOutputWindow
         import blockforge

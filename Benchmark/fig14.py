@@ -1,0 +1,148 @@
+#!/usr/bin/python3
+"""The paper's Fig. 14, ours: the axial force on a distributor vane and the torque about
+the machine axis computed by simpleFoam on BlockForge grids of increasing density.
+
+For every density multiplier the distributor passage (Templates/axial_passage_oh.yaml on
+Data/distributor) is written as an OpenFOAM case by the native command line into a copy
+of Testing/Data/openfoam/distributor_passage (swirling inlet at 1 m/s, outlet pressure,
+walls, cyclic periodic sides, k-omega SST, water) and simpleFoam runs a fixed number of
+iterations. The force and moment come from the case's `forces` function object on the
+vane (patch blade, CofR on the axis): axial force = F_z, torque = M_z, per vane, each the
+mean of the last quarter of the iterations (their spread is shown too). Grids are
+unoptimized (the optimizer does not exist yet).
+
+Writes doc/fig14_distributor.png and Benchmark/FIG14.md. Needs a build and OpenFOAM.
+Usage: fig14.py [--densities 0.5,0.75,1,1.5,2] [--iterations 500]
+"""
+import argparse
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+CASE = ROOT / "Testing" / "Data" / "openfoam" / "distributor_passage"
+TEMPLATE = ROOT / "Templates" / "axial_passage_oh.yaml"
+INPUT = ROOT / "Data" / "distributor" / "BladeGen.inf"
+BASHRC = "/usr/share/openfoam/etc/bashrc"
+VANES = 16
+
+
+def read_vectors(path):
+    """Time and the total (first) vector of every line of a forces .dat file."""
+    rows = []
+    for line in Path(path).read_text().splitlines():
+        if line.startswith("#") or not line.strip():
+            continue
+        numbers = re.findall(r"[-+0-9.eE]+", line)
+        rows.append([float(x) for x in numbers[:4]])
+    return np.array(rows)
+
+
+def run_density(cli, density, iterations, work):
+    case = work / f"d{density:g}"
+    shutil.copytree(CASE, case)
+    control = case / "system" / "controlDict"
+    control.write_text(re.sub(r"endTime\s+\d+;", f"endTime         {iterations};",
+                              control.read_text()))
+    mesh = subprocess.run([str(cli), str(TEMPLATE), "-i", str(INPUT), "-d", str(density),
+                           "-o", str(case / "distributor.foam")], capture_output=True, text=True)
+    if mesh.returncode != 0:
+        raise RuntimeError(mesh.stderr)
+    cells = int(re.search(r"cells: (\d+)", mesh.stdout).group(1))
+    start = time.perf_counter()
+    solve = subprocess.run(["bash", "-c", f"source {BASHRC} >/dev/null 2>&1; simpleFoam -case '{case}'"],
+                           capture_output=True, text=True)
+    seconds = time.perf_counter() - start
+    if solve.returncode != 0:
+        raise RuntimeError(solve.stdout[-3000:] + solve.stderr[-3000:])
+    folder = case / "postProcessing" / "vaneForces" / "0"
+    force = read_vectors(folder / "force.dat")
+    moment = read_vectors(folder / "moment.dat")
+    tail = max(1, len(force) // 4)
+    residual = re.findall(r"Solving for p, Initial residual = ([0-9.eE+-]+)", solve.stdout)
+    return {"density": density, "cells": cells, "seconds": seconds,
+            "axial": force[-tail:, 3].mean(), "axial_spread": np.ptp(force[-tail:, 3]),
+            "torque": moment[-tail:, 3].mean(), "torque_spread": np.ptp(moment[-tail:, 3]),
+            "p_residual": float(residual[-1]) if residual else float("nan"),
+            "history": (force[:, 0], force[:, 3], moment[:, 3])}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--densities", default="0.5,0.75,1,1.5,2")
+    parser.add_argument("--iterations", type=int, default=500)
+    parser.add_argument("--build", default=str(ROOT / "build"))
+    parser.add_argument("--png", default=str(ROOT / "doc" / "fig14_distributor.png"))
+    parser.add_argument("--table", default=str(HERE / "FIG14.md"))
+    args = parser.parse_args()
+    cli = Path(args.build) / "bin" / "blockforge"
+    if not cli.exists() or not Path(BASHRC).exists():
+        sys.exit("needs build/bin/blockforge and OpenFOAM (scripts/setup.sh)")
+    densities = [float(d) for d in args.densities.split(",")]
+    work = Path(tempfile.mkdtemp(prefix="blockforge-fig14-"))
+    started = time.time()
+    try:
+        results = []
+        for density in densities:
+            result = run_density(cli, density, args.iterations, work)
+            results.append(result)
+            print(f"density {density:g}: {result['cells']} cells, axial force "
+                  f"{result['axial']:.2f} N, torque {result['torque']:.2f} N m "
+                  f"({result['seconds']:.0f} s)", file=sys.stderr, flush=True)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cells = [r["cells"] for r in results]
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for axis, key, label in ((axes[0], "axial", "axial force on a vane F_z [N]"),
+                             (axes[1], "torque", "torque about the axis M_z [N m]")):
+        axis.errorbar(cells, [r[key] for r in results],
+                      yerr=[r[key + "_spread"] / 2 for r in results], marker="o", capsize=3,
+                      label="unoptimized grids")
+        axis.set_xscale("log")
+        axis.set_xlabel("cells (one passage)")
+        axis.set_ylabel(label)
+        axis.grid(True, which="both", alpha=0.3)
+        axis.legend()
+    fig.suptitle("Distributor passage, axial_passage_oh, simpleFoam k-omega SST "
+                 f"({args.iterations} iterations)")
+    fig.tight_layout()
+    Path(args.png).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(args.png, dpi=110)
+
+    finest = results[-1]
+    lines = ["# Fig. 14, ours: vane force and torque against grid density", "",
+             f"Distributor passage (Templates/axial_passage_oh.yaml on Data/distributor, 16 "
+             f"vanes), simpleFoam k-omega SST, {args.iterations} iterations, values per vane "
+             f"(whole row: x{VANES}), mean of the last quarter of the iterations (spread: max - "
+             f"min over it). Unoptimized grids. Generated by Benchmark/fig14.py in "
+             f"{time.time() - started:.0f} s.", "",
+             "| density | cells | axial force F_z [N] | from finest | torque M_z [N m] | from finest | final p residual | solver time |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in results:
+        lines.append(
+            f"| {r['density']:g} | {r['cells']} | {r['axial']:.3f} (±{r['axial_spread'] / 2:.3f}) | "
+            f"{100 * (r['axial'] / finest['axial'] - 1):+.2f} % | {r['torque']:.3f} "
+            f"(±{r['torque_spread'] / 2:.3f}) | {100 * (r['torque'] / finest['torque'] - 1):+.2f} % | "
+            f"{r['p_residual']:.2g} | {r['seconds']:.0f} s |")
+    lines += ["", f"![force and torque against cells](../doc/{Path(args.png).name})", ""]
+    text = "\n".join(lines)
+    Path(args.table).write_text(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,360 @@
+#include "StagedOutput.h"
+
+#include <cerrno>
+#include <csignal>
+#include <random>
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace blockforge
+{
+namespace exporting
+{
+namespace
+{
+std::string reason(int error)
+{
+  return std::strerror(error);
+}
+
+std::string folderOf(const std::string& path)
+{
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string(".") : path.substr(0, slash == 0 ? 1 : slash);
+}
+
+std::string nameOf(const std::string& path)
+{
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+} // namespace
+
+CheckedFile::CheckedFile(const std::string& path)
+  : Path(path)
+{
+  File = std::fopen(path.c_str(), "wb");
+  if (!File)
+  {
+    fail(errno);
+  }
+  // Large writes go straight through; the buffer only gathers the small ones.
+  std::setvbuf(File, nullptr, _IOFBF, 1 << 20);
+}
+
+CheckedFile::~CheckedFile()
+{
+  if (File)
+  {
+    std::fclose(File);
+  }
+}
+
+void CheckedFile::fail(int error) const
+{
+  throw std::runtime_error("could not write " + Path + ": " + reason(error ? error : EIO));
+}
+
+void CheckedFile::write(const void* data, std::size_t bytes)
+{
+  errno = 0;
+  if (bytes && std::fwrite(data, 1, bytes, File) != bytes)
+  {
+    fail(errno);
+  }
+}
+
+void CheckedFile::close()
+{
+  errno = 0;
+  const bool flushed = std::fflush(File) == 0;
+  const int flushError = errno;
+  const int closed = std::fclose(File);
+  const int closeError = errno;
+  File = nullptr;
+  if (!flushed)
+  {
+    fail(flushError);
+  }
+  if (closed != 0)
+  {
+    fail(closeError);
+  }
+}
+
+PositionalFile::PositionalFile(const std::string& path)
+  : Path(path)
+{
+  Descriptor = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (Descriptor < 0)
+  {
+    fail(errno);
+  }
+}
+
+PositionalFile::~PositionalFile()
+{
+  if (Descriptor >= 0)
+  {
+    ::close(Descriptor);
+  }
+}
+
+void PositionalFile::fail(int error) const
+{
+  throw std::runtime_error("could not write " + Path + ": " + reason(error ? error : EIO));
+}
+
+void PositionalFile::writeAt(unsigned long long offset, const void* data, std::size_t bytes)
+{
+  const char* next = static_cast<const char*>(data);
+  while (bytes > 0)
+  {
+    const ssize_t written = ::pwrite(Descriptor, next, bytes, static_cast<off_t>(offset));
+    if (written < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (written <= 0)
+    {
+      fail(written < 0 ? errno : ENOSPC);
+    }
+    next += written;
+    offset += static_cast<unsigned long long>(written);
+    bytes -= static_cast<std::size_t>(written);
+  }
+}
+
+void PositionalFile::close()
+{
+  const int descriptor = Descriptor;
+  Descriptor = -1;
+  if (::close(descriptor) != 0)
+  {
+    fail(errno);
+  }
+}
+
+PositionalFile::Region::Region(PositionalFile& file, unsigned long long offset)
+  : File(file)
+  , Offset(offset)
+  , Buffer(Capacity, '\0')
+{
+}
+
+void PositionalFile::Region::put(const void* data, std::size_t bytes)
+{
+  if (Used + bytes > Capacity)
+  {
+    flush();
+  }
+  if (bytes > Capacity)
+  {
+    File.writeAt(Offset, data, bytes);
+    Offset += bytes;
+    return;
+  }
+  std::memcpy(&Buffer[Used], data, bytes);
+  Used += bytes;
+}
+
+void PositionalFile::Region::flush()
+{
+  File.writeAt(Offset, Buffer.data(), Used);
+  Offset += Used;
+  Used = 0;
+}
+
+namespace
+{
+const char* const StagingSuffix = ".staging";
+
+bool processAlive(long pid)
+{
+  if (pid == static_cast<long>(::getpid()))
+  {
+    return false; // one process writes one target at a time: our own leftovers are stale
+  }
+  return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM;
+}
+} // namespace
+
+void removeStaleStaging(const std::string& target)
+{
+  const std::string folder = folderOf(target);
+  const std::string prefix = "." + nameOf(target) + ".";
+  DIR* directory = ::opendir(folder.c_str());
+  if (!directory)
+  {
+    return;
+  }
+  std::vector<std::string> stale;
+  while (dirent* entry = ::readdir(directory))
+  {
+    // .NAME.<pid>-<hex token>.staging, as blockforge.output names them too.
+    const std::string name = entry->d_name;
+    const std::size_t suffix = std::strlen(StagingSuffix);
+    if (name.size() <= prefix.size() + suffix || name.compare(0, prefix.size(), prefix) != 0 ||
+      name.compare(name.size() - suffix, suffix, StagingSuffix) != 0)
+    {
+      continue;
+    }
+    const std::string middle = name.substr(prefix.size(), name.size() - prefix.size() - suffix);
+    const std::size_t dash = middle.find('-');
+    if (dash == std::string::npos || dash == 0 ||
+      middle.find_first_not_of("0123456789") != dash ||
+      middle.find_first_not_of("0123456789abcdef", dash + 1) != std::string::npos)
+    {
+      continue;
+    }
+    if (!processAlive(std::stol(middle.substr(0, dash))))
+    {
+      stale.push_back(folder + "/" + name);
+    }
+  }
+  ::closedir(directory);
+  for (const std::string& path : stale)
+  {
+    removeTree(path);
+  }
+}
+
+StagedOutput::StagedOutput(const std::string& target, Kind kind)
+  : Target(target)
+  , What(kind)
+{
+  makeDirectories(folderOf(target));
+  removeStaleStaging(target);
+  // The naming of blockforge.output (issue 12): .NAME.<pid>-<token>.staging beside the
+  // target, so either side removes what a killed run of the other left.
+  static std::mt19937_64 generator(std::random_device{}());
+  char token[32];
+  std::snprintf(token, sizeof(token), "%ld-%08llx", static_cast<long>(::getpid()),
+    static_cast<unsigned long long>(generator() & 0xffffffffULL));
+  Staging = folderOf(target) + "/." + nameOf(target) + "." + token + StagingSuffix;
+  const int made = kind == Kind::Directory
+    ? ::mkdir(Staging.c_str(), 0777)
+    : ::open(Staging.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (made < 0)
+  {
+    throw std::runtime_error("could not write " + target + ": " + reason(errno));
+  }
+  if (kind == Kind::File)
+  {
+    ::close(made);
+  }
+}
+
+StagedOutput::~StagedOutput()
+{
+  if (!Published)
+  {
+    removeTree(Staging);
+  }
+}
+
+void StagedOutput::publish()
+{
+  struct stat existing;
+  if (What == Kind::Directory && ::lstat(Target.c_str(), &existing) == 0 &&
+    S_ISDIR(existing.st_mode))
+  {
+    // One exchange publishes the new directory; the older one ends up at the staging
+    // path and is removed with it.
+    if (::renameat2(AT_FDCWD, Staging.c_str(), AT_FDCWD, Target.c_str(), RENAME_EXCHANGE) == 0)
+    {
+      removeTree(Staging);
+      Published = true;
+      return;
+    }
+    if (errno != EINVAL && errno != ENOSYS)
+    {
+      throw std::runtime_error("could not write " + Target + ": " + reason(errno));
+    }
+    // A file system without exchange: move the older directory aside first, back on failure.
+    const std::string old = Staging + ".old";
+    if (::rename(Target.c_str(), old.c_str()) != 0)
+    {
+      throw std::runtime_error("could not write " + Target + ": " + reason(errno));
+    }
+    if (::rename(Staging.c_str(), Target.c_str()) != 0)
+    {
+      const int error = errno;
+      ::rename(old.c_str(), Target.c_str());
+      throw std::runtime_error("could not write " + Target + ": " + reason(error));
+    }
+    removeTree(old);
+    Published = true;
+    return;
+  }
+  if (::rename(Staging.c_str(), Target.c_str()) != 0)
+  {
+    throw std::runtime_error("could not write " + Target + ": " + reason(errno));
+  }
+  Published = true;
+}
+
+void makeDirectories(const std::string& path)
+{
+  if (path.empty())
+  {
+    return;
+  }
+  std::size_t position = 0;
+  while (position != std::string::npos)
+  {
+    position = path.find('/', position + 1);
+    const std::string prefix = path.substr(0, position);
+    if (prefix.empty() || ::mkdir(prefix.c_str(), 0777) == 0 || errno == EEXIST)
+    {
+      continue;
+    }
+    throw std::runtime_error("could not make the folder " + prefix + ": " + reason(errno));
+  }
+  struct stat status;
+  if (::stat(path.c_str(), &status) != 0 || !S_ISDIR(status.st_mode))
+  {
+    throw std::runtime_error("could not make the folder " + path + ": it is not a folder");
+  }
+}
+
+void removeTree(const std::string& path)
+{
+  struct stat status;
+  if (path.empty() || ::lstat(path.c_str(), &status) != 0)
+  {
+    return;
+  }
+  if (S_ISDIR(status.st_mode))
+  {
+    if (DIR* directory = ::opendir(path.c_str()))
+    {
+      std::vector<std::string> entries;
+      while (dirent* entry = ::readdir(directory))
+      {
+        const std::string name = entry->d_name;
+        if (name != "." && name != "..")
+        {
+          entries.push_back(path + "/" + name);
+        }
+      }
+      ::closedir(directory);
+      for (const std::string& entry : entries)
+      {
+        removeTree(entry);
+      }
+    }
+    ::rmdir(path.c_str());
+    return;
+  }
+  ::unlink(path.c_str());
+}
+} // namespace exporting
+} // namespace blockforge

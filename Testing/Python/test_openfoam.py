@@ -1,0 +1,142 @@
+"""OpenFOAM's own checkMesh on the polyMesh BlockForge writes, for every template and
+every machine of Data/ at default parameters (plain Python: `import blockforge`, with
+OpenFOAM from the Debian package `openfoam`).
+
+Asserted: "Mesh OK"; periodic pairs written as cyclic patches whose points match under
+the rotation; under -allGeometry -allTopology no failed check except the ones listed per
+template (thin cells near walls and axes: the cell determinant); the per-cell
+non-orthogonality and skewness checkMesh writes (-writeFields) equal GridQuality's.
+"""
+import os
+import re
+import shutil
+import unittest
+
+import numpy as np
+
+import blockforge
+from blockforge import writers
+from vtkmodules.numpy_interface import dataset_adapter as dsa
+
+import bftest
+from bftest import DISTRIBUTOR_INF, ROTOR37_INF, SOURCE
+import foamtools
+
+
+def template(name):
+    return os.path.join(SOURCE, "Templates", name + ".yaml")
+
+
+# (case name, template, input) for every template and every machine of Data/.
+CASES = [("cylinder_in_box", "cylinder_in_box", None),
+         ("annular_sector", "annular_sector", None),
+         ("wedge_sector", "wedge_sector", None)] + [
+    (f"{name}_{machine}", name, inf)
+    for name in ("axial_passage_h", "axial_passage_oh")
+    for machine, inf in (("distributor", DISTRIBUTOR_INF), ("rotor37", ROTOR37_INF))]
+
+# Checks that -allGeometry -allTopology may fail, and why (the grid, not the writer).
+ALLOWED_FAILURES = {
+    # 20 of the 60 prisms on the axis are slivers (aspect ratio 32).
+    "wedge_sector": {"determinant"},
+    # Thin cells on the blade (O-grid expansion k_o towards the wall, aspect ratio up to
+    # 37); and where the O-grid's leading/trailing-edge blocks meet its side blocks the cell
+    # length along the blade jumps (uniform spacing in each block): low interpolation weights.
+    "axial_passage_oh_distributor": {"determinant", "interpolation weight"},
+    "axial_passage_oh_rotor37": {"determinant", "interpolation weight"},
+}
+
+
+# Cells where GridQuality's Skewness differs from checkMesh's by more than 1e-3, with the
+# largest difference seen: one cell on the blade (O_te, i 4, j 0, k 7: its wall face),
+# checkMesh 0.0639, GridQuality 0.0519 (boundary-face skewness, reported to the GridQuality
+# owner). Any other cell beyond 1e-3 fails the test.
+SKEWNESS_OUTLIERS = {("axial_passage_oh_rotor37", 2068): 0.013}
+
+
+def block_cell_array(grid, name):
+    """A cell array of every block, concatenated in block order (OpenFOAM's cell order)."""
+    return np.concatenate([np.array(dsa.WrapDataObject(block).CellData[name])
+                           for block in bftest.leaves(grid)])
+
+
+class CheckMeshTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.results = {}
+        for name, template_name, inf in CASES:
+            quality = blockforge.mesh_template(template(template_name), input_file=inf)
+            grid = quality.GetOutputDataObject(0)
+            case = bftest.output_path(os.path.join("openfoam", name))
+            shutil.rmtree(case, ignore_errors=True)
+            writers.write_solver_grid(grid, os.path.join(case, name + ".foam"))
+            status, plain = foamtools.run_foam(["checkMesh"], case)
+            status_all, full = foamtools.run_foam(
+                ["checkMesh", "-allGeometry", "-allTopology", "-writeFields",
+                 "(nonOrthoAngle skewness)"], case)
+            cls.results[name] = {
+                "plain": foamtools.check_mesh_summary(plain), "plain_text": plain,
+                "all": foamtools.check_mesh_summary(full), "all_text": full,
+                "case": case, "grid": grid, "boundary":
+                open(os.path.join(case, "constant", "polyMesh", "boundary")).read()}
+
+    def test_mesh_ok(self):
+        for name, *_ in CASES:
+            with self.subTest(case=name):
+                result = self.results[name]["plain"]
+                self.assertTrue(result["ok"], self.results[name]["plain_text"][-3000:])
+                self.assertEqual(result["failed"], [])
+                self.assertEqual(result["cells"], sum(
+                    b.GetNumberOfCells() for b in bftest.leaves(self.results[name]["grid"])))
+
+    def test_wedge_cells_are_prisms(self):
+        result = self.results["wedge_sector"]["plain"]
+        self.assertEqual(result["prisms"], 60)  # n_around x n_height cells on the axis
+        self.assertEqual(result["hexahedra"], 1140)
+
+    def test_periodic_pairs_are_matched_cyclics(self):
+        for name, *_ in CASES:
+            boundary = self.results[name]["boundary"]
+            if "periodic" not in boundary:
+                continue
+            with self.subTest(case=name):
+                self.assertEqual(len(re.findall(r"type\s+cyclic;", boundary)), 2)
+                self.assertIn("transform       rotational;", boundary)
+                self.assertTrue(self.results[name]["all"]["coupled_ok"],
+                                self.results[name]["all_text"][-3000:])
+
+    def test_all_checks(self):
+        for name, *_ in CASES:
+            with self.subTest(case=name):
+                failed = self.results[name]["all"]["failed"]
+                kinds = set()
+                for line in failed:
+                    if "determinant" in line:
+                        kinds.add("determinant")
+                    elif "interpolation weight" in line:
+                        kinds.add("interpolation weight")
+                    else:
+                        kinds.add(line)
+                self.assertLessEqual(kinds, ALLOWED_FAILURES.get(name, set()), failed)
+
+    def test_cell_quality_equals_grid_quality(self):
+        for name, *_ in CASES:
+            with self.subTest(case=name):
+                result = self.results[name]
+                constant = os.path.join(result["case"], "constant")
+                theirs = foamtools.read_cell_field(os.path.join(constant, "nonOrthoAngle"))
+                ours = block_cell_array(result["grid"], "NonOrthogonality")
+                self.assertEqual(theirs.shape, ours.shape)
+                self.assertLess(np.max(np.abs(theirs - ours)), 1e-3)
+                theirs = foamtools.read_cell_field(os.path.join(constant, "skewness"))
+                ours = block_cell_array(result["grid"], "Skewness")
+                difference = np.abs(theirs - ours)
+                for (outlier_case, cell), bound in SKEWNESS_OUTLIERS.items():
+                    if outlier_case == name:
+                        self.assertLess(difference[cell], bound)
+                        difference[cell] = 0.0
+                self.assertLess(np.max(difference), 1e-3, int(np.argmax(difference)))
+
+
+if __name__ == "__main__":
+    bftest.run_tests()

@@ -1,0 +1,218 @@
+"""The solver-format writers through `import blockforge`, the Python command line and the
+native command line `blockforge`: Plot3D read back by VTK's vtkMultiBlockPLOT3DReader
+node for node, ASCII and binary polyMesh alike, both command lines writing the same bytes,
+and failures (no model, an unwritable folder, a full disk) that leave no partial grid
+and keep an older one."""
+import filecmp
+import os
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import unittest
+
+import numpy as np
+
+import blockforge
+from blockforge import writers
+from vtkmodules.vtkCommonDataModel import vtkMultiBlockDataSet, vtkStructuredGrid
+from vtkmodules.vtkCommonCore import vtkPoints
+from vtkmodules.vtkIOParallel import vtkMultiBlockPLOT3DReader
+from vtkmodules.vtkIOGeometry import vtkOpenFOAMReader
+
+import bftest
+from bftest import CYLINDER, DISTRIBUTOR_INF, SOURCE
+
+AXIAL_OH = os.path.join(SOURCE, "Templates", "axial_passage_oh.yaml")
+CLI = os.environ.get("BLOCKFORGE_CLI", "")
+POLYMESH_FILES = ("points", "faces", "owner", "neighbour", "boundary")
+
+
+def mesh(template, inf=None, density=1.0):
+    return blockforge.mesh_template(template, density_multiplier=density,
+                                    input_file=inf).GetOutputDataObject(0)
+
+
+def read_plot3d(path, binary):
+    reader = vtkMultiBlockPLOT3DReader()
+    reader.SetXYZFileName(path)
+    reader.SetBinaryFile(binary)
+    reader.SetMultiGrid(True)
+    reader.SetHasByteCount(binary)
+    reader.SetDoublePrecision(True)
+    reader.SetIBlanking(False)
+    reader.SetByteOrderToLittleEndian()
+    reader.AutoDetectFormatOff()
+    reader.Update()
+    output = reader.GetOutput()
+    return [output.GetBlock(b) for b in range(output.GetNumberOfBlocks())]
+
+
+def limited_file_size(limit):
+    """A preexec_fn: files may not grow beyond `limit` bytes (writes fail with EFBIG)."""
+    def apply():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+    return apply
+
+
+def read_bytes(path):
+    with open(path, "rb") as stream:
+        return stream.read()
+
+
+def leftovers(folder):
+    """Hidden staging entries (.NAME.XXXXXX) left in a folder tree."""
+    return [os.path.join(root, name) for root, dirs, files in os.walk(folder)
+            for name in dirs + files if name.startswith(".")]
+
+
+class Plot3DTest(unittest.TestCase):
+    def test_read_back_node_for_node(self):
+        for name, template, inf in (("cylinder", CYLINDER, None),
+                                    ("distributor_oh", AXIAL_OH, DISTRIBUTOR_INF)):
+            grid = mesh(template, inf)
+            ours = bftest.leaves(grid)
+            for binary in (True, False):
+                with self.subTest(grid=name, binary=binary):
+                    path = bftest.output_path(f"plot3d/{name}_{'bin' if binary else 'ascii'}.xyz")
+                    writers.write_solver_grid(grid, path, binary=binary)
+                    theirs = read_plot3d(path, binary)
+                    self.assertEqual(len(theirs), len(ours))
+                    for a, b in zip(ours, theirs):
+                        self.assertEqual(bftest.node_array(a).shape, bftest.node_array(b).shape)
+                        self.assertTrue(np.array_equal(bftest.points(a), bftest.points(b)))
+                    self.assertTrue(os.path.exists(path[:-4] + ".nmf"))
+            # The Neutral Map File lists every interface once and every periodic pair once.
+            with open(path[:-4] + ".nmf") as stream:
+                text = stream.read()
+            pairs = 3 if name == "distributor_oh" else 0
+            interfaces = {"cylinder": 4, "distributor_oh": 16}[name]
+            self.assertEqual(text.count("'ONE_TO_ONE'"), interfaces + pairs)
+
+
+class CgnsTest(unittest.TestCase):
+    def test_cgnscheck_and_paraview_reader(self):
+        for name, template, inf in (("cylinder", CYLINDER, None),
+                                    ("wedge", os.path.join(SOURCE, "Templates", "wedge_sector.yaml"), None),
+                                    ("distributor_oh", AXIAL_OH, DISTRIBUTOR_INF)):
+            with self.subTest(grid=name):
+                grid = mesh(template, inf)
+                path = bftest.output_path(f"cgns/{name}.cgns")
+                writers.write_solver_grid(grid, path)
+                check = subprocess.run(["cgnscheck", path], capture_output=True, text=True)
+                self.assertEqual(check.returncode, 0, check.stdout + check.stderr)
+                self.assertNotIn("ERROR", check.stdout + check.stderr)
+                self.assertNotIn("WARNING", check.stdout + check.stderr)
+                zones = bftest.read_cgns_zones(path)
+                ours = dict(bftest.named_leaves(grid))
+                self.assertEqual(sorted(zones), sorted(ours))
+                for zone, block in ours.items():
+                    self.assertTrue(np.array_equal(bftest.points(block), bftest.points(zones[zone])),
+                                    zone)
+
+
+class FoamFormatsTest(unittest.TestCase):
+    def test_ascii_and_binary_are_the_same_mesh(self):
+        grid = mesh(AXIAL_OH, DISTRIBUTOR_INF, 0.5)
+        result = []
+        for binary in (True, False):
+            case = bftest.output_path(f"foam_formats/{'bin' if binary else 'ascii'}")
+            shutil.rmtree(case, ignore_errors=True)
+            writers.write_solver_grid(grid, os.path.join(case, "d.foam"), binary=binary)
+            reader = vtkOpenFOAMReader()
+            reader.SetFileName(os.path.join(case, "d.foam"))
+            reader.Update()
+            internal = reader.GetOutput().GetBlock(0)
+            result.append((internal.GetNumberOfCells(), bftest.points(internal)))
+        self.assertEqual(result[0][0], 1200)
+        self.assertEqual(result[0][0], result[1][0])
+        self.assertTrue(np.array_equal(result[0][1], result[1][1]))
+
+
+class ErrorsTest(unittest.TestCase):
+    def test_grid_without_model(self):
+        grid = vtkMultiBlockDataSet()
+        block = vtkStructuredGrid()
+        block.SetDimensions(2, 2, 2)
+        points = vtkPoints()
+        for k in range(2):
+            for j in range(2):
+                for i in range(2):
+                    points.InsertNextPoint(i, j, k)
+        block.SetPoints(points)
+        grid.SetBlock(0, block)
+        for extension in writers.SOLVER_WRITERS:
+            path = bftest.output_path("no_model/grid" + extension)
+            with self.assertRaisesRegex(RuntimeError, "carries no BlockForge model"):
+                writers.write_solver_grid(grid, path)
+            self.assertFalse(os.path.exists(path))
+
+    def test_unwritable_folder(self):
+        grid = mesh(CYLINDER, density=0.5)
+        blocker = bftest.output_path("a_file")
+        open(blocker, "w").close()
+        for target in ("case/c.foam", "grid.xyz"):
+            with self.assertRaisesRegex(RuntimeError, "a_file"):
+                writers.write_solver_grid(grid, os.path.join(blocker, target))
+
+    def test_full_disk_keeps_the_older_grid(self):
+        """A file-size limit makes the writes fail half way, as a full disk does: the
+        command fails with the reason, the older grid stays, nothing is left over."""
+        folder = bftest.output_path("full_disk")
+        shutil.rmtree(folder, ignore_errors=True)
+        commands = [("python", [sys.executable, "-m", "blockforge"])]
+        if CLI:
+            commands.append(("native", [CLI]))
+        for label, command in commands:
+            for output in ("case/c.foam", "grid.xyz"):
+                with self.subTest(command=label, output=output):
+                    target = os.path.join(folder, label, output)
+                    small = subprocess.run(command + [CYLINDER, "-d", "0.5", "-o", target],
+                                           capture_output=True, text=True)
+                    self.assertEqual(small.returncode, 0, small.stderr)
+                    written = (os.path.join(os.path.dirname(target), "constant", "polyMesh",
+                                            "points") if output.endswith(".foam") else target)
+                    before = read_bytes(written)
+                    big = subprocess.run(command + [CYLINDER, "-d", "3", "-o", target],
+                                         capture_output=True, text=True,
+                                         preexec_fn=limited_file_size(len(before) + 1000))
+                    self.assertNotEqual(big.returncode, 0)
+                    self.assertIn("File too large", big.stderr)
+                    self.assertEqual(read_bytes(written), before)
+                    self.assertEqual(leftovers(os.path.join(folder, label)), [])
+
+
+@unittest.skipUnless(CLI, "BLOCKFORGE_CLI not set")
+class NativeCommandLineTest(unittest.TestCase):
+    def test_same_bytes_as_the_python_pipeline(self):
+        folder = bftest.output_path("native_vs_python")
+        shutil.rmtree(folder, ignore_errors=True)
+        arguments = [AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "n_span=8"]
+        for label, command in (("python", [sys.executable, "-m", "blockforge"]),
+                               ("native", [CLI])):
+            for output in ("case/c.foam", "grid.xyz"):
+                run = subprocess.run(command + arguments + ["-o", os.path.join(folder, label, output)],
+                                     capture_output=True, text=True)
+                self.assertEqual(run.returncode, 0, run.stderr)
+        for name in POLYMESH_FILES:
+            self.assertTrue(filecmp.cmp(os.path.join(folder, "python/case/constant/polyMesh", name),
+                                        os.path.join(folder, "native/case/constant/polyMesh", name),
+                                        shallow=False), name)
+        for name in ("grid.xyz", "grid.nmf"):
+            self.assertTrue(filecmp.cmp(os.path.join(folder, "python", name),
+                                        os.path.join(folder, "native", name), shallow=False))
+
+    def test_errors_name_the_problem(self):
+        run = subprocess.run([CLI, os.path.join(SOURCE, "Testing", "Data", "bad_syntax.yaml"),
+                              "-o", bftest.output_path("bad/x.foam")], capture_output=True, text=True)
+        self.assertEqual(run.returncode, 1)
+        self.assertIn("bad_syntax.yaml:", run.stderr)
+        run = subprocess.run([CLI, CYLINDER, "-o", "x.vtk"], capture_output=True, text=True)
+        self.assertEqual(run.returncode, 2)
+        self.assertIn("must end in .foam", run.stderr)
+
+
+if __name__ == "__main__":
+    bftest.run_tests()
