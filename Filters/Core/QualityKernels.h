@@ -507,17 +507,19 @@ struct FaceGeometry
   V3<T> centre;
   T area2;       ///< |area|^2
   T diagonals2;  ///< sum of the squared diagonals (the face's size)
-  T weightSum;   ///< sum of the projected triangle weights
+  T weightSum;   ///< sum of the triangle weights |n_k| (OpenFOAM's sumA)
   V3<T> average; ///< point average (OpenFOAM's fallback centre)
 };
 
 /**
- * OpenFOAM (current -dev) face::areaAndCentre: triangle fan about the point average;
- * the centre weights each triangle centre by its area projected on the face normal.
- * Corners are taken relative to the average, q_k = p_k - average, where each fan
- * triangle's area vector is simply q_k x q_k+1; the projection weights are kept
- * unnormalised (n_k . sum n), which divides out. Branch-free: see scalarFace and
- * usableLanes for the degenerate cases.
+ * OpenFOAM's face centre and area vector (primitiveMesh::makeFaceCentresAndAreas of
+ * OpenFOAM v1912, the version Debian ships and checkMesh validates against): a triangle
+ * fan about the point average; the centre weights each triangle's centre by the
+ * triangle's area |n_k|. (Later OpenFOAM.org versions weight by the area projected on the
+ * face normal, n_k . sum n; on a warped face the two differ by up to about 1e-3 degrees
+ * of non-orthogonality.) Corners are taken relative to the average, q_k = p_k - average,
+ * where each fan triangle's area vector is simply q_k x q_k+1. Branch-free: see
+ * scalarFace and usableLanes for the degenerate cases.
  */
 template <typename T>
 inline FaceGeometry<T> quadFace(const V3<T> (&p)[4])
@@ -530,7 +532,8 @@ inline FaceGeometry<T> quadFace(const V3<T> (&p)[4])
   const V3<T> sumN = (n0 + n1) + (n2 + n3);
   face.area = 0.5 * sumN;
   face.area2 = dot(face.area, face.area);
-  const T w0 = dot(n0, sumN), w1 = dot(n1, sumN), w2 = dot(n2, sumN), w3 = dot(n3, sumN);
+  const T w0 = vsqrt(dot(n0, n0)), w1 = vsqrt(dot(n1, n1)), w2 = vsqrt(dot(n2, n2)),
+          w3 = vsqrt(dot(n3, n3));
   face.weightSum = (w0 + w1) + (w2 + w3);
   const V3<T> weighted = (w0 * (q0 + q1) + w1 * (q1 + q2)) + (w2 * (q2 + q3) + w3 * (q3 + q0));
   const T scale = 1.0 / (3.0 * face.weightSum);
@@ -546,13 +549,17 @@ inline bool faceCollapsed(double area2, double diagonals2)
   return area2 <= collapsedFaceFraction * collapsedFaceFraction * diagonals2 * diagonals2;
 }
 
-/// Scalar face with OpenFOAM's guard for the centre: "sumAn > vSmall", where
-/// sumAn = weightSum / |sum n| = weightSum / (2 |area|).
+/// OpenFOAM v1912's guard for the face centre: the point average when sumA < rootVSmall.
+inline bool regularCentre(double weightSum)
+{
+  return weightSum >= rootVSmall;
+}
+
+/// Scalar face with OpenFOAM's guard for the centre (regularCentre).
 inline FaceGeometry<double> scalarFace(const P3 (&p)[4])
 {
   FaceGeometry<double> face = quadFace(p);
-  if (!(face.weightSum > 0.0 &&
-        face.weightSum * face.weightSum > 4.0 * vSmall * vSmall * face.area2))
+  if (!regularCentre(face.weightSum))
   {
     face.centre = face.average;
   }
@@ -669,8 +676,7 @@ inline int usableLanes(const FaceGeometry<T>& face, const FaceMeasures<T>& m)
   for (int l = 0; l < lanes; ++l)
   {
     if (!faceCollapsed(area2[l], diagonals2[l]) && std::abs(areaDotD[l]) >= 1e-100 &&
-      sv2[l] > 0.0 && weightSum[l] > 0.0 &&
-      weightSum[l] * weightSum[l] > 4.0 * vSmall * vSmall * area2[l])
+      sv2[l] > 0.0 && regularCentre(weightSum[l]))
     {
       usable |= 1 << l;
     }
@@ -722,16 +728,13 @@ inline void hexFaceGeometry(const V3<T> (&c)[8], FaceGeometry<T> (&faces)[6])
   }
 }
 
-/// Positive where a face is regular for the centroid (not collapsed, positive centre
-/// weights, OpenFOAM's centre guard met); NaN inputs give NaN, which callers treat as not
-/// positive.
+/// Positive where a face is not collapsed (faceCollapsed); NaN inputs give NaN, which
+/// callers treat as not positive.
 template <typename T>
-inline T regularFaceMargin(const FaceGeometry<T>& face)
+inline T collapseMargin(const FaceGeometry<T>& face)
 {
-  const T collapse =
-    face.area2 - (collapsedFaceFraction * collapsedFaceFraction) * (face.diagonals2 * face.diagonals2);
-  const T guard = face.weightSum * face.weightSum - (4.0 * vSmall * vSmall) * face.area2;
-  return vmin(collapse, vmin(face.weightSum, guard));
+  return face.area2 -
+    (collapsedFaceFraction * collapsedFaceFraction) * (face.diagonals2 * face.diagonals2);
 }
 
 /**
@@ -756,22 +759,23 @@ inline V3<T> cellCentroidKernel(int& usable, const FaceGeometry<T> (&faces)[6])
     weighted = weighted + pyramid3 * (0.75 * face.centre + 0.25 * estimate);
     volume = volume + pyramid3;
   }
-  // One lane-wise minimum of the conditions (each must be positive), one extraction: the
-  // faces' areas against their collapse threshold, their centre weights, OpenFOAM's
-  // centre guard; and the volume against vSmall.
-  T worst = regularFaceMargin(faces[0]);
+  // Lane-wise minima over the faces, extracted once: the areas against their collapse
+  // threshold, the centre weights against OpenFOAM's guard; and the volume against vSmall.
+  T collapse = collapseMargin(faces[0]), weight = faces[0].weightSum;
   for (int f = 1; f < 6; ++f)
   {
-    worst = vmin(worst, regularFaceMargin(faces[f]));
+    collapse = vmin(collapse, collapseMargin(faces[f]));
+    weight = vmin(weight, faces[f].weightSum);
   }
   constexpr int lanes = laneCount<T>;
-  double volumes[lanes], conditions[lanes];
+  double volumes[lanes], collapses[lanes], weights[lanes];
   extractLanes(volume, volumes);
-  extractLanes(worst, conditions);
+  extractLanes(collapse, collapses);
+  extractLanes(weight, weights);
   usable = 0;
   for (int l = 0; l < lanes; ++l)
   {
-    usable |= (std::abs(volumes[l]) > vSmall && conditions[l] > 0.0) << l;
+    usable |= (std::abs(volumes[l]) > vSmall && collapses[l] > 0.0 && regularCentre(weights[l])) << l;
   }
   return (1.0 / volume) * weighted;
 }

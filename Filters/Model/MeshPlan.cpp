@@ -4,6 +4,8 @@
 #include "MeshInternals.h"
 #include "Mesher.h"
 
+#include "../Core/InvertedCells.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -391,7 +393,7 @@ Feasibility MeshPlan::update(const std::vector<int>& moved)
   P->Pending.clear();
   for (const int b : P->Updated)
   {
-    const Feasibility cells = checkCells(P->Nodes[b].data(), P->Topo.blocks[b].nodes, b, size);
+    const Feasibility cells = checkCells(P->Nodes[b].data(), P->Topo.blocks[b].nodes, b);
     if (!cells.feasible())
     {
       return cells;
@@ -405,49 +407,19 @@ void MeshPlan::rebuildCarrier(int index)
   P->Geometry.rebuild(P->Model, index);
 }
 
-Feasibility checkCells(const double* xyz, const std::array<int, 3>& nodes, int block, double size)
+Feasibility checkCells(const double* xyz, const std::array<int, 3>& nodes, int block)
 {
-  const int ni = nodes[0], nj = nodes[1], nk = nodes[2];
-  auto at = [&](int i, int j, int k) {
-    const double* p = xyz + 3 * (i + static_cast<std::size_t>(ni) * (j + static_cast<std::size_t>(nj) * k));
-    return Vec3(p[0], p[1], p[2]);
-  };
-  const double tiny = 1e-12 * size;
-  for (int k = 0; k + 1 < nk; ++k)
+  const InvertedCells inverted = findInvertedCells(xyz, nodes[0], nodes[1], nodes[2]);
+  if (inverted.count == 0)
   {
-    for (int j = 0; j + 1 < nj; ++j)
-    {
-      for (int i = 0; i + 1 < ni; ++i)
-      {
-        for (int corner = 0; corner < 8; ++corner)
-        {
-          const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
-          const Vec3 p = at(i + di, j + dj, k + dk);
-          // Edges towards the neighbours along +i, +j, +k as seen from the cell's
-          // (0, 0, 0) corner: flip the ones that point backwards from this corner.
-          const Vec3 ds = (at(i + 1 - di, j + dj, k + dk) - p) * (di ? -1.0 : 1.0);
-          const Vec3 dt = (at(i + di, j + 1 - dj, k + dk) - p) * (dj ? -1.0 : 1.0);
-          const Vec3 du = (at(i + di, j + dj, k + 1 - dk) - p) * (dk ? -1.0 : 1.0);
-          const double ls = ds.norm(), lt = dt.norm(), lu = du.norm();
-          if (ls <= tiny || lt <= tiny || lu <= tiny)
-          {
-            continue; // a collapsed edge (wedge): degenerate corners are allowed
-          }
-          if (ds.dot(dt.cross(du)) < -1e-10 * ls * lt * lu)
-          {
-            Feasibility result;
-            result.problem = Feasibility::Problem::InvertedCell;
-            result.block = block;
-            result.message = "cell (" + std::to_string(i) + ", " + std::to_string(j) + ", " +
-              std::to_string(k) + ") of block " + std::to_string(block) +
-              " is inverted at a corner";
-            return result;
-          }
-        }
-      }
-    }
+    return Feasibility();
   }
-  return Feasibility();
+  const std::array<int, 3>& c = inverted.worstCell;
+  return infeasible(Feasibility::Problem::InvertedCell, block,
+    std::to_string(inverted.count) + " inverted cell(s) in block " + std::to_string(block) +
+      ", the worst (" + std::to_string(c[0]) + ", " + std::to_string(c[1]) + ", " +
+      std::to_string(c[2]) + ") with scaled Jacobian " +
+      syntax::shortNumber(inverted.worstScaledJacobian));
 }
 } // namespace model
 } // namespace blockforge

@@ -87,8 +87,8 @@ private:
   std::unique_ptr<Impl> P;
 };
 
-/// Feasibility of the nodes of one block: InvertedCell (naming `block`) when a cell has a
-/// corner whose three edges form a left-handed frame (collapsed edges are skipped).
-Feasibility checkCells(const double* xyz, const std::array<int, 3>& nodes, int block, double size);
+/// Feasibility of the nodes of one block: InvertedCell (naming `block`) when Core's
+/// findInvertedCells finds an inverted cell (InvertedCells.h).
+Feasibility checkCells(const double* xyz, const std::array<int, 3>& nodes, int block);
 } // namespace model
 } // namespace blockforge

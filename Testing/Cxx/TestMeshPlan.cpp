@@ -239,8 +239,8 @@ TEST(MeshPlan, InfeasibleMovesAreValuesNamingTheBlock)
   std::vector<double> grid = plan.blockNodes(0);
   const std::array<int, 3> n = plan.nodeCounts(0);
   grid[3 * (1 + n[0] * (1 + n[1] * 1))] = -3.0; // node (1, 1, 1) moved to x = -3
-  const Feasibility inverted = checkCells(grid.data(), n, 0, 2.0);
+  const Feasibility inverted = checkCells(grid.data(), n, 0);
   EXPECT_EQ(inverted.problem, Feasibility::Problem::InvertedCell);
   EXPECT_EQ(inverted.block, 0);
-  EXPECT_TRUE(checkCells(plan.blockNodes(0).data(), n, 0, 2.0).feasible());
+  EXPECT_TRUE(checkCells(plan.blockNodes(0).data(), n, 0).feasible());
 }

@@ -47,11 +47,11 @@ ALLOWED_FAILURES = {
 }
 
 
-# Cells where GridQuality's Skewness differs from checkMesh's by more than 1e-3, with the
-# largest difference seen: one cell on the blade (O_te, i 4, j 0, k 7: its wall face),
-# checkMesh 0.0639, GridQuality 0.0519 (boundary-face skewness, reported to the GridQuality
-# owner). Any other cell beyond 1e-3 fails the test.
-SKEWNESS_OUTLIERS = {("axial_passage_oh_rotor37", 2068): 0.013}
+# GridQuality follows OpenFOAM v1912's face centres (triangle fan weighted by area), so
+# per cell it agrees with checkMesh to round-off: about 1e-10 degrees on the passage grids,
+# 1.5e-6 degrees where the angle is near zero (acos near 1 keeps only about 1e-8 rad).
+# The issue asks for 1e-3 degrees; the bound leaves room for round-off only.
+CELL_QUALITY_BOUND = 1e-5
 
 
 def block_cell_array(grid, name):
@@ -65,7 +65,10 @@ class CheckMeshTest(unittest.TestCase):
     def setUpClass(cls):
         cls.results = {}
         for name, template_name, inf in CASES:
-            quality = blockforge.mesh_template(template(template_name), input_file=inf)
+            # The template's own grids (optimize=False): the checks allowed to fail and the
+            # skewness outliers below are those of these grids.
+            quality = blockforge.mesh_template(template(template_name), input_file=inf,
+                                               optimize=False)
             grid = quality.GetOutputDataObject(0)
             case = bftest.output_path(os.path.join("openfoam", name))
             shutil.rmtree(case, ignore_errors=True)
@@ -127,15 +130,11 @@ class CheckMeshTest(unittest.TestCase):
                 theirs = foamtools.read_cell_field(os.path.join(constant, "nonOrthoAngle"))
                 ours = block_cell_array(result["grid"], "NonOrthogonality")
                 self.assertEqual(theirs.shape, ours.shape)
-                self.assertLess(np.max(np.abs(theirs - ours)), 1e-3)
+                self.assertLess(np.max(np.abs(theirs - ours)), CELL_QUALITY_BOUND)
                 theirs = foamtools.read_cell_field(os.path.join(constant, "skewness"))
                 ours = block_cell_array(result["grid"], "Skewness")
                 difference = np.abs(theirs - ours)
-                for (outlier_case, cell), bound in SKEWNESS_OUTLIERS.items():
-                    if outlier_case == name:
-                        self.assertLess(difference[cell], bound)
-                        difference[cell] = 0.0
-                self.assertLess(np.max(difference), 1e-3, int(np.argmax(difference)))
+                self.assertLess(np.max(difference), CELL_QUALITY_BOUND, int(np.argmax(difference)))
 
 
 if __name__ == "__main__":
