@@ -119,7 +119,10 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     model = template
     if optimize:
         optimizer = vtkBlockOptimizer()
-        optimizer.SetDensityMultiplier(float(density_multiplier))
+        # The objective is measured on the template's grid (or a coarser one): it ranks
+        # configurations as the finer grid does, and a huge density is the mesher's to
+        # refuse with its memory message.
+        optimizer.SetDensityMultiplier(min(1.0, float(density_multiplier)))
         optimizer.SetInputConnection(template.GetOutputPort())
         stages.append(("optimize", optimizer))
         model = optimizer

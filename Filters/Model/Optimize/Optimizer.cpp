@@ -1,13 +1,48 @@
 #include "Optimizer.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace blockforge
 {
 namespace optimize
 {
-OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeometry& geometry,
-  const OptimizerSettings& settings, const ProgressFunction& progress)
+namespace
 {
+/// Nodes of the grid of `model` at density multiplier `density` (as the mesher rounds).
+double nodeCount(const model::BlockModel& model, double density)
+{
+  double nodes = 0.0;
+  for (const model::Block& block : model.blocks)
+  {
+    double product = 1.0;
+    for (int cells : block.cells)
+    {
+      product *= std::max(1.0, std::round(cells * density)) + 1.0;
+    }
+    nodes += product;
+  }
+  return nodes;
+}
+} // namespace
+
+double measuredDensity(const model::BlockModel& model, double densityMultiplier)
+{
+  double density = densityMultiplier;
+  while (density > 1e-6 && nodeCount(model, density) > MaximumMeasuredNodes)
+  {
+    density *= 0.8;
+  }
+  return density;
+}
+
+OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeometry& geometry,
+  const OptimizerSettings& requested, const ProgressFunction& progress)
+{
+  OptimizerSettings settings = requested;
+  settings.densityMultiplier = measuredDensity(model, requested.densityMultiplier);
   OptimizerResult result;
+  result.densityMultiplier = settings.densityMultiplier;
   // The input as it is gives the "before" of the class counts (an input that folds or
   // cannot be meshed is infeasible; the search may still find a way out).
   if (!settings.moves.empty())

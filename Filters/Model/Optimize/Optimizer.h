@@ -13,11 +13,21 @@ namespace blockforge
 {
 namespace optimize
 {
+/// The largest grid the objective is measured on (nodes); a larger one is measured on a
+/// coarsened copy (a smaller density multiplier), so the optimizer never allocates what
+/// the mesher would refuse and stays fast on fine grids.
+constexpr double MaximumMeasuredNodes = 1.0e6;
+
+/// The density multiplier the objective is measured at: `densityMultiplier`, lowered by
+/// factors of 0.8 until the grid has at most MaximumMeasuredNodes nodes.
+double measuredDensity(const model::BlockModel& model, double densityMultiplier);
+
 struct OptimizerSettings
 {
   ObjectiveSettings objective;
   SearchSettings search;
-  /// The grid the objective measures: the model's cell counts times this (as BlockMesher).
+  /// The grid the objective measures: the model's cell counts times this (as BlockMesher),
+  /// coarsened to at most MaximumMeasuredNodes nodes.
   double densityMultiplier = 1.0;
   /// Control points that stay where they are (names of vertices).
   std::vector<std::string> fixed;
@@ -35,6 +45,7 @@ struct OptimizerResult
   SearchResult search;               ///< history of the automatic run (empty without one)
   std::vector<ControlVariable> variables;
   std::vector<std::string> boundaryLocked;
+  double densityMultiplier = 1.0;    ///< the density the objective was measured at
 };
 
 /**
