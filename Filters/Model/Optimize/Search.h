@@ -29,8 +29,8 @@ enum class SearchAlgorithm
 
 struct SearchSettings
 {
-  /// Compass by default: on the passage templates it reached 2-4 degrees more than
-  /// BOBYQA in the same evaluations, each about 5 times cheaper (Benchmark/OPTIMIZER.md).
+  /// Compass by default: on the passage templates it reached 1-4 degrees more than
+  /// BOBYQA, with evaluations about 5 times cheaper (README, "The optimizer").
   SearchAlgorithm algorithm = SearchAlgorithm::Compass;
   int maxEvaluations = 400;
   /// Stop when a step changes the objective by less than this (degrees for the angle
