@@ -83,7 +83,7 @@ public:
   ///@{
   /// The grid the objective measures: the template's cell counts times this (as
   /// vtkBlockMesher's DensityMultiplier; default 1).
-  vtkSetClampMacro(DensityMultiplier, double, 0.01, 100.0);
+  vtkSetMacro(DensityMultiplier, double); // validated when run, as the mesher's
   vtkGetMacro(DensityMultiplier, double);
   ///@}
 

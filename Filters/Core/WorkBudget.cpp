@@ -4,7 +4,6 @@
 
 namespace blockforge
 {
-thread_local WorkBudget* WorkBudget::Current = nullptr;
 
 WorkBudget::WorkBudget(std::size_t limit, std::string what)
   : Limit(limit)

@@ -91,6 +91,6 @@ private:
   std::size_t Spent = 0;
   std::string What;
   WorkBudget* Parent = nullptr; ///< the enclosing scope's budget while in a Scope
-  static thread_local WorkBudget* Current;
+  inline static thread_local WorkBudget* Current = nullptr;
 };
 } // namespace blockforge

@@ -1,5 +1,5 @@
 """Client-server mode: pvpython connects to a pvserver on localhost (2 MPI ranks), loads
-the plugin on the server, runs reader -> BlockTemplate -> BlockMesher -> GridQuality there
+the plugin on the server, runs reader -> BlockTemplate -> BlockOptimizer -> BlockMesher -> GridQuality there
 and fetches the result: every array of every cell equals the serial run in this process,
 the class table arrives, and errors come back to the client with the template's file and
 line. The first look is Surface With Edges coloured by block (not Outline).
@@ -74,6 +74,9 @@ class ClientServer(unittest.TestCase):
     def test_pipeline_on_server_equals_serial(self):
         reader = TurboPointSetsReader(FileName=bftest.DISTRIBUTOR_INF)  # noqa: F821
         model = BlockTemplate(Input=reader, TemplateFile=TEMPLATE)  # noqa: F821
+        # The optimizer runs on the server too, as in the serial run (mesh_template
+        # optimizes by default): both must give the same grid.
+        model = BlockOptimizer(Input=model)  # noqa: F821
         grid = BlockMesher(Input=model)  # noqa: F821
         quality = GridQuality(Input=grid)  # noqa: F821
         quality.UpdatePipeline()

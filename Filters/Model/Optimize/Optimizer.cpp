@@ -1,5 +1,7 @@
 #include "Optimizer.h"
 
+#include "MemoryBudget.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -39,6 +41,9 @@ double measuredDensity(const model::BlockModel& model, double densityMultiplier)
 OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeometry& geometry,
   const OptimizerSettings& requested, const ProgressFunction& progress)
 {
+  // The mesher's rules for the density (errors, not clamps): a density it would refuse is
+  // refused here too, before any work.
+  model::checkDensityMultiplier(model, requested.densityMultiplier);
   OptimizerSettings settings = requested;
   settings.densityMultiplier = measuredDensity(model, requested.densityMultiplier);
   OptimizerResult result;
