@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # The main job on the bundled default example: set-up, build, then the whole pipeline
-# (point data -> template -> block model -> transfinite grid -> quality), writing the grid
+# (point data -> template -> block model -> optimized control points (BlockOptimizer;
+# --no-optimize skips it) -> transfinite grid -> quality), writing the grid
 # to out/<template>.vtm (plus its pieces in out/<template>/) and printing a quality summary.
 # Default: the O-grid template Templates/axial_passage_oh.yaml on the distributor's point
 # data (-i Data/distributor/BladeGen.inf), written to out/axial_passage_oh.vtm.
 # Usage: scripts/example.sh [template.yaml] [-i input] [-p NAME=EXPR ...] [-d DENSITY]
+#          [--no-optimize]
 #   A template given without -i is applied without input (templates without inputs);
 #   -i alone replaces the default input of the default template.
 set -euo pipefail

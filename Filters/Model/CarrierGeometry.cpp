@@ -249,6 +249,12 @@ void CarrierGeometry::build(const BlockModel& model, int index)
   buildEntry(model, index, 0);
 }
 
+void CarrierGeometry::rebuild(const BlockModel& model, int index)
+{
+  Entries.at(index) = Entry();
+  buildEntry(model, index, 0);
+}
+
 void CarrierGeometry::buildEntry(const BlockModel& model, int index, int depth)
 {
   const Carrier& carrier = model.carriers.at(index);

@@ -106,6 +106,9 @@ public:
   explicit CarrierGeometry(const BlockModel& model);
   /// Builds carrier `index` and, first, the carriers it refers to (template engine).
   void build(const BlockModel& model, int index);
+  /// Builds carrier `index` again from its (changed) definition in `model`, e.g. a surface
+  /// curve drawn through control points that moved. Carriers built on it are not rebuilt.
+  void rebuild(const BlockModel& model, int index);
 
   bool isSurface(int index) const { return Entries.at(index).surface != nullptr; }
   const CurvePtr& curve(int index) const { return Entries.at(index).curve; }

@@ -402,6 +402,11 @@ Feasibility MeshPlan::update(const std::vector<int>& moved)
   return Feasibility();
 }
 
+void MeshPlan::rebuildCarrier(int index)
+{
+  P->Geometry.rebuild(P->Model, index);
+}
+
 Feasibility checkCells(const double* xyz, const std::array<int, 3>& nodes, int block)
 {
   const InvertedCells inverted = findInvertedCells(xyz, nodes[0], nodes[1], nodes[2]);

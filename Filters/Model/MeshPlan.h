@@ -70,6 +70,11 @@ public:
    */
   Feasibility update(const std::vector<int>& moved);
 
+  /// Builds carrier `index` again from its changed definition in model() (a surface curve
+  /// drawn through control points that moved); then update() the vertices of the edges on
+  /// it, so they follow.
+  void rebuildCarrier(int index);
+
   /// Blocks recomputed by the last update (all blocks after construction).
   const std::vector<int>& updatedBlocks() const;
   int blockCount() const;

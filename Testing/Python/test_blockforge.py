@@ -452,5 +452,58 @@ class BadInputTest(unittest.TestCase):
         self.assertIn("inside-out", str(context.exception))
 
 
+class OptimizerTest(unittest.TestCase):
+    """vtkBlockOptimizer through `import blockforge`, and the optimizer in mesh_template and
+    the command line (on by default, --no-optimize / optimize=False to skip it)."""
+    SYMMETRIC = os.path.join(DATA, "optimizer_symmetric.yaml")
+
+    def min_angle(self, quality):
+        grid = quality.GetOutputDataObject(0)
+        return grid.GetFieldData().GetArray("MinAngleSummary").GetTuple3(0)[0]
+
+    def test_vtk_pipeline(self):
+        source = blockforge.vtkBlockTemplateSource()
+        source.SetTemplateFile(self.SYMMETRIC)
+        optimizer = blockforge.vtkBlockOptimizer()
+        optimizer.SetInputConnection(source.GetOutputPort())
+        optimizer.SetTolerance(1e-12)
+        optimizer.SetControlPointMove("m0", "0.45")
+        optimizer.SetAutomatic(False)
+        optimizer.Update()
+        fields = optimizer.GetOutputDataObject(0).GetFieldData()
+        self.assertAlmostEqual(fields.GetArray("MinAngleAfter").GetValue(0),
+                               math.degrees(math.atan2(1.0, 0.1)), places=9)
+        optimizer.ClearControlPointMoves()
+        optimizer.SetAutomatic(True)
+        optimizer.Update()
+        fields = optimizer.GetOutputDataObject(0).GetFieldData()
+        self.assertGreater(fields.GetArray("MinAngleAfter").GetValue(0), 90.0 - 1e-3)
+        history = optimizer.GetOutputDataObject(1)
+        self.assertEqual(history.GetNumberOfRows(),
+                         fields.GetArray("OptimizerEvaluations").GetValue(0))
+
+    def test_mesh_template_optimizes_by_default(self):
+        optimized = self.min_angle(blockforge.mesh_template(self.SYMMETRIC))
+        placed = self.min_angle(blockforge.mesh_template(self.SYMMETRIC, optimize=False))
+        self.assertAlmostEqual(placed, math.degrees(math.atan2(1.0, 0.4)), places=9)
+        self.assertGreater(optimized, 89.9)
+
+    def test_command_line_switch(self):
+        for arguments, expected in (((), "optimize"), (("--no-optimize",), None)):
+            out, err = io.StringIO(), io.StringIO()
+            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+                status = blockforge_main([self.SYMMETRIC, *arguments])
+            self.assertEqual(status, 0, err.getvalue())
+            timing = [line for line in out.getvalue().splitlines() if line.startswith("time")]
+            self.assertEqual(len(timing), 1)
+            if expected:
+                self.assertIn(expected, timing[0])
+                self.assertIn("optimizer: smallest element angle 68.20 -> 89.9", out.getvalue())
+                self.assertIn("(1 control point parameters", out.getvalue())
+            else:
+                self.assertNotIn("optimize", timing[0])
+                self.assertNotIn("optimizer:", out.getvalue())
+
+
 if __name__ == "__main__":
     bftest.run_tests()

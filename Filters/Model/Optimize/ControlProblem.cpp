@@ -1,0 +1,724 @@
+#include "ControlProblem.h"
+
+#include "Errors.h"
+#include "MeshPlan.h"
+#include "ModelSyntax.h"
+#include "Placement.h"
+#include "Topology.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+namespace blockforge
+{
+namespace optimize
+{
+using model::BlockModel;
+using model::CarrierGeometry;
+
+namespace
+{
+/// Share of the way to a neighbour a vertex may go: half-way less a margin when the
+/// neighbour moves too (they cannot cross), most of the way when it stays.
+constexpr double movingNeighbourShare = 0.45;
+constexpr double fixedNeighbourShare = 0.9;
+/// Parameter step of the boundary test, and its tolerances.
+constexpr double probeStep = 1.0e-5;
+constexpr double onSurfaceTolerance = 1.0e-7;
+constexpr double inPlaneTolerance = 1.0e-6;
+
+[[noreturn]] void failVertex(const model::Vertex& vertex, const std::string& what)
+{
+  throw model::TemplateError(
+    vertex.where.file, vertex.where.line, model::syntax::entity("vertex", vertex.name), what);
+}
+
+/// Difference a - b of two parameters, wrapped into (-0.5, 0.5] on closed carriers.
+double parameterDifference(double a, double b, bool closed)
+{
+  double d = a - b;
+  if (closed)
+  {
+    d -= std::floor(d + 0.5);
+  }
+  return d;
+}
+
+/// A surface curve drawn through control points: point `index` of carrier `carrier` is
+/// the (s, t) of `vertex` on the surface.
+struct ThroughPoint
+{
+  int carrier = -1;
+  int index = -1;
+  int vertex = -1;
+};
+
+std::vector<ThroughPoint> throughPoints(const BlockModel& model)
+{
+  std::vector<ThroughPoint> found;
+  for (std::size_t c = 0; c < model.carriers.size(); ++c)
+  {
+    const model::Carrier& carrier = model.carriers[c];
+    if (carrier.kind != model::Carrier::Kind::SurfaceCurve || carrier.refs.empty())
+    {
+      continue;
+    }
+    for (std::size_t k = 0; k < carrier.parameterPoints.size(); ++k)
+    {
+      for (std::size_t v = 0; v < model.vertices.size(); ++v)
+      {
+        const model::VertexConstraint& constraint = model.vertices[v].constraint;
+        if (constraint.carrier == carrier.refs[0] &&
+          constraint.s == carrier.parameterPoints[k][0] &&
+          constraint.t == carrier.parameterPoints[k][1])
+        {
+          found.push_back({ static_cast<int>(c), static_cast<int>(k), static_cast<int>(v) });
+          break;
+        }
+      }
+    }
+  }
+  return found;
+}
+
+/// Whether carrier `c` is referred to by another carrier (then it cannot be rebuilt alone).
+bool referredTo(const BlockModel& model, int c)
+{
+  for (const model::Carrier& other : model.carriers)
+  {
+    if (std::find(other.refs.begin(), other.refs.end(), c) != other.refs.end() ||
+      std::find(other.crossRefs.begin(), other.crossRefs.end(), c) != other.crossRefs.end())
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+/**
+ * Surface curves drawn through moved control points are drawn again: their parameter
+ * points take the points' new (s, t). Returns the vertices at the ends of the named edges
+ * on redrawn curves (the plan must update them so those edges follow).
+ */
+std::vector<int> redrawCurves(model::MeshPlan& plan, const std::vector<ThroughPoint>& through)
+{
+  BlockModel& work = plan.model();
+  std::set<int> redraw;
+  for (const ThroughPoint& point : through)
+  {
+    const model::VertexConstraint& constraint = work.vertices[point.vertex].constraint;
+    Eigen::Vector2d& st = work.carriers[point.carrier].parameterPoints[point.index];
+    if (constraint.s != st[0] || constraint.t != st[1])
+    {
+      st = Eigen::Vector2d(constraint.s, constraint.t);
+      redraw.insert(point.carrier);
+    }
+  }
+  std::vector<int> ends;
+  for (int carrier : redraw)
+  {
+    plan.rebuildCarrier(carrier);
+    for (const model::Edge& edge : work.edges)
+    {
+      if (edge.carrier == carrier)
+      {
+        ends.push_back(edge.from);
+        ends.push_back(edge.to);
+      }
+    }
+  }
+  return ends;
+}
+
+/// Sets component `component` of `vertex`'s parameters (wrapped on closed carriers).
+void setParameter(BlockModel& model, const CarrierGeometry& geometry, int vertex, int component,
+  double value)
+{
+  model::VertexConstraint& constraint = model.vertices[vertex].constraint;
+  const bool closed =
+    component == 0 ? geometry.closedS(constraint.carrier) : geometry.closedT(constraint.carrier);
+  (component == 0 ? constraint.s : constraint.t) = closed ? model::wrapUnit(value) : value;
+}
+
+/// Block vertices adjacent to each vertex along block edges.
+std::vector<std::set<int>> edgeNeighbours(const BlockModel& model)
+{
+  std::vector<std::set<int>> neighbours(model.vertices.size());
+  for (const model::Block& block : model.blocks)
+  {
+    for (int e = 0; e < 12; ++e)
+    {
+      const std::array<int, 2> ends = model::edgeVertices(e);
+      const int a = block.vertices[ends[0]], b = block.vertices[ends[1]];
+      if (a != b)
+      {
+        neighbours[a].insert(b);
+        neighbours[b].insert(a);
+      }
+    }
+  }
+  return neighbours;
+}
+
+/// Every vertex that follows `vertex` (itself included).
+std::vector<int> followers(const std::vector<std::vector<int>>& dependents, int vertex)
+{
+  std::vector<int> result, stack{ vertex };
+  std::set<int> seen;
+  while (!stack.empty())
+  {
+    const int v = stack.back();
+    stack.pop_back();
+    if (!seen.insert(v).second)
+    {
+      continue;
+    }
+    result.push_back(v);
+    stack.insert(stack.end(), dependents[v].begin(), dependents[v].end());
+  }
+  return result;
+}
+} // namespace
+
+struct ControlProblem::Impl
+{
+  BlockModel Base;
+  CarrierGeometry Geometry;
+  double Density = 1.0;
+  ObjectiveSettings Objective;
+  std::vector<ThroughPoint> Through;
+  std::vector<ControlVariable> Variables;
+  /// The grid kept alive between evaluations, and the configuration it holds.
+  std::unique_ptr<model::MeshPlan> Plan;
+  std::vector<double> Current;
+
+  /// Moves the plan to configuration x (only the parameters that changed) and updates it.
+  model::Feasibility place(const std::vector<double>& x)
+  {
+    if (!Plan)
+    {
+      Plan.reset(new model::MeshPlan(Base, Geometry, Density));
+      Current.clear();
+      for (const ControlVariable& variable : Variables)
+      {
+        Current.push_back(variable.start);
+      }
+    }
+    BlockModel& work = Plan->model();
+    std::vector<int> moved;
+    for (std::size_t i = 0; i < Variables.size(); ++i)
+    {
+      if (x[i] != Current[i])
+      {
+        setParameter(work, Plan->carriers(), Variables[i].vertex, Variables[i].component, x[i]);
+        moved.push_back(Variables[i].vertex);
+      }
+    }
+    Current = x;
+    std::vector<int> applied = model::applyPlacement(work, Plan->carriers(), moved);
+    const std::vector<int> ends = redrawCurves(*Plan, Through);
+    applied.insert(applied.end(), ends.begin(), ends.end());
+    return Plan->update(applied);
+  }
+};
+
+ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& geometry,
+  double densityMultiplier, const ObjectiveSettings& objective,
+  const std::vector<std::string>& fixed)
+  : P(new Impl)
+{
+  P->Base = model;
+  P->Geometry = geometry;
+  P->Density = densityMultiplier;
+  P->Objective = objective;
+  const BlockModel& base = P->Base;
+  std::set<int> fixedVertices;
+  for (const std::string& name : fixed)
+  {
+    const int v = base.findVertex(name);
+    if (v < 0)
+    {
+      throw model::TemplateError(base.sourceFile, 0, model::syntax::entity("vertex", name),
+        "FixedControlPoints names a vertex the model does not have");
+    }
+    fixedVertices.insert(v);
+  }
+  const int vertexCount = static_cast<int>(base.vertices.size());
+  std::vector<char> inBlock(vertexCount, 0);
+  for (const model::Block& block : base.blocks)
+  {
+    for (int v : block.vertices)
+    {
+      inBlock[v] = 1;
+    }
+  }
+  const std::vector<std::vector<int>> dependents = model::vertexDependents(base);
+  // Surface curves drawn through control points follow them, unless other carriers are
+  // built on them (then those points stay).
+  std::vector<char> drawsCurve(vertexCount, 0);
+  for (const ThroughPoint& point : throughPoints(base))
+  {
+    if (referredTo(base, point.carrier))
+    {
+      fixedVertices.insert(point.vertex);
+      continue;
+    }
+    P->Through.push_back(point);
+    drawsCurve[point.vertex] = 1;
+  }
+  // Candidates: free parameters of vertices that are not fixed and move a block vertex
+  // or a curve drawn through them.
+  std::vector<model::FreeParameter> candidates;
+  for (const model::FreeParameter& parameter : model::freeParameters(base, P->Geometry))
+  {
+    if (fixedVertices.count(parameter.vertex))
+    {
+      continue;
+    }
+    const std::vector<int> moved = followers(dependents, parameter.vertex);
+    if (std::none_of(moved.begin(), moved.end(),
+          [&](int v) { return inBlock[v] != 0 || drawsCurve[v] != 0; }))
+    {
+      continue;
+    }
+    candidates.push_back(parameter);
+  }
+  std::vector<std::set<int>> neighbours = edgeNeighbours(base);
+  // The points a curve is drawn through are neighbours along it.
+  for (const ThroughPoint& a : P->Through)
+  {
+    for (const ThroughPoint& b : P->Through)
+    {
+      if (a.carrier == b.carrier && std::abs(a.index - b.index) == 1)
+      {
+        neighbours[a.vertex].insert(b.vertex);
+      }
+    }
+  }
+  const double size = model::modelSize(base);
+  // Boundary faces (one block, not periodic) with their surface carrier (-1: none).
+  const model::Topology topology = model::buildTopology(base);
+  std::set<int> periodicFaces;
+  for (const model::PeriodicPair& pair : topology.periodic)
+  {
+    periodicFaces.insert(pair.source);
+    periodicFaces.insert(pair.image);
+  }
+  std::map<std::pair<int, int>, int> faceCarrier;
+  for (const model::SurfaceFaces& set : base.surfaceFaces)
+  {
+    for (const model::BlockFace& face : set.faces)
+    {
+      faceCarrier[{ face.block, face.face }] = set.carrier;
+    }
+  }
+  struct BoundaryFace
+  {
+    std::array<int, 4> ids;
+    int carrier;
+  };
+  std::vector<std::vector<BoundaryFace>> boundaryOf(vertexCount);
+  for (std::size_t f = 0; f < topology.faces.size(); ++f)
+  {
+    const model::TopologyFace& face = topology.faces[f];
+    if (face.uses.size() != 1 || periodicFaces.count(static_cast<int>(f)))
+    {
+      continue;
+    }
+    const auto found = faceCarrier.find({ face.uses[0].block, face.uses[0].face });
+    const BoundaryFace entry{ face.ownerIds, found == faceCarrier.end() ? -1 : found->second };
+    std::set<int> corners(face.ownerIds.begin(), face.ownerIds.end());
+    for (int v : corners)
+    {
+      boundaryOf[v].push_back(entry);
+    }
+  }
+  auto staysOnBoundary = [&](const BlockModel& moved, int v) {
+    const Vec3 before = base.vertices[v].position, after = moved.vertices[v].position;
+    const Vec3 step = after - before;
+    if (step.norm() == 0.0)
+    {
+      return true;
+    }
+    for (const BoundaryFace& face : boundaryOf[v])
+    {
+      if (face.carrier >= 0)
+      {
+        double s = 0.0, t = 0.0, distance = 0.0;
+        P->Geometry.project(face.carrier, after, s, t, distance);
+        if (distance > onSurfaceTolerance * size)
+        {
+          return false;
+        }
+        continue;
+      }
+      // A face without carrier: its corners must be coplanar and the step in their plane.
+      Vec3 normal = Vec3::Zero();
+      for (int c = 0; c < 4; ++c)
+      {
+        const Vec3& p = base.vertices[face.ids[c]].position;
+        const Vec3& q = base.vertices[face.ids[(c + 1) % 4]].position;
+        normal += (p - q).cross(p + q) * 0.5; // Newell's method
+      }
+      if (normal.norm() == 0.0)
+      {
+        return false;
+      }
+      normal.normalize();
+      for (int c = 1; c < 4; ++c)
+      {
+        const Vec3 d = base.vertices[face.ids[c]].position - base.vertices[face.ids[0]].position;
+        if (std::abs(d.dot(normal)) > onSurfaceTolerance * size)
+        {
+          return false;
+        }
+      }
+      if (std::abs(step.dot(normal)) > inPlaneTolerance * step.norm())
+      {
+        return false;
+      }
+    }
+    return true;
+  };
+  // The boundary test: a small step must keep every moved vertex on its boundary faces.
+  std::set<std::string> locked;
+  std::vector<model::FreeParameter> kept;
+  std::vector<char> moves(vertexCount, 0); // vertex moves with some kept parameter
+  for (const model::FreeParameter& parameter : candidates)
+  {
+    const int v = parameter.vertex;
+    if (fixedVertices.count(v))
+    {
+      continue;
+    }
+    const model::VertexConstraint& constraint = base.vertices[v].constraint;
+    const double value = parameter.component == 0 ? constraint.s : constraint.t;
+    BlockModel probe = base;
+    const double step = value + probeStep <= parameter.high || parameter.wraps ? probeStep : -probeStep;
+    setParameter(probe, P->Geometry, v, parameter.component, value + step);
+    bool keeps = true;
+    for (int w : model::applyPlacement(probe, P->Geometry, { v }))
+    {
+      keeps = keeps && staysOnBoundary(probe, w);
+    }
+    if (!keeps)
+    {
+      locked.insert(base.vertices[v].name + (parameter.component == 0 ? ".s" : ".t"));
+      continue;
+    }
+    kept.push_back(parameter);
+    for (int w : followers(dependents, v))
+    {
+      moves[w] = 1;
+    }
+  }
+  // Bounds: between the neighbours on the carrier.
+  for (const model::FreeParameter& parameter : kept)
+  {
+    const int v = parameter.vertex;
+    const model::Vertex& vertex = base.vertices[v];
+    const int carrier = vertex.constraint.carrier;
+    const int component = parameter.component;
+    const bool closed = parameter.wraps;
+    const double value = component == 0 ? vertex.constraint.s : vertex.constraint.t;
+    // Neighbours on the carrier: parameter offsets towards each side.
+    double gapLow = 0.0, gapHigh = 0.0, shareLow = 0.0, shareHigh = 0.0;
+    auto consider = [&](int w, double delta) {
+      const double share = moves[w] ? movingNeighbourShare : fixedNeighbourShare;
+      if (delta < 0.0 && (gapLow == 0.0 || -delta < gapLow))
+      {
+        gapLow = -delta;
+        shareLow = share;
+      }
+      else if (delta > 0.0 && (gapHigh == 0.0 || delta < gapHigh))
+      {
+        gapHigh = delta;
+        shareHigh = share;
+      }
+    };
+    if (!P->Geometry.isSurface(carrier))
+    {
+      for (int w = 0; w < vertexCount; ++w)
+      {
+        if (w != v && inBlock[w] && base.vertices[w].constraint.carrier == carrier)
+        {
+          consider(w, parameterDifference(base.vertices[w].constraint.s, value, closed));
+        }
+      }
+    }
+    else
+    {
+      // Physical lengths of unit parameter steps, to tell which direction a neighbour is in.
+      const double h = 1.0e-6;
+      const double s0 = vertex.constraint.s, t0 = vertex.constraint.t;
+      const double lengthS =
+        (P->Geometry.point(carrier, s0 + h, t0) - P->Geometry.point(carrier, s0 - h, t0)).norm() / (2 * h);
+      const double lengthT =
+        (P->Geometry.point(carrier, s0, t0 + h) - P->Geometry.point(carrier, s0, t0 - h)).norm() / (2 * h);
+      for (int w : neighbours[v])
+      {
+        double s = 0.0, t = 0.0, distance = 0.0;
+        P->Geometry.vertexParameters(base, w, carrier, s, t, distance);
+        if (distance > onSurfaceTolerance * size)
+        {
+          continue;
+        }
+        const double ds = parameterDifference(s, s0, P->Geometry.closedS(carrier));
+        const double dt = parameterDifference(t, t0, P->Geometry.closedT(carrier));
+        const double along = component == 0 ? std::abs(ds) * lengthS : std::abs(dt) * lengthT;
+        const double across = component == 0 ? std::abs(dt) * lengthT : std::abs(ds) * lengthS;
+        if (along >= 0.5 * across)
+        {
+          consider(w, component == 0 ? ds : dt);
+        }
+      }
+    }
+    if (gapLow == 0.0 && gapHigh == 0.0)
+    {
+      continue; // no neighbour in this direction: nothing to keep it between
+    }
+    if (gapLow == 0.0)
+    {
+      gapLow = gapHigh;
+      shareLow = shareHigh;
+    }
+    if (gapHigh == 0.0)
+    {
+      gapHigh = gapLow;
+      shareHigh = shareLow;
+    }
+    ControlVariable variable;
+    variable.vertex = v;
+    variable.component = component;
+    variable.start = value;
+    variable.low = value - shareLow * gapLow;
+    variable.high = value + shareHigh * gapHigh;
+    if (!closed)
+    {
+      variable.low = std::max(variable.low, parameter.low);
+      variable.high = std::min(variable.high, parameter.high);
+    }
+    variable.name = vertex.name + (component == 0 ? ".s" : ".t");
+    if (variable.low < variable.high)
+    {
+      Variables.push_back(variable);
+    }
+  }
+  // Vertices fixed above (surface curve points under other carriers) drop out.
+  Variables.erase(std::remove_if(Variables.begin(), Variables.end(),
+                    [&](const ControlVariable& v) { return fixedVertices.count(v.vertex) > 0; }),
+    Variables.end());
+  Locked.assign(locked.begin(), locked.end());
+  P->Variables = Variables;
+}
+
+ControlProblem::~ControlProblem() = default;
+
+std::vector<double> ControlProblem::start() const
+{
+  std::vector<double> x;
+  for (const ControlVariable& v : Variables)
+  {
+    x.push_back(v.start);
+  }
+  return x;
+}
+
+std::vector<double> ControlProblem::low() const
+{
+  std::vector<double> x;
+  for (const ControlVariable& v : Variables)
+  {
+    x.push_back(v.low);
+  }
+  return x;
+}
+
+std::vector<double> ControlProblem::high() const
+{
+  std::vector<double> x;
+  for (const ControlVariable& v : Variables)
+  {
+    x.push_back(v.high);
+  }
+  return x;
+}
+
+GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
+{
+  try
+  {
+    const model::Feasibility feasibility = P->place(x);
+    if (!feasibility.feasible())
+    {
+      GridMeasures failed;
+      failed.invertedCells = 1;
+      failed.objective = infeasibleObjective(1);
+      failed.failure = feasibility.message;
+      return failed;
+    }
+    std::vector<BlockGrid> blocks;
+    for (int b = 0; b < P->Plan->blockCount(); ++b)
+    {
+      const std::array<int, 3> n = P->Plan->nodeCounts(b);
+      blocks.push_back({ P->Plan->blockNodes(b).data(), n[0], n[1], n[2] });
+    }
+    const std::vector<PeriodicSideLink> periodic =
+      P->Objective.kind == ObjectiveKind::NonOrthogonality
+      ? P->Plan->topology().periodicSideLinks()
+      : std::vector<PeriodicSideLink>();
+    return measureGrid(blocks, periodic, P->Objective);
+  }
+  catch (const std::exception& error)
+  {
+    // The input model itself fails the mesher's check: nothing to evaluate.
+    P->Plan.reset();
+    GridMeasures failed;
+    failed.invertedCells = 1;
+    failed.objective = infeasibleObjective(1);
+    failed.failure = error.what();
+    return failed;
+  }
+}
+
+BlockModel ControlProblem::modelAt(const std::vector<double>& x)
+{
+  P->place(x);
+  return P->Plan->model();
+}
+
+std::vector<Vec3> ControlProblem::verticesAt(const std::vector<double>& x) const
+{
+  BlockModel work = P->Base;
+  std::vector<int> moved;
+  for (std::size_t i = 0; i < Variables.size(); ++i)
+  {
+    setParameter(work, P->Geometry, Variables[i].vertex, Variables[i].component, x[i]);
+    moved.push_back(Variables[i].vertex);
+  }
+  model::applyPlacement(work, P->Geometry, moved);
+  std::vector<Vec3> positions;
+  for (const model::Vertex& vertex : work.vertices)
+  {
+    positions.push_back(vertex.position);
+  }
+  return positions;
+}
+
+std::vector<std::vector<double>> ControlProblem::gridAt(const std::vector<double>& x)
+{
+  const model::Feasibility feasibility = P->place(x);
+  if (!feasibility.feasible())
+  {
+    throw std::runtime_error(feasibility.message);
+  }
+  std::vector<std::vector<double>> grids;
+  for (int b = 0; b < P->Plan->blockCount(); ++b)
+  {
+    grids.push_back(P->Plan->blockNodes(b));
+  }
+  return grids;
+}
+
+void applyMoves(BlockModel& model, CarrierGeometry& geometry,
+  const std::vector<ControlPointMove>& moves)
+{
+  if (moves.empty())
+  {
+    return;
+  }
+  model::MeshPlan plan(model, geometry);
+  BlockModel& work = plan.model();
+  std::vector<int> moved;
+  for (const ControlPointMove& move : moves)
+  {
+    const int v = work.findVertex(move.name);
+    if (v < 0)
+    {
+      throw model::TemplateError(model.sourceFile, 0, model::syntax::entity("vertex", move.name),
+        "ControlPointMoves names a vertex the model does not have");
+    }
+    const model::Vertex& vertex = work.vertices[v];
+    if (vertex.rule.kind != model::VertexRule::Kind::OnCarrier)
+    {
+      failVertex(vertex, "is not a control point with free parameters (it follows its placement "
+                         "rule), so it cannot be moved by hand");
+    }
+    const int carrier = vertex.constraint.carrier;
+    const std::size_t expected = geometry.isSurface(carrier) ? 2 : 1;
+    if (move.parameters.size() != expected)
+    {
+      failVertex(vertex, "a move on its carrier takes " + std::to_string(expected) +
+          (expected == 1 ? " value (s)" : " values (s t)") + ", got " +
+          std::to_string(move.parameters.size()));
+    }
+    for (std::size_t c = 0; c < expected; ++c)
+    {
+      const double value = move.parameters[c];
+      const bool closed = c == 0 ? geometry.closedS(carrier) : geometry.closedT(carrier);
+      const double low = c == 0 ? 0.0 : geometry.tMin(carrier);
+      const double high = c == 0 ? 1.0 : geometry.tMax(carrier);
+      if (!std::isfinite(value) || (!closed && (value < low || value > high)))
+      {
+        failVertex(vertex, std::string("the moved parameter ") + (c == 0 ? "s" : "t") +
+            " is outside its carrier's range");
+      }
+      setParameter(work, geometry, v, static_cast<int>(c), value);
+    }
+    moved.push_back(v);
+  }
+  std::vector<int> applied = model::applyPlacement(work, plan.carriers(), moved);
+  std::vector<ThroughPoint> through;
+  for (const ThroughPoint& point : throughPoints(model))
+  {
+    if (!referredTo(model, point.carrier))
+    {
+      through.push_back(point);
+    }
+  }
+  const std::vector<int> ends = redrawCurves(plan, through);
+  applied.insert(applied.end(), ends.begin(), ends.end());
+  // The plan follows carrier edges to their moved ends; a move that folds the grid is
+  // still the user's move (the mesher reports the fold).
+  plan.update(applied);
+  for (std::size_t c = 0; c < model.carriers.size(); ++c)
+  {
+    if (work.carriers[c].parameterPoints != model.carriers[c].parameterPoints)
+    {
+      geometry.rebuild(work, static_cast<int>(c));
+    }
+  }
+  model = work;
+}
+
+ControlPointMove moveTowards(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::string& name, const Vec3& point)
+{
+  const int v = model.findVertex(name);
+  if (v < 0)
+  {
+    throw model::TemplateError(model.sourceFile, 0, model::syntax::entity("vertex", name),
+      "the handle's control point is not a vertex of the model");
+  }
+  const int carrier = model.vertices[v].constraint.carrier;
+  if (carrier < 0 || model.vertices[v].rule.kind != model::VertexRule::Kind::OnCarrier)
+  {
+    failVertex(model.vertices[v], "is not a control point with free parameters");
+  }
+  double s = 0.0, t = 0.0, distance = 0.0;
+  geometry.project(carrier, point, s, t, distance);
+  ControlPointMove move;
+  move.name = name;
+  move.parameters = { s };
+  if (geometry.isSurface(carrier))
+  {
+    move.parameters.push_back(t);
+  }
+  return move;
+}
+} // namespace optimize
+} // namespace blockforge

@@ -1,0 +1,107 @@
+/**
+ * @file ControlProblem.h
+ * @brief The block optimizer's problem on a model (paper section 2.4): which control
+ * point parameters may move, within which bounds, and what the final cells are at a
+ * configuration.
+ *
+ * Variables are the free parameters of the placement rules (Placement.h): s of a control
+ * point on a curve, (s, t) on a surface. A parameter is left out when
+ * - its vertex is fixed by name (FixedControlPoints, or moved by hand);
+ * - moving it moves no block vertex (directly or through the vertices that follow it);
+ * - moving it would change the domain's boundary: a moved vertex (itself or a follower)
+ *   on a boundary face leaves that face's surface carrier or, for faces without one,
+ *   the face's plane (a curved boundary face without carrier holds its vertices).
+ *   Periodic faces are not boundary: their partners move with them.
+ * Bounds keep each vertex between its neighbours on its carrier: the block vertices next
+ * to it along a curve carrier, or its block-edge neighbours in each parameter direction
+ * of a surface; a vertex may cover 45 % of the way to a neighbour that moves too, 90 %
+ * to one that stays.
+ *
+ * Everything that follows a moved vertex follows it: vertices placed from it (rules),
+ * the parameters of carrier edges ending at it, and surface curves drawn through it.
+ * Evaluations run on a mesh plan (MeshPlan.h) kept between them, which recomputes only
+ * what depends on the parameters that changed.
+ */
+#pragma once
+
+#include "GridObjective.h"
+
+#include "BlockModel.h"
+#include "CarrierGeometry.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace blockforge
+{
+namespace optimize
+{
+/// One free parameter: component 0 (s) or 1 (t) of control point `vertex`.
+struct ControlVariable
+{
+  int vertex = -1;
+  int component = 0;
+  double start = 0.0, low = 0.0, high = 1.0;
+  std::string name; ///< "vertex.s" or "vertex.t"
+};
+
+/// A manual move: the control point's new parameters (s on a curve, s and t on a surface).
+struct ControlPointMove
+{
+  std::string name;
+  std::vector<double> parameters;
+};
+
+/**
+ * Applies manual moves (and everything that follows them) to `model`; surface curves
+ * drawn through a moved point are drawn again in `geometry`. Throws
+ * model::TemplateError naming the vertex when it is unknown, not a control point with
+ * free parameters, given the wrong number of values or values outside its carrier.
+ */
+void applyMoves(model::BlockModel& model, model::CarrierGeometry& geometry,
+  const std::vector<ControlPointMove>& moves);
+
+/**
+ * A manual move given as a point (the GUI's handle): the parameters of the point of
+ * control point `name`'s carrier nearest to `point`.
+ */
+ControlPointMove moveTowards(const model::BlockModel& model, const model::CarrierGeometry& geometry,
+  const std::string& name, const Vec3& point);
+
+class ControlProblem
+{
+public:
+  /// Throws model::TemplateError for unknown fixed names and for models the mesher refuses.
+  ControlProblem(const model::BlockModel& model, const model::CarrierGeometry& geometry,
+    double densityMultiplier, const ObjectiveSettings& objective,
+    const std::vector<std::string>& fixed);
+  ~ControlProblem();
+
+  const std::vector<ControlVariable>& variables() const { return Variables; }
+  std::vector<double> start() const;
+  std::vector<double> low() const;
+  std::vector<double> high() const;
+  /// Control points held because they would move the domain's boundary, for the log.
+  const std::vector<std::string>& boundaryLocked() const { return Locked; }
+
+  /// Places the configuration, meshes it and measures its final cells. Never throws: a
+  /// configuration the mesher refuses is infeasible, with the reason in `failure`.
+  GridMeasures evaluate(const std::vector<double>& x);
+  /// The model at configuration x (vertices, carrier edges and surface curves moved).
+  model::BlockModel modelAt(const std::vector<double>& x);
+  /// The vertices placed at configuration x (placement rules only: no edge, curve or
+  /// grid follows), e.g. for scores of the blocks as single cells.
+  std::vector<Vec3> verticesAt(const std::vector<double>& x) const;
+  /// The grid (nodes of every block, i fastest) at configuration x; throws
+  /// std::runtime_error when it is infeasible.
+  std::vector<std::vector<double>> gridAt(const std::vector<double>& x);
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> P;
+  std::vector<ControlVariable> Variables;
+  std::vector<std::string> Locked;
+};
+} // namespace optimize
+} // namespace blockforge

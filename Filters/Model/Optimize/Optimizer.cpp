@@ -1,0 +1,95 @@
+#include "Optimizer.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace blockforge
+{
+namespace optimize
+{
+namespace
+{
+/// Nodes of the grid of `model` at density multiplier `density` (as the mesher rounds).
+double nodeCount(const model::BlockModel& model, double density)
+{
+  double nodes = 0.0;
+  for (const model::Block& block : model.blocks)
+  {
+    double product = 1.0;
+    for (int cells : block.cells)
+    {
+      product *= std::max(1.0, std::round(cells * density)) + 1.0;
+    }
+    nodes += product;
+  }
+  return nodes;
+}
+} // namespace
+
+double measuredDensity(const model::BlockModel& model, double densityMultiplier)
+{
+  double density = densityMultiplier;
+  while (density > 1e-6 && nodeCount(model, density) > MaximumMeasuredNodes)
+  {
+    density *= 0.8;
+  }
+  return density;
+}
+
+OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeometry& geometry,
+  const OptimizerSettings& requested, const ProgressFunction& progress)
+{
+  OptimizerSettings settings = requested;
+  settings.densityMultiplier = measuredDensity(model, requested.densityMultiplier);
+  OptimizerResult result;
+  result.densityMultiplier = settings.densityMultiplier;
+  // The input as it is gives the "before" of the class counts (an input that folds or
+  // cannot be meshed is infeasible; the search may still find a way out).
+  if (!settings.moves.empty())
+  {
+    ControlProblem input(model, geometry, settings.densityMultiplier, settings.objective, {});
+    result.before = input.evaluate(input.start());
+  }
+  result.model = model;
+  applyMoves(result.model, geometry, settings.moves);
+  std::vector<std::string> fixed = settings.fixed;
+  for (const ControlPointMove& move : settings.moves)
+  {
+    fixed.push_back(move.name);
+  }
+  ControlProblem problem(
+    result.model, geometry, settings.densityMultiplier, settings.objective, fixed);
+  result.variables = problem.variables();
+  result.boundaryLocked = problem.boundaryLocked();
+  if (!settings.automatic)
+  {
+    result.after = problem.evaluate(problem.start());
+    if (settings.moves.empty())
+    {
+      result.before = result.after;
+    }
+    return result;
+  }
+  result.search = search(problem.start(), problem.low(), problem.high(),
+    settings.objective.kind,
+    [&](const std::vector<double>& x) { return problem.evaluate(x); }, settings.search,
+    progress);
+  result.after = result.search.bestMeasures;
+  if (settings.moves.empty())
+  {
+    result.before = result.search.start;
+  }
+  const model::BlockModel moved = result.model;
+  result.model = problem.modelAt(result.search.best);
+  // Surface curves drawn through points that moved are drawn again in `geometry`.
+  for (std::size_t c = 0; c < moved.carriers.size(); ++c)
+  {
+    if (moved.carriers[c].parameterPoints != result.model.carriers[c].parameterPoints)
+    {
+      geometry.rebuild(result.model, static_cast<int>(c));
+    }
+  }
+  return result;
+}
+} // namespace optimize
+} // namespace blockforge

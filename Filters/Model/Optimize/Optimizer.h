@@ -1,0 +1,59 @@
+/**
+ * @file Optimizer.h
+ * @brief The block optimizer (paper step 3, section 2.4): manual moves first, then the
+ * control points slide along their carriers until the final cells are as good as the
+ * geometry allows. The output is the same block model with moved vertices.
+ */
+#pragma once
+
+#include "ControlProblem.h"
+#include "Search.h"
+
+namespace blockforge
+{
+namespace optimize
+{
+/// The largest grid the objective is measured on (nodes); a larger one is measured on a
+/// coarsened copy (a smaller density multiplier), so the optimizer never allocates what
+/// the mesher would refuse and stays fast on fine grids.
+constexpr double MaximumMeasuredNodes = 1.0e6;
+
+/// The density multiplier the objective is measured at: `densityMultiplier`, lowered by
+/// factors of 0.8 until the grid has at most MaximumMeasuredNodes nodes.
+double measuredDensity(const model::BlockModel& model, double densityMultiplier);
+
+struct OptimizerSettings
+{
+  ObjectiveSettings objective;
+  SearchSettings search;
+  /// The grid the objective measures: the model's cell counts times this (as BlockMesher),
+  /// coarsened to at most MaximumMeasuredNodes nodes.
+  double densityMultiplier = 1.0;
+  /// Control points that stay where they are (names of vertices).
+  std::vector<std::string> fixed;
+  /// Manual moves, applied before the automatic run, which then holds these points.
+  std::vector<ControlPointMove> moves;
+  /// false: only the manual moves are applied (no automatic run).
+  bool automatic = true;
+};
+
+struct OptimizerResult
+{
+  model::BlockModel model;           ///< the model with moved vertices
+  GridMeasures before;               ///< the input model's grid
+  GridMeasures after;                ///< the output model's grid
+  SearchResult search;               ///< history of the automatic run (empty without one)
+  std::vector<ControlVariable> variables;
+  std::vector<std::string> boundaryLocked;
+  double densityMultiplier = 1.0;    ///< the density the objective was measured at
+};
+
+/**
+ * Optimizes `model` (its carriers built in `geometry`, which is updated for surface
+ * curves drawn through moved points). Throws model::TemplateError for bad names or
+ * moves and when the input model cannot be meshed. `progress` gets fractions in [0, 1].
+ */
+OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeometry& geometry,
+  const OptimizerSettings& settings, const ProgressFunction& progress = {});
+} // namespace optimize
+} // namespace blockforge

@@ -1,0 +1,305 @@
+// The block optimizer on models (Filters/Model/Optimize): a known optimum, the domain's
+// boundary and periodic partners kept, never worse than the start, deterministic, manual
+// moves held, and the blade-passage templates on both machines.
+#include "Optimizer.h"
+
+#include "CarrierGeometry.h"
+#include "Mesher.h"
+#include "ModelDocument.h"
+#include "Template.h"
+
+#include "TestHelpers.h"
+#include "TestTurboInputs.h"
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace blockforge;
+using namespace blockforge::optimize;
+
+namespace
+{
+std::string dataPath(const std::string& name)
+{
+  return std::string(BLOCKFORGE_SOURCE_DIR) + "/Testing/Data/" + name;
+}
+
+struct Loaded
+{
+  model::BlockModel model;
+  model::CarrierGeometry geometry;
+};
+
+Loaded loadSymmetric(const std::string& s0 = "0.3")
+{
+  Loaded loaded;
+  loaded.model = model::loadTemplate(
+    dataPath("optimizer_symmetric.yaml"), { { "s0", s0 } }, nullptr, &loaded.geometry);
+  return loaded;
+}
+
+Loaded loadPassage(const std::string& templateName, const std::string& machine)
+{
+  Loaded loaded;
+  const model::TemplateInputs inputs = test::readTemplateInputs(
+    std::string(BLOCKFORGE_SOURCE_DIR) + "/Data/" + machine + "/BladeGen.inf");
+  loaded.model = model::loadTemplate(
+    test::templatePath(templateName + ".yaml"), {}, &inputs, &loaded.geometry);
+  return loaded;
+}
+
+/// Smallest element angle of the grid the full mesher makes of `model`.
+double meshedMinAngle(const model::BlockModel& model)
+{
+  const test::Grid grid = test::meshAll(model);
+  std::vector<BlockGrid> blocks;
+  for (std::size_t b = 0; b < grid.xyz.size(); ++b)
+  {
+    blocks.push_back({ grid.xyz[b].data(), grid.nodes[b][0], grid.nodes[b][1], grid.nodes[b][2] });
+  }
+  return measureGrid(blocks, {}, ObjectiveSettings{}).minAngle;
+}
+
+const ControlVariable* findVariable(const std::vector<ControlVariable>& variables,
+  const std::string& name)
+{
+  for (const ControlVariable& variable : variables)
+  {
+    if (variable.name == name)
+    {
+      return &variable;
+    }
+  }
+  return nullptr;
+}
+} // namespace
+
+TEST(Optimizer, FindsTheSymmetricOptimum)
+{
+  Loaded loaded = loadSymmetric();
+  OptimizerSettings settings;
+  settings.search.tolerance = 1e-12;
+  settings.search.maxEvaluations = 300;
+  const OptimizerResult result = optimizeModel(loaded.model, loaded.geometry, settings);
+  // Only the shared vertex moves: the carrier's ends are corners of the domain.
+  ASSERT_EQ(result.variables.size(), 1u);
+  EXPECT_EQ(result.variables[0].name, "m0.s");
+  EXPECT_EQ(result.boundaryLocked, (std::vector<std::string>{ "a0.s", "b1.s" }));
+  const int m0 = result.model.findVertex("m0");
+  EXPECT_NEAR(result.model.vertices[m0].constraint.s, 0.5, 1e-6);
+  EXPECT_NEAR(result.model.vertices[m0].position.x(), 1.0, 2e-6);
+  EXPECT_NEAR(result.before.minAngle, std::atan2(1.0, 0.4) * 180.0 / M_PI, 1e-9);
+  EXPECT_NEAR(result.after.minAngle, 90.0, 1e-3);
+  EXPECT_EQ(result.after.classes[4], 128); // all 2 x 4^3 cells in 80-90
+  // The output model meshes to what the optimizer measured.
+  EXPECT_EQ(meshedMinAngle(result.model), result.after.minAngle);
+}
+
+TEST(Optimizer, BoundsKeepTheVertexBetweenItsNeighbours)
+{
+  Loaded loaded = loadSymmetric("0.3");
+  ControlProblem problem(loaded.model, loaded.geometry, 1.0, ObjectiveSettings{}, {});
+  ASSERT_EQ(problem.variables().size(), 1u);
+  // Neighbours on the carrier: a0 at 0 and b1 at 1, both held: 90 % of the way to each.
+  EXPECT_NEAR(problem.low()[0], 0.3 - 0.9 * 0.3, 1e-15);
+  EXPECT_NEAR(problem.high()[0], 0.3 + 0.9 * 0.7, 1e-15);
+}
+
+TEST(Optimizer, BoundaryStaysPut)
+{
+  Loaded loaded = loadSymmetric("0.35");
+  OptimizerSettings settings;
+  const OptimizerResult result = optimizeModel(loaded.model, loaded.geometry, settings);
+  const test::Grid grid = test::meshAll(result.model);
+  // Every node of the bottom (z = 0), front (y = 0), inlet (x = 0) and outlet (x = 2)
+  // faces stays on its plane.
+  for (std::size_t b = 0; b < grid.xyz.size(); ++b)
+  {
+    const auto& n = grid.nodes[b];
+    for (int k = 0; k < n[2]; ++k)
+    {
+      for (int j = 0; j < n[1]; ++j)
+      {
+        for (int i = 0; i < n[0]; ++i)
+        {
+          const Vec3 p = grid.at(static_cast<int>(b), i, j, k);
+          if (k == 0)
+          {
+            EXPECT_NEAR(p.z(), 0.0, 1e-12);
+          }
+          if (j == 0)
+          {
+            EXPECT_NEAR(p.y(), 0.0, 1e-12);
+          }
+          if (b == 0 && i == 0)
+          {
+            EXPECT_NEAR(p.x(), 0.0, 1e-12);
+          }
+          if (b == 1 && i == n[0] - 1)
+          {
+            EXPECT_NEAR(p.x(), 2.0, 1e-12);
+          }
+        }
+      }
+    }
+  }
+  for (const char* corner : { "a0", "b1", "a3", "b2", "a4", "b5" })
+  {
+    const int v = result.model.findVertex(corner);
+    EXPECT_TRUE(test::sameBits(result.model.vertices[v].position, loaded.model.vertices[v].position))
+      << corner;
+  }
+}
+
+TEST(Optimizer, AnOptimalStartStays)
+{
+  Loaded loaded = loadSymmetric("0.5");
+  const OptimizerResult result = optimizeModel(loaded.model, loaded.geometry, OptimizerSettings{});
+  const int m0 = result.model.findVertex("m0");
+  EXPECT_EQ(result.model.vertices[m0].constraint.s, 0.5);
+  EXPECT_NEAR(result.after.minAngle, 90.0, 1e-9);
+}
+
+TEST(Optimizer, ManualMoveIsHeld)
+{
+  Loaded loaded = loadSymmetric("0.3");
+  OptimizerSettings settings;
+  settings.moves = { { "m0", { 0.42 } } };
+  const OptimizerResult result = optimizeModel(loaded.model, loaded.geometry, settings);
+  const int m0 = result.model.findVertex("m0");
+  EXPECT_EQ(result.model.vertices[m0].constraint.s, 0.42);
+  EXPECT_NEAR(result.model.vertices[m0].position.x(), 0.84, 1e-12);
+  EXPECT_TRUE(result.variables.empty());
+  EXPECT_NEAR(result.before.minAngle, std::atan2(1.0, 0.4) * 180.0 / M_PI, 1e-9);
+  EXPECT_NEAR(result.after.minAngle, std::atan2(1.0, 0.16) * 180.0 / M_PI, 1e-9);
+  // The moved model travels through the model document.
+  const model::BlockModel reread = model::readModelDocument(model::writeModelDocument(result.model));
+  EXPECT_EQ(reread.vertices[m0].constraint.s, 0.42);
+}
+
+TEST(Optimizer, FixedControlPointStays)
+{
+  Loaded loaded = loadSymmetric("0.3");
+  OptimizerSettings settings;
+  settings.fixed = { "m0" };
+  const OptimizerResult result = optimizeModel(loaded.model, loaded.geometry, settings);
+  EXPECT_TRUE(result.variables.empty());
+  EXPECT_EQ(result.model.vertices[result.model.findVertex("m0")].constraint.s, 0.3);
+}
+
+TEST(Optimizer, BadNamesAndMovesAreErrors)
+{
+  Loaded loaded = loadSymmetric();
+  OptimizerSettings settings;
+  settings.fixed = { "nowhere" };
+  test::expectError([&] { optimizeModel(loaded.model, loaded.geometry, settings); },
+    { "nowhere", "FixedControlPoints" });
+  settings.fixed.clear();
+  settings.moves = { { "a2", { 0.5 } } };
+  test::expectError([&] { optimizeModel(loaded.model, loaded.geometry, settings); },
+    { "optimizer_symmetric.yaml", "a2", "not a control point" });
+  settings.moves = { { "m0", { 0.5, 0.2 } } };
+  test::expectError(
+    [&] { optimizeModel(loaded.model, loaded.geometry, settings); }, { "m0", "1 value" });
+  settings.moves = { { "m0", { 1.5 } } };
+  test::expectError(
+    [&] { optimizeModel(loaded.model, loaded.geometry, settings); }, { "m0", "outside" });
+}
+
+TEST(Optimizer, HandleProjectsOntoTheCarrier)
+{
+  Loaded loaded = loadSymmetric();
+  const ControlPointMove move = moveTowards(loaded.model, loaded.geometry, "m0", Vec3(1.3, 0.4, -0.2));
+  ASSERT_EQ(move.parameters.size(), 1u);
+  EXPECT_NEAR(move.parameters[0], 0.65, 1e-12);
+}
+
+namespace
+{
+/// The passage templates, a short run: what every passage test checks.
+struct PassageRun
+{
+  Loaded loaded;
+  OptimizerResult result;
+};
+
+PassageRun runPassage(const std::string& templateName, const std::string& machine, int evaluations)
+{
+  PassageRun run;
+  run.loaded = loadPassage(templateName, machine);
+  OptimizerSettings settings;
+  settings.search.maxEvaluations = evaluations;
+  model::CarrierGeometry geometry = run.loaded.geometry;
+  run.result = optimizeModel(run.loaded.model, geometry, settings);
+  return run;
+}
+} // namespace
+
+TEST(OptimizerPassage, ImprovesAndKeepsBoundaryAndPeriodicity)
+{
+  for (const char* machine : { "distributor", "rotor37/turbogrid" })
+  {
+    const PassageRun run = runPassage("axial_passage_oh", machine, 100);
+    const OptimizerResult& result = run.result;
+    SCOPED_TRACE(machine);
+    EXPECT_GT(result.variables.size(), 10u);
+    EXPECT_TRUE(result.after.feasible);
+    EXPECT_GE(result.after.minAngle, result.before.minAngle); // never worse
+    EXPECT_GT(result.after.minAngle, result.before.minAngle);
+    // Inlet and outlet vertices move only around the axis (their s is held).
+    for (const char* name : { "lo_in_h.s", "a_in_h.s", "b_out_s.s" })
+    {
+      EXPECT_EQ(findVariable(result.variables, name), nullptr) << name;
+    }
+    EXPECT_NE(findVariable(result.variables, "a_in_h.t"), nullptr);
+    // The output meshes (full mesher) to what the optimizer measured.
+    EXPECT_EQ(meshedMinAngle(result.model), result.after.minAngle);
+    // Periodic partners still match, inlet and outlet vertices keep their axial planes.
+    const model::BlockModel& before = run.loaded.model;
+    const model::BlockModel& after = result.model;
+    const model::Machine& machineAxis = after.machine;
+    const double size = model::modelSize(before);
+    for (std::size_t v = 0; v < after.vertices.size(); ++v)
+    {
+      const model::Vertex& vertex = after.vertices[v];
+      if (vertex.constraint.periodicSource >= 0)
+      {
+        const Vec3 source = after.vertices[vertex.constraint.periodicSource].position;
+        const Eigen::AngleAxisd rotation(vertex.constraint.pitches * machineAxis.pitch(), machineAxis.axis);
+        const Vec3 image = machineAxis.axisPoint + rotation * (source - machineAxis.axisPoint);
+        EXPECT_LT((image - vertex.position).norm(), 1e-9 * size) << vertex.name;
+      }
+      if (vertex.name.find("_in_") != std::string::npos ||
+        vertex.name.find("_out_") != std::string::npos)
+      {
+        const double axialBefore = machineAxis.axis.dot(before.vertices[v].position);
+        const double axialAfter = machineAxis.axis.dot(vertex.position);
+        EXPECT_NEAR(axialAfter, axialBefore, 1e-12 * size) << vertex.name;
+      }
+    }
+  }
+}
+
+TEST(OptimizerPassage, SameResultTwiceBitForBit)
+{
+  const PassageRun first = runPassage("axial_passage_oh", "distributor", 30);
+  const PassageRun second = runPassage("axial_passage_oh", "distributor", 30);
+  ASSERT_EQ(first.result.search.history.size(), second.result.search.history.size());
+  for (std::size_t i = 0; i < first.result.search.history.size(); ++i)
+  {
+    EXPECT_TRUE(test::sameBits(
+      first.result.search.history[i].objective, second.result.search.history[i].objective));
+  }
+  EXPECT_EQ(model::writeModelDocument(first.result.model),
+    model::writeModelDocument(second.result.model));
+}
+
+TEST(OptimizerPassage, HTemplateNeverWorse)
+{
+  const PassageRun run = runPassage("axial_passage_h", "rotor37/turbogrid", 40);
+  EXPECT_TRUE(run.result.after.feasible);
+  EXPECT_GE(run.result.after.minAngle, run.result.before.minAngle);
+  EXPECT_EQ(meshedMinAngle(run.result.model), run.result.after.minAngle);
+}

@@ -1,0 +1,297 @@
+// The optimizer's objective over final cells and its search (Filters/Model/Optimize),
+// against closed forms: no block model involved.
+#include "GridObjective.h"
+#include "Search.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <vector>
+
+using namespace blockforge;
+using namespace blockforge::optimize;
+
+namespace
+{
+const double degrees = 180.0 / M_PI;
+
+struct Grid
+{
+  int ni, nj, nk;
+  std::vector<double> xyz;
+  BlockGrid block() const { return { xyz.data(), ni, nj, nk }; }
+};
+
+Grid makeGrid(int ni, int nj, int nk, const std::function<Vec3(int, int, int)>& at)
+{
+  Grid g{ ni, nj, nk, {} };
+  for (int k = 0; k < nk; ++k)
+  {
+    for (int j = 0; j < nj; ++j)
+    {
+      for (int i = 0; i < ni; ++i)
+      {
+        const Vec3 p = at(i, j, k);
+        g.xyz.insert(g.xyz.end(), { p.x(), p.y(), p.z() });
+      }
+    }
+  }
+  return g;
+}
+
+/// A unit-spaced block whose layers k > 0 are sheared along x by tan(angle) per layer.
+Grid shearedBlock(int n, double angle)
+{
+  return makeGrid(n, n, n, [&](int i, int j, int k) {
+    return Vec3(i + k * std::tan(angle), j, k);
+  });
+}
+
+GridMeasures measure(const Grid& grid, ObjectiveKind kind = ObjectiveKind::MinAngle)
+{
+  ObjectiveSettings settings;
+  settings.kind = kind;
+  return measureGrid({ grid.block() }, {}, settings);
+}
+} // namespace
+
+TEST(GridObjective, CellAnglesOfAShearedBlock)
+{
+  const double shear = 35.0 / degrees; // corner angles 55 and 125 degrees in the xz faces
+  const Grid grid = shearedBlock(4, shear);
+  std::vector<double> angles(27);
+  cellMinAngles(grid.block(), angles.data());
+  for (double angle : angles)
+  {
+    EXPECT_NEAR(angle, 55.0, 1e-9);
+  }
+  const GridMeasures measures = measure(grid);
+  EXPECT_TRUE(measures.feasible);
+  EXPECT_NEAR(measures.minAngle, 55.0, 1e-9);
+  EXPECT_EQ(measures.classes[2], 27); // [40, 60)
+}
+
+TEST(GridObjective, CellAnglesAgreeWithGridQuality)
+{
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> jitter(-0.25, 0.25);
+  const Grid grid = makeGrid(6, 5, 4, [&](int i, int j, int k) {
+    return Vec3(i + jitter(random), j + jitter(random), k + jitter(random));
+  });
+  std::vector<double> angles(5 * 4 * 3);
+  cellMinAngles(grid.block(), angles.data());
+  const std::vector<CellQualityArrays> quality = computeGridQuality({ grid.block() });
+  ASSERT_EQ(quality[0].minAngle.size(), angles.size());
+  for (std::size_t c = 0; c < angles.size(); ++c)
+  {
+    EXPECT_NEAR(angles[c], quality[0].minAngle[c], 1e-9) << "cell " << c;
+  }
+}
+
+TEST(GridObjective, WedgeCellsTakeCoreRules)
+{
+  // A block whose i = 0 layer collapses onto the z axis (a wedge at every cell there).
+  const Grid grid = makeGrid(3, 3, 2, [&](int i, int j, int k) {
+    const double r = i, angle = j * 20.0 / degrees;
+    return Vec3(r * std::cos(angle), r * std::sin(angle), k);
+  });
+  std::vector<double> angles(2 * 2 * 1);
+  cellMinAngles(grid.block(), angles.data());
+  const std::vector<CellQualityArrays> quality = computeGridQuality({ grid.block() });
+  for (std::size_t c = 0; c < angles.size(); ++c)
+  {
+    EXPECT_NEAR(angles[c], quality[0].minAngle[c], 1e-9) << "cell " << c;
+  }
+  EXPECT_NEAR(angles[0], 20.0, 1e-9); // the wedge's apex angle
+}
+
+TEST(GridObjective, SmoothMinimumBounds)
+{
+  const std::vector<double> values = { 30.0, 31.0, 45.0, 80.0, 30.0 };
+  const double k = 2.0;
+  const double soft = softMinimum(values, k);
+  const double expected =
+    30.0 - std::log(2.0 + std::exp(-2.0) + std::exp(-30.0) + std::exp(-100.0)) / k;
+  EXPECT_NEAR(soft, expected, 1e-12);
+  EXPECT_LE(soft, 30.0);
+  EXPECT_GE(soft, 30.0 - std::log(5.0) / k);
+}
+
+TEST(GridObjective, SmoothMinimumOverCornerAngles)
+{
+  // Every cell has 4 corners of 60 degrees and 4 of 120 (its two xz faces); the other 16
+  // are right angles.
+  const Grid grid = shearedBlock(4, 30.0 / degrees);
+  ObjectiveSettings settings;
+  settings.angleSharpness = 0.5;
+  const GridMeasures measures = measureGrid({ grid.block() }, {}, settings);
+  const double expected =
+    60.0 - std::log(27.0 * (4.0 + 16.0 * std::exp(-15.0) + 4.0 * std::exp(-30.0))) / 0.5;
+  EXPECT_NEAR(measures.softMinAngle, expected, 1e-9);
+  EXPECT_NEAR(measures.objective, -expected, 1e-9);
+}
+
+TEST(GridObjective, InvertedCellsAreInfeasible)
+{
+  Grid grid = shearedBlock(3, 0.0);
+  // Push one interior node through its neighbour.
+  const int n = 1 + 3 * (1 + 3 * 1);
+  grid.xyz[3 * n] += 1.5;
+  const GridMeasures measures = measure(grid);
+  EXPECT_FALSE(measures.feasible);
+  EXPECT_GT(measures.invertedCells, 0);
+  EXPECT_GE(measures.objective, infeasibleObjective(1));
+}
+
+TEST(GridObjective, NeighbourSizeRatio)
+{
+  // Geometric spacing 1.5 along i, uniform along j and k.
+  const Grid grid = makeGrid(5, 3, 3, [&](int i, int j, int k) {
+    return Vec3((std::pow(1.5, i) - 1.0) / 0.5, j, k);
+  });
+  EXPECT_NEAR(maxNeighbourSizeRatio(grid.block()), 1.5, 1e-12);
+  ObjectiveSettings settings;
+  settings.kind = ObjectiveKind::MinAngleAndSizeRatio;
+  settings.sizeRatioWeight = 10.0;
+  const GridMeasures measures = measureGrid({ grid.block() }, {}, settings);
+  EXPECT_NEAR(measures.objective, -measures.softMinAngle + 5.0, 1e-12);
+}
+
+TEST(GridObjective, NonOrthogonalityOfAShearedBlock)
+{
+  const Grid grid = shearedBlock(4, 25.0 / degrees);
+  const GridMeasures measures = measure(grid, ObjectiveKind::NonOrthogonality);
+  EXPECT_NEAR(measures.maxNonOrthogonality, 25.0, 1e-9);
+  EXPECT_GE(measures.objective, 25.0 - 1e-9);
+}
+
+TEST(GridObjective, ObjectiveNames)
+{
+  EXPECT_EQ(objectiveFromName("NonOrthogonality"), ObjectiveKind::NonOrthogonality);
+  EXPECT_STREQ(objectiveName(ObjectiveKind::MinAngleAndSizeRatio), "MinAngleAndSizeRatio");
+  EXPECT_THROW(objectiveFromName("Orthogonality"), std::invalid_argument);
+}
+
+namespace
+{
+/// A closed-form stand-in for a grid: the "smallest angle" is 90 - |x - optimum| * 50
+/// summed over the variables, feasible inside |x - optimum| < 0.8.
+GridMeasures peak(const std::vector<double>& x, const std::vector<double>& optimum)
+{
+  GridMeasures m;
+  double distance = 0.0, squared = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i)
+  {
+    distance += std::abs(x[i] - optimum[i]);
+    squared += (x[i] - optimum[i]) * (x[i] - optimum[i]);
+  }
+  if (distance >= 0.8)
+  {
+    m.invertedCells = 3;
+    m.objective = infeasibleObjective(3);
+    return m;
+  }
+  m.feasible = true;
+  m.minAngle = 90.0 - 50.0 * distance;
+  m.objective = -90.0 + 100.0 * squared; // smooth surrogate with the same optimum
+  return m;
+}
+} // namespace
+
+TEST(Search, FindsTheOptimumWithinBounds)
+{
+  const std::vector<double> optimum = { 0.55, 0.35 };
+  SearchSettings settings;
+  settings.tolerance = 1e-14;
+  settings.maxEvaluations = 200;
+  const SearchResult result = search({ 0.4, 0.5 }, { 0.0, 0.0 }, { 1.0, 1.0 },
+    ObjectiveKind::MinAngle, [&](const std::vector<double>& x) { return peak(x, optimum); },
+    settings);
+  ASSERT_EQ(result.best.size(), 2u);
+  EXPECT_NEAR(result.best[0], 0.55, 1e-6);
+  EXPECT_NEAR(result.best[1], 0.35, 1e-6);
+  EXPECT_LE(result.evaluations, 200);
+  EXPECT_EQ(static_cast<int>(result.history.size()), result.evaluations);
+  EXPECT_EQ(result.history.front().evaluation, 1);
+  EXPECT_GT(result.bestMeasures.minAngle, result.start.minAngle);
+}
+
+TEST(Search, OptimumOnABoundIsKept)
+{
+  const std::vector<double> optimum = { 1.3 };
+  SearchSettings settings;
+  settings.tolerance = 1e-14;
+  const SearchResult result = search({ 0.8 }, { 0.0 }, { 1.0 }, ObjectiveKind::MinAngle,
+    [&](const std::vector<double>& x) { return peak(x, optimum); }, settings);
+  EXPECT_NEAR(result.best[0], 1.0, 1e-9);
+}
+
+TEST(Search, NeverWorseThanTheStart)
+{
+  // The surrogate prefers x = 0.5, the true smallest angle is best at the start x = 0.
+  auto evaluate = [](const std::vector<double>& x) {
+    GridMeasures m;
+    m.feasible = true;
+    m.minAngle = 40.0 - std::abs(x[0]);
+    m.objective = (x[0] - 0.5) * (x[0] - 0.5);
+    return m;
+  };
+  const SearchResult result = search({ 0.0 }, { -1.0 }, { 1.0 }, ObjectiveKind::MinAngle,
+    evaluate, SearchSettings{});
+  EXPECT_EQ(result.best[0], 0.0);
+  EXPECT_EQ(result.bestMeasures.minAngle, 40.0);
+  EXPECT_GT(result.evaluations, 1);
+}
+
+TEST(Search, DeterministicBitForBit)
+{
+  const std::vector<double> optimum = { 0.21, 0.77, 0.5 };
+  auto run = [&](SearchAlgorithm algorithm) {
+    SearchSettings settings;
+    settings.algorithm = algorithm;
+    settings.maxEvaluations = 60;
+    return search({ 0.3, 0.6, 0.45 }, { 0.0, 0.0, 0.0 }, { 1.0, 1.0, 1.0 },
+      ObjectiveKind::MinAngle, [&](const std::vector<double>& x) { return peak(x, optimum); },
+      settings);
+  };
+  for (SearchAlgorithm algorithm :
+    { SearchAlgorithm::Bobyqa, SearchAlgorithm::Cobyla, SearchAlgorithm::Subplex,
+      SearchAlgorithm::Compass })
+  {
+    const SearchResult a = run(algorithm), b = run(algorithm);
+    ASSERT_EQ(a.history.size(), b.history.size());
+    for (std::size_t i = 0; i < a.history.size(); ++i)
+    {
+      EXPECT_EQ(a.history[i].objective, b.history[i].objective);
+    }
+    EXPECT_EQ(a.best, b.best);
+  }
+}
+
+TEST(Search, EvaluationLimitAndProgress)
+{
+  int calls = 0;
+  double lastProgress = 0.0;
+  SearchSettings settings;
+  settings.maxEvaluations = 17;
+  settings.tolerance = 0.0;
+  const SearchResult result = search({ 0.5, 0.5 }, { 0.0, 0.0 }, { 1.0, 1.0 },
+    ObjectiveKind::MinAngle,
+    [&](const std::vector<double>& x) {
+      ++calls;
+      return peak(x, { 0.123, 0.987 });
+    },
+    settings, [&](double fraction) { lastProgress = fraction; });
+  EXPECT_EQ(calls, 17);
+  EXPECT_EQ(result.evaluations, 17);
+  EXPECT_DOUBLE_EQ(lastProgress, 1.0);
+}
+
+TEST(Search, RejectsAStartOutsideItsBounds)
+{
+  EXPECT_THROW(search({ 2.0 }, { 0.0 }, { 1.0 }, ObjectiveKind::MinAngle,
+                 [](const std::vector<double>& x) { return peak(x, { 0.5 }); }, SearchSettings{}),
+    std::invalid_argument);
+}
