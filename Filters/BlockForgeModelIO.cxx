@@ -1,6 +1,7 @@
 #include "BlockForgeModelIO.h"
 
 #include "BlockForgeParallel.h"
+#include "BlockForgeRanges.h"
 
 #include "../Model/ModelDocument.h"
 #include "../Model/Partition.h"
@@ -273,6 +274,11 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
     blockId->SetNumberOfTuples(grid->GetNumberOfCells());
     blockId->FillValue(b);
     grid->GetCellData()->AddArray(blockId);
+    // Ranges ParaView asks for after every update, computed now while cheap.
+    cacheRanges(coordinates);
+    cacheConstantRange(blockId, b);
+    // The active scalars are what ParaView colours by at first: the decomposition.
+    grid->GetCellData()->SetActiveScalars("BlockId");
 
     output->SetBlock(static_cast<unsigned int>(b), grid);
     if (progress)

@@ -11,6 +11,7 @@
 #include <vtkSMPTools.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <map>
 #include <mutex>
 #include <set>
@@ -25,6 +26,13 @@ void useSMPTools()
   std::call_once(installed,
     []
     {
+      // Debian's ParaView 5.11 has the STDThread backend built in but starts on the
+      // Sequential one: turn threads on, unless the user chose a backend.
+      const char* chosen = std::getenv("VTK_SMP_BACKEND_IN_USE");
+      if ((!chosen || !*chosen) && std::string(vtkSMPTools::GetBackend()) == "Sequential")
+      {
+        vtkSMPTools::SetBackend("STDThread");
+      }
       vtkSMPTools::Initialize();
       const int threads = vtkSMPTools::GetEstimatedNumberOfThreads();
       if (threads <= 1)

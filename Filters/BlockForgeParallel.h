@@ -21,10 +21,12 @@ namespace vtkglue
 {
 /**
  * Lets the numerical core run its chunks of work (k-layers of large blocks when meshing
- * and measuring) through vtkSMPTools, with the backend and thread count ParaView uses
- * (Debian's ParaView 5.11: STDThread; VTK_SMP_MAX_THREADS limits the threads,
- * VTK_SMP_BACKEND_IN_USE=Sequential turns them off). Idempotent. Results do not depend on
- * the threads, bit for bit.
+ * and measuring, value ranges) through vtkSMPTools. Debian's ParaView 5.11 builds the
+ * Sequential and STDThread backends and starts on Sequential: unless the user chose one
+ * (VTK_SMP_BACKEND_IN_USE), this switches the process to STDThread, which ParaView's own
+ * threaded code (array ranges, many filters) then uses too. VTK_SMP_MAX_THREADS limits
+ * the threads; VTK_SMP_BACKEND_IN_USE=Sequential keeps one. Idempotent. Results do not
+ * depend on the threads, bit for bit.
  */
 void useSMPTools();
 

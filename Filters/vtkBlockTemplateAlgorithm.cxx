@@ -1,5 +1,6 @@
 #include "vtkBlockTemplateAlgorithm.h"
 
+#include "BlockForgeFileStamps.h"
 #include "BlockForgeModelIO.h"
 
 #include "../Model/CarrierGeometry.h"
@@ -20,9 +21,93 @@
 #include <vtkFieldData.h>
 #include <vtkStructuredGrid.h>
 
+#include <iomanip>
 #include <iterator>
+#include <sstream>
 
-vtkBlockTemplateAlgorithm::vtkBlockTemplateAlgorithm() = default;
+namespace
+{
+std::string trimmed(const std::string& text)
+{
+  const std::size_t first = text.find_first_not_of(" \t");
+  const std::size_t last = text.find_last_not_of(" \t");
+  return first == std::string::npos ? std::string() : text.substr(first, last - first + 1);
+}
+} // namespace
+
+struct vtkBlockTemplateAlgorithm::Internals
+{
+  blockforge::vtkglue::FileStamps TemplateStamp;
+  /// The parameter table and what it was read from.
+  vtkNew<vtkStringArray> ParameterTable;
+  std::string TableFile;
+  vtkMTimeType TableTime = 0;
+  vtkMTimeType TableRunTime = 0;
+  vtkTimeStamp RunTime;
+};
+
+vtkBlockTemplateAlgorithm::vtkBlockTemplateAlgorithm()
+  : Internal(new Internals)
+{
+}
+
+vtkMTimeType vtkBlockTemplateAlgorithm::GetMTime()
+{
+  return std::max(this->Superclass::GetMTime(), this->Internal->TemplateStamp.changeTime());
+}
+
+vtkStringArray* vtkBlockTemplateAlgorithm::GetTemplateParameters()
+{
+  Internals& internal = *this->Internal;
+  const std::string file = this->TemplateFile ? this->TemplateFile : "";
+  const vtkMTimeType fileTime = internal.TemplateStamp.changeTime();
+  if (file == internal.TableFile && fileTime == internal.TableTime &&
+    internal.RunTime.GetMTime() == internal.TableRunTime)
+  {
+    return internal.ParameterTable;
+  }
+  internal.TableFile = file;
+  internal.TableTime = fileTime;
+  internal.TableRunTime = internal.RunTime.GetMTime();
+  vtkStringArray* table = internal.ParameterTable;
+  table->Initialize();
+  if (file.empty())
+  {
+    return table;
+  }
+  try
+  {
+    for (const auto& parameter : blockforge::model::templateParameters(file))
+    {
+      table->InsertNextValue(parameter.name);
+      table->InsertNextValue(parameter.expression);
+      const auto value = this->ParameterValues.find(parameter.name);
+      std::ostringstream text;
+      if (value != this->ParameterValues.end())
+      {
+        text << std::setprecision(10) << value->second;
+      }
+      table->InsertNextValue(text.str());
+      // The comment is the description, with the unit in its last [...].
+      std::string description = parameter.comment;
+      std::string unit;
+      const std::size_t open = description.rfind('[');
+      const std::size_t close = description.rfind(']');
+      if (open != std::string::npos && close != std::string::npos && close > open)
+      {
+        unit = trimmed(description.substr(open + 1, close - open - 1));
+        description = trimmed(description.substr(0, open) + description.substr(close + 1));
+      }
+      table->InsertNextValue(unit);
+      table->InsertNextValue(description);
+    }
+  }
+  catch (const std::exception&)
+  {
+    table->Initialize(); // the run reports the error, with file and line
+  }
+  return table;
+}
 
 vtkBlockTemplateAlgorithm::~vtkBlockTemplateAlgorithm()
 {
@@ -150,6 +235,11 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
     carriers->Initialize();
   }
   this->ModelDocument.clear();
+  this->ParameterValues.clear();
+  this->Internal->RunTime.Modified();
+  // Watched for edits from now on, also when it fails (fixing the file runs it again).
+  this->Internal->TemplateStamp.remember(
+    { this->TemplateFile ? std::string(this->TemplateFile) : std::string() });
   if (!this->TemplateFile || !*this->TemplateFile)
   {
     vtkErrorMacro("No TemplateFile set: choose a BlockForge template (.yaml).");
@@ -197,6 +287,10 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
     }
     output->GetFieldData()->AddArray(notes);
     this->ModelDocument = document;
+    for (const auto& parameter : blockModel.parameters)
+    {
+      this->ParameterValues[parameter.first] = parameter.second;
+    }
   }
   catch (const std::exception& error)
   {

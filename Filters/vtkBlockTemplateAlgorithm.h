@@ -16,9 +16,11 @@
 #include "vtkMultiBlockDataSetAlgorithm.h"
 
 #include <map>
+#include <memory>
 #include <string>
 
 class vtkDataObject;
+class vtkStringArray;
 
 class BLOCKFORGEFILTERS_EXPORT vtkBlockTemplateAlgorithm : public vtkMultiBlockDataSetAlgorithm
 {
@@ -59,6 +61,23 @@ public:
   /// The model document of the last successful run ("" before or after a failure).
   const char* GetModelDocument() const { return this->ModelDocument.c_str(); }
 
+  /**
+   * The parameters the template declares, five strings per parameter: name, default
+   * expression (as written), value in the last successful run ("" before one), unit and
+   * description (from the comment on the parameter's line, `# radius [m]`). Read from
+   * TemplateFile when asked (again when the file changed); empty without a readable
+   * template. ParaView's panel lists them (information property TemplateParameters).
+   */
+  vtkStringArray* GetTemplateParameters();
+
+  /// Reads the template (and, for vtkBlockTemplate, gets the input) again at the next
+  /// update, although nothing changed: ParaView's Reload Files.
+  void Reload() { this->Modified(); }
+
+  /// Also newer when the template file was edited on disk since it was last seen, so
+  /// that an update reads the edited template.
+  vtkMTimeType GetMTime() override;
+
 protected:
   vtkBlockTemplateAlgorithm();
   ~vtkBlockTemplateAlgorithm() override;
@@ -78,6 +97,11 @@ protected:
   double MaximumMemory = 0.0;
   std::map<std::string, std::string> Parameters;
   std::string ModelDocument;
+  /// Parameter values of the last successful run.
+  std::map<std::string, double> ParameterValues;
+
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
 
 private:
   vtkBlockTemplateAlgorithm(const vtkBlockTemplateAlgorithm&) = delete;

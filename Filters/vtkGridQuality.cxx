@@ -6,6 +6,7 @@
 #include "../Model/Topology.h"
 #include "BlockForgeModelIO.h"
 #include "BlockForgeParallel.h"
+#include "BlockForgeRanges.h"
 
 #include <vtkCellData.h>
 #include <vtkCompositeDataSet.h>
@@ -42,6 +43,7 @@ namespace
 const char* const MeasureNames[6] = { "MinAngle", "MaxAngle", "NonOrthogonality", "Skewness",
   "AspectRatio", "ScaledJacobian" };
 const char* const ClassLabels[5] = { "0-20", "20-40", "40-60", "60-80", "80-90" };
+const double ClassCentres[5] = { 10.0, 30.0, 50.0, 70.0, 85.0 };
 
 } // namespace
 
@@ -196,7 +198,10 @@ int vtkGridQuality::RequestData(
       blockId->SetNumberOfTuples(cells);
       blockId->FillValue(static_cast<int>(b));
       measured->GetCellData()->AddArray(blockId);
+      blockforge::vtkglue::cacheConstantRange(blockId, static_cast<double>(b));
     }
+    // ParaView colours by the active scalars at first: the paper's criterion.
+    measured->GetCellData()->SetActiveScalars("MinAngle");
     measuredGrids.push_back(measured);
   }
   try
@@ -246,6 +251,10 @@ int vtkGridQuality::RequestData(
         maximum[m] = std::max(maximum[m], values[c]);
         sum[m] += values[c];
       }
+    }
+    for (int m = 0; m < 6; ++m)
+    {
+      blockforge::vtkglue::cacheRanges(measureArrays[b][m]);
     }
     const auto blockClasses = blockforge::minAngleClasses(
       measureArrays[b][0]->GetPointer(0), static_cast<std::size_t>(cells));
@@ -298,21 +307,29 @@ int vtkGridQuality::RequestData(
   }
   fieldData->AddArray(counts);
 
+  // The class table is made for ParaView's bar chart: "bin_extents" (the class centre
+  // angle) is the column charts take as their x axis and do not plot; the labels are
+  // strings, which charts do not plot either; so the cells are the only bars. Percentages
+  // would be invisible beside the counts: they go to the field data.
   vtkNew<vtkStringArray> labelColumn;
   labelColumn->SetName("Class");
+  vtkNew<vtkDoubleArray> centreColumn;
+  centreColumn->SetName("bin_extents");
   vtkNew<vtkIdTypeArray> cellColumn;
   cellColumn->SetName("Cells");
-  vtkNew<vtkDoubleArray> percentColumn;
-  percentColumn->SetName("Percent");
+  vtkNew<vtkDoubleArray> percent;
+  percent->SetName("MinAngleClassPercent");
   for (int c = 0; c < 5; ++c)
   {
     labelColumn->InsertNextValue(ClassLabels[c]);
+    centreColumn->InsertNextValue(ClassCentres[c]);
     cellColumn->InsertNextValue(static_cast<vtkIdType>(classCounts[c]));
-    percentColumn->InsertNextValue(cellCount > 0 ? 100.0 * classCounts[c] / cellCount : 0.0);
+    percent->InsertNextValue(cellCount > 0 ? 100.0 * classCounts[c] / cellCount : 0.0);
   }
   classTable->AddColumn(labelColumn);
   classTable->AddColumn(cellColumn);
-  classTable->AddColumn(percentColumn);
+  classTable->AddColumn(centreColumn);
+  fieldData->AddArray(percent);
 
   vtkNew<vtkStringArray> measureColumn;
   measureColumn->SetName("Measure");

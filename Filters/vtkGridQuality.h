@@ -18,7 +18,9 @@
  * MinAngleClassCounts (cells with MinAngle in [0,20), [20,40), [40,60), [60,80),
  * [80,90] degrees) and, for every measure, "<Measure>Summary" (min, mean, max).
  * Output port 1 is a table of the MinAngle classes for a bar chart (columns Class,
- * Cells, Percent); output port 2 a table of the statistics (Measure, Min, Mean, Max).
+ * Cells, bin_extents: the class centre angle, which ParaView's charts take as the x axis),
+ * and the field data MinAngleClassPercent; output port 2 a table of the statistics
+ * (Measure, Min, Mean, Max). The grid's active cell scalars are MinAngle.
  * Under MPI the class counts and statistics are global.
  *
  * Periodic faces are paired when the input carries its block model (the mesher's output

@@ -2,6 +2,7 @@
 
 #include "TurboPointSets.h"
 
+#include "BlockForgeFileStamps.h"
 #include "BlockForgeModelIO.h"
 
 #include <vtkCellArray.h>
@@ -104,7 +105,13 @@ std::string text(const char* value)
 }
 } // namespace
 
+struct vtkTurboPointSetsReader::Internals
+{
+  blockforge::vtkglue::FileStamps Stamps;
+};
+
 vtkTurboPointSetsReader::vtkTurboPointSetsReader()
+  : Internal(new Internals)
 {
   this->SetNumberOfInputPorts(0);
   this->SetAxis("Z");
@@ -126,23 +133,37 @@ int vtkTurboPointSetsReader::CanReadFile(const char* fileName)
   return fileName && blockforge::io::canReadTurboPointSets(fileName) ? 1 : 0;
 }
 
+vtkMTimeType vtkTurboPointSetsReader::GetMTime()
+{
+  return std::max(this->Superclass::GetMTime(), this->Internal->Stamps.changeTime());
+}
+
 int vtkTurboPointSetsReader::RequestInformation(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   // The curves are small: piece 0 carries them, other pieces only the block structure.
   outputVector->GetInformationObject(0)->Set(CAN_HANDLE_PIECE_REQUEST(), 1);
+  // Read once here too (the files are small) so that the values found in them are known
+  // before the first Apply; errors are reported by RequestData.
+  try
+  {
+    this->ReadSets(nullptr, false);
+  }
+  catch (const std::exception&)
+  {
+  }
   return 1;
 }
 
-int vtkTurboPointSetsReader::RequestData(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+void vtkTurboPointSetsReader::ReadSets(vtkMultiBlockDataSet* result, bool holdsData)
 {
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  auto* output = vtkMultiBlockDataSet::GetData(outInfo);
-  const int piece = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-    : 0;
-
+  this->BladeCountFound.clear();
+  this->AxisFound.clear();
+  this->UnitsFound.clear();
+  this->DescriptionFound.clear();
+  // Watched for edits from now on, also when reading fails (fixing the file reads it).
+  this->Internal->Stamps.remember({ text(this->FileName), text(this->HubFile),
+    text(this->ShroudFile), text(this->ProfileFile) });
   blockforge::io::ReadOptions options;
   options.hubFile = text(this->HubFile);
   options.shroudFile = text(this->ShroudFile);
@@ -155,75 +176,107 @@ int vtkTurboPointSetsReader::RequestData(
   if (text(this->FileName).empty() && options.hubFile.empty() && options.shroudFile.empty() &&
     options.profileFile.empty())
   {
-    vtkErrorMacro("No FileName set: choose a BladeGen .inf, an Info.txt or a point file "
-                  "(.curve, .crv, .dat, .csv).");
-    output->Initialize();
-    return 0;
+    throw std::runtime_error("No FileName set: choose a BladeGen .inf, an Info.txt or a point "
+                             "file (.curve, .crv, .dat, .csv).");
   }
 
+  const blockforge::io::TurboPointSets sets = blockforge::io::readTurboPointSets(
+    text(this->FileName), options, [this, result](double fraction) {
+      if (result)
+      {
+        this->UpdateProgress(0.8 * fraction);
+      }
+    });
+  auto fallback = [](const std::string& value)
+  { return "(not in the files: " + value + " used)"; };
+  this->BladeCountFound = sets.bladeCountFromFiles ? std::to_string(sets.bladeCount)
+                                                   : fallback(std::to_string(sets.bladeCount));
+  this->AxisFound = sets.axisFromFiles ? sets.axisName : fallback(sets.axisName);
+  this->UnitsFound = sets.unitsFromFiles ? sets.units : fallback(sets.units);
+  this->DescriptionFound = sets.descriptionFile;
+  std::vector<std::string> filesRead = { text(this->FileName), text(this->HubFile),
+    text(this->ShroudFile), text(this->ProfileFile), sets.descriptionFile, sets.hub.file,
+    sets.shroud.file };
+  for (const auto& section : sets.profiles)
+  {
+    filesRead.push_back(section.file);
+  }
+  this->Internal->Stamps.remember(filesRead);
+  if (!result)
+  {
+    return;
+  }
+  for (const auto& warning : sets.warnings)
+  {
+    vtkWarningMacro(<< blockforge::vtkglue::printable(warning.c_str()));
+  }
+
+  result->SetNumberOfBlocks(3);
+  const blockforge::io::PointSet* contours[2] = { &sets.hub, &sets.shroud };
+  const char* contourNames[2] = { "Hub", "Shroud" };
+  for (unsigned int i = 0; i < 2; ++i)
+  {
+    if (holdsData && !contours[i]->points.empty())
+    {
+      result->SetBlock(i, makeCurve(*contours[i], sets.scale));
+    }
+    result->GetMetaData(i)->Set(vtkCompositeDataSet::NAME(), contourNames[i]);
+  }
+
+  vtkNew<vtkMultiBlockDataSet> profiles;
+  const unsigned int count = static_cast<unsigned int>(sets.profiles.size());
+  profiles->SetNumberOfBlocks(count);
+  for (unsigned int k = 0; k < count; ++k)
+  {
+    const auto& section = sets.profiles[k];
+    if (holdsData)
+    {
+      vtkSmartPointer<vtkPolyData> curve = makeCurve(section, sets.scale);
+      const double fraction = section.spanPercent / 100.0;
+      addDoubles(curve->GetFieldData(), "SpanFraction", &fraction, 1);
+      addInt(curve->GetFieldData(), "SpanGiven", section.spanGiven ? 1 : 0);
+      addInt(curve->GetFieldData(), "ProfileNumber", section.number);
+      addString(curve->GetFieldData(), "Closure", closureName(section.closure, options.cap));
+      addDoubles(curve->GetFieldData(), "GapFraction", &section.gapFraction, 1);
+      if (!section.blade.empty())
+      {
+        addString(curve->GetFieldData(), "BladeName", section.blade);
+      }
+      profiles->SetBlock(k, curve);
+    }
+    profiles->GetMetaData(k)->Set(vtkCompositeDataSet::NAME(), section.name.c_str());
+    this->UpdateProgress(0.8 + 0.2 * (k + 1) / count);
+  }
+  result->SetBlock(2, profiles);
+  result->GetMetaData(2u)->Set(vtkCompositeDataSet::NAME(), "Profiles");
+
+  vtkFieldData* fields = result->GetFieldData();
+  addInt(fields, "BladeCount", sets.bladeCount);
+  addInt(fields, "BladesPerSet", sets.bladesPerSet);
+  addDoubles(fields, "Axis", sets.axis.data(), 3);
+  addString(fields, "AxisName", sets.axisName);
+  addString(fields, "Units", sets.units);
+  addDoubles(fields, "UnitScale", &sets.scale, 1);
+  if (!sets.descriptionFile.empty())
+  {
+    addString(fields, "DescriptionFile", sets.descriptionFile);
+  }
+}
+
+int vtkTurboPointSetsReader::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  auto* output = vtkMultiBlockDataSet::GetData(outInfo);
+  const int piece = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+    : 0;
   this->UpdateProgress(0.0);
   vtkNew<vtkMultiBlockDataSet> result;
   try
   {
-    const blockforge::io::TurboPointSets sets =
-      blockforge::io::readTurboPointSets(text(this->FileName), options,
-        [this](double fraction) { this->UpdateProgress(0.8 * fraction); });
-    for (const auto& warning : sets.warnings)
-    {
-      vtkWarningMacro(<< blockforge::vtkglue::printable(warning.c_str()));
-    }
-
-    const bool holdsData = piece == 0;
-    result->SetNumberOfBlocks(3);
-    const blockforge::io::PointSet* contours[2] = { &sets.hub, &sets.shroud };
-    const char* contourNames[2] = { "Hub", "Shroud" };
-    for (unsigned int i = 0; i < 2; ++i)
-    {
-      if (holdsData && !contours[i]->points.empty())
-      {
-        result->SetBlock(i, makeCurve(*contours[i], sets.scale));
-      }
-      result->GetMetaData(i)->Set(vtkCompositeDataSet::NAME(), contourNames[i]);
-    }
-
-    vtkNew<vtkMultiBlockDataSet> profiles;
-    const unsigned int count = static_cast<unsigned int>(sets.profiles.size());
-    profiles->SetNumberOfBlocks(count);
-    for (unsigned int k = 0; k < count; ++k)
-    {
-      const auto& section = sets.profiles[k];
-      if (holdsData)
-      {
-        vtkSmartPointer<vtkPolyData> curve = makeCurve(section, sets.scale);
-        const double fraction = section.spanPercent / 100.0;
-        addDoubles(curve->GetFieldData(), "SpanFraction", &fraction, 1);
-        addInt(curve->GetFieldData(), "SpanGiven", section.spanGiven ? 1 : 0);
-        addInt(curve->GetFieldData(), "ProfileNumber", section.number);
-        addString(curve->GetFieldData(), "Closure", closureName(section.closure, options.cap));
-        addDoubles(curve->GetFieldData(), "GapFraction", &section.gapFraction, 1);
-        if (!section.blade.empty())
-        {
-          addString(curve->GetFieldData(), "BladeName", section.blade);
-        }
-        profiles->SetBlock(k, curve);
-      }
-      profiles->GetMetaData(k)->Set(vtkCompositeDataSet::NAME(), section.name.c_str());
-      this->UpdateProgress(0.8 + 0.2 * (k + 1) / count);
-    }
-    result->SetBlock(2, profiles);
-    result->GetMetaData(2u)->Set(vtkCompositeDataSet::NAME(), "Profiles");
-
-    vtkFieldData* fields = result->GetFieldData();
-    addInt(fields, "BladeCount", sets.bladeCount);
-    addInt(fields, "BladesPerSet", sets.bladesPerSet);
-    addDoubles(fields, "Axis", sets.axis.data(), 3);
-    addString(fields, "AxisName", sets.axisName);
-    addString(fields, "Units", sets.units);
-    addDoubles(fields, "UnitScale", &sets.scale, 1);
-    if (!sets.descriptionFile.empty())
-    {
-      addString(fields, "DescriptionFile", sets.descriptionFile);
-    }
+    // Piece 0 holds the curves; the other pieces the same blocks with null leaves.
+    this->ReadSets(result, piece == 0);
   }
   catch (const std::exception& error)
   {

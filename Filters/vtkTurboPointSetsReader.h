@@ -59,6 +59,10 @@
 #include "BlockForgeFiltersModule.h"
 #include "vtkMultiBlockDataSetAlgorithm.h"
 
+#include <memory>
+#include <string>
+#include <vector>
+
 class BLOCKFORGEFILTERS_EXPORT vtkTurboPointSetsReader : public vtkMultiBlockDataSetAlgorithm
 {
 public:
@@ -121,6 +125,24 @@ public:
   /// that share an extension (.dat is also Tecplot's).
   int CanReadFile(const char* fileName);
 
+  ///@{
+  /**
+   * What the files said, after the last read (RequestInformation reads them too, so
+   * ParaView's panel shows them before Apply): the blade count, axis and unit as found,
+   * or "(not in the files: <fallback> used)"; the description file read ("" if none).
+   */
+  const char* GetBladeCountInFiles() const { return this->BladeCountFound.c_str(); }
+  const char* GetAxisInFiles() const { return this->AxisFound.c_str(); }
+  const char* GetUnitsInFiles() const { return this->UnitsFound.c_str(); }
+  const char* GetDescriptionFileRead() const { return this->DescriptionFound.c_str(); }
+  ///@}
+
+  /// Reads the files again at the next update although nothing changed (Reload Files).
+  void Reload() { this->Modified(); }
+
+  /// Also newer when a file read last time (or named now) was edited on disk.
+  vtkMTimeType GetMTime() override;
+
 protected:
   vtkTurboPointSetsReader();
   ~vtkTurboPointSetsReader() override;
@@ -138,6 +160,14 @@ protected:
   int TrailingEdgeCap = Straight;
 
 private:
+  /// Reads the files and notes what they said; fills `result` (if given) with the blocks,
+  /// the curves only when `holdsData`.
+  void ReadSets(vtkMultiBlockDataSet* result, bool holdsData);
+
+  std::string BladeCountFound, AxisFound, UnitsFound, DescriptionFound;
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+
   vtkTurboPointSetsReader(const vtkTurboPointSetsReader&) = delete;
   void operator=(const vtkTurboPointSetsReader&) = delete;
 };

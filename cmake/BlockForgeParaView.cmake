@@ -4,7 +4,21 @@
 # VTK's imported targets reference Python and MPI targets that only exist once found.
 find_package(Python3 REQUIRED COMPONENTS Interpreter Development.Module)
 find_package(MPI REQUIRED COMPONENTS C)
-find_package(ParaView 5.10 REQUIRED COMPONENTS RemotingClientServerStream)
+find_package(ParaView 5.10 REQUIRED COMPONENTS RemotingClientServerStream
+  OPTIONAL_COMPONENTS pqComponents)
+# Debian's paraview-dev exports link interfaces that name targets of packages it does not
+# install (Boost, HDF5, NetCDF, GLEW, libxml2, X11, Qt5 OpenGL); only linking against
+# ParaView's Qt libraries (the panel widget, Plugin/) meets them. Those are shared
+# libraries that bring their own dependencies, so empty stand-ins are enough. Defined
+# after find_package(ParaView), whose own searches for them have then failed.
+if(TARGET ParaView::pqComponents)
+  foreach(target Boost::boost GLEW::GLEW LibXml2::LibXml2 NetCDF::NetCDF Qt5::OpenGL X11::X11
+      hdf5::hdf5 hdf5::hdf5_hl)
+    if(NOT TARGET ${target})
+      add_library(${target} INTERFACE IMPORTED)
+    endif()
+  endforeach()
+endif()
 
 set(BLOCKFORGE_PYTHON_DESTINATION
   "lib/python${Python3_VERSION_MAJOR}.${Python3_VERSION_MINOR}/dist-packages"

@@ -9,7 +9,8 @@ build="${BLOCKFORGE_BUILD_DIR:-$root/build}"
 packages=(cmake g++ make pkg-config
   paraview paraview-dev python3-paraview python3-numpy libopenmpi-dev qtbase5-dev libutfcpp-dev
   libeigen3-dev libyaml-cpp-dev libmuparser-dev libgtest-dev libnlopt-cxx-dev xvfb
-  openfoam cgns-convert libcgns-dev "$@")
+  openfoam cgns-convert libcgns-dev
+  qttools5-dev qttools5-dev-tools qtxmlpatterns5-dev-tools "$@")
 missing=()
 for package in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" ||

@@ -216,9 +216,9 @@ private:
  *
  * The whole search is bounded: every curve evaluation of the meridional projections and
  * every evaluation of the distance is charged to `budget` (default: a fresh one of
- * IntersectionWorkLimit units, over 6 times what the Rotor 37 and distributor blades
- * need), and a GeometryError ends it when the budget is spent, so kinked or spiky input
- * fails in a fraction of a second.
+ * IntersectionWorkLimit units per 64 initial samples, over 6 times what the Rotor 37 and
+ * distributor blades need), and a GeometryError ends it when the budget is spent, so
+ * kinked or spiky input fails in a fraction of a second.
  */
 std::shared_ptr<SurfaceCurve> intersectWithRevolution(std::shared_ptr<const GordonSurface> surface,
   const SurfaceOfRevolution& revolution, double tMin = -0.5, double tMax = 1.5,

@@ -48,16 +48,20 @@ private:
   double Sum = 0.0, Compensation = 0.0;
 };
 
+/// Smallest cell, as a fraction of its edge: below it the nodes of a cell coincide once
+/// they are placed on the edge's coordinates (rounding), and the cell has no volume.
+constexpr double MinCellFraction = 1e-12;
+
 void requireStrictlyIncreasing(const std::vector<double>& s, const char* lawName)
 {
   for (std::size_t i = 1; i < s.size(); ++i)
   {
-    if (!(s[i] > s[i - 1]))
+    if (!(s[i] - s[i - 1] >= MinCellFraction))
     {
       throw GeometryError(std::string(lawName) + " distribution: with " +
-        std::to_string(s.size()) +
-        " nodes the smallest cells become too small to represent; reduce the expansion "
-        "ratio or the number of nodes");
+        std::to_string(s.size()) + " nodes the smallest cells become too small to " +
+        "represent (below 1e-12 of the edge); reduce the expansion ratio or the number of " +
+        "nodes");
     }
   }
 }
@@ -314,6 +318,75 @@ std::vector<double> firstCell(const DistributionLaw& law, int nodeCount, double 
 }
 } // namespace
 
+/**
+ * Cells whose logarithmic sizes run linearly from ln(first) to ln(last) across the edge
+ * plus a bump beta * 4 xi (1 - xi) that makes them fill it: cell i (xi = i / (cells - 1))
+ * has size mean * exp(A(xi)), with beta found by bisection so that the sizes add up to the
+ * edge (the sum grows with beta). The ends are then exactly first and last times the
+ * mean, and neighbour cells differ by a smooth factor. With too few cells to fill the edge
+ * that way (1 or 2, or ends too large for the count) the shape is scaled to fit instead.
+ */
+std::vector<double> endSizes(double first, double last, int nodeCount)
+{
+  if (!(first > 0.0) || !(last > 0.0) || !std::isfinite(first) || !std::isfinite(last))
+  {
+    throw GeometryError("ends distribution: the end cell sizes (relative to the mean cell) "
+                        "must be positive numbers");
+  }
+  if (first == 1.0 && last == 1.0)
+  {
+    return uniform(nodeCount); // the same nodes, bit for bit, as the uniform law
+  }
+  const int cells = nodeCount - 1;
+  auto sizes = [&](double beta) {
+    std::vector<double> h(cells);
+    for (int i = 0; i < cells; ++i)
+    {
+      const double xi = cells > 1 ? static_cast<double>(i) / (cells - 1) : 0.5;
+      h[i] = std::exp((1.0 - xi) * std::log(first) + xi * std::log(last) +
+        4.0 * beta * xi * (1.0 - xi));
+    }
+    return h;
+  };
+  auto mean = [&](const std::vector<double>& h) {
+    CompensatedSum sum;
+    for (double v : h)
+    {
+      sum.add(v);
+    }
+    return sum.value() / cells;
+  };
+  std::vector<double> h = sizes(0.0);
+  if (cells >= 3)
+  {
+    double low = -60.0, high = 60.0;
+    if (mean(sizes(low)) <= 1.0 && mean(sizes(high)) >= 1.0)
+    {
+      for (int iteration = 0; iteration < 200 && high - low > 1e-13; ++iteration)
+      {
+        const double middle = 0.5 * (low + high);
+        (mean(sizes(middle)) < 1.0 ? low : high) = middle;
+      }
+      h = sizes(0.5 * (low + high));
+    }
+  }
+  CompensatedSum total;
+  for (double v : h)
+  {
+    total.add(v);
+  }
+  std::vector<double> s(nodeCount);
+  CompensatedSum running;
+  s[0] = 0.0;
+  for (int i = 0; i < cells; ++i)
+  {
+    running.add(h[i]);
+    s[i + 1] = running.value() / total.value();
+  }
+  s[nodeCount - 1] = 1.0;
+  return s;
+}
+
 std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
   double edgeLength)
 {
@@ -332,6 +405,8 @@ std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
       return twoSided(law.expansionRatio, nodeCount);
     case DistributionLaw::Kind::FirstCell:
       return firstCell(law, nodeCount, edgeLength);
+    case DistributionLaw::Kind::Ends:
+      return endSizes(law.firstCellSize, law.lastCellSize, nodeCount);
   }
   throw GeometryError("unknown distribution law");
 }
@@ -348,6 +423,9 @@ DistributionLaw reversedLaw(const DistributionLaw& law)
     case DistributionLaw::Kind::FirstCell:
       throw GeometryError("a first-cell distribution cannot be reversed into another "
         "first-cell law; reverse its node parameters instead");
+    case DistributionLaw::Kind::Ends:
+      std::swap(reversed.firstCellSize, reversed.lastCellSize);
+      return reversed;
     default:
       return reversed; // Uniform and TwoSided are symmetric
   }

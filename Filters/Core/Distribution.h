@@ -20,7 +20,8 @@ struct DistributionLaw
     Uniform,   ///< equal cells
     Geometric, ///< paper eq. 7: each cell is ExpansionRatio times the previous one
     TwoSided,  ///< cells grow by ExpansionRatio from both ends towards the middle
-    FirstCell  ///< first cell of FirstCellSize, growing by at most ExpansionRatio
+    FirstCell, ///< first cell of FirstCellSize, growing by at most ExpansionRatio
+    Ends       ///< first and last cells FirstCellSize and LastCellSize times the mean cell
   };
   Kind kind = Kind::Uniform;
   /// Geometric/TwoSided: ratio of successive cell sizes (k in eq. 7, > 0).
@@ -29,12 +30,17 @@ struct DistributionLaw
   /// FirstCell means "solve the ratio so that all cells grow geometrically".
   double expansionRatio = 1.0;
   /// FirstCell: size of the first cell in length units of the edge (> 0).
+  /// Ends: size of the first cell over the mean cell (edge length / cells, > 0).
   double firstCellSize = 0.0;
+  /// Ends: size of the last cell over the mean cell (> 0). Relative sizes do not change
+  /// with the cell count, so a refined grid keeps the shape: neighbour blocks whose end
+  /// cells match at one density match at all.
+  double lastCellSize = 0.0;
 
   bool operator==(const DistributionLaw& o) const
   {
     return kind == o.kind && expansionRatio == o.expansionRatio &&
-      firstCellSize == o.firstCellSize;
+      firstCellSize == o.firstCellSize && lastCellSize == o.lastCellSize;
   }
   bool operator!=(const DistributionLaw& o) const { return !(*this == o); }
 };
@@ -43,12 +49,13 @@ struct DistributionLaw
  * Relative node positions s_0 = 0 < s_1 < ... < s_(n-1) = 1 for `nodeCount` nodes
  * (>= 2) on an edge of length `edgeLength` (used only by FirstCell). Throws
  * GeometryError when the law cannot be met (non-positive ratio, first cell too large
- * or too small for the edge with the given ratio), the message says why in user terms.
+ * or too small for the edge with the given ratio, a cell below 1e-12 of the edge, whose
+ * nodes would coincide once placed), the message says why in user terms.
  */
 std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
   double edgeLength = 1.0);
 
-/// The law seen from the other end of the edge (Geometric k -> 1/k). FirstCell cannot be
+/// The law seen from the other end of the edge (Geometric k -> 1/k, Ends swapped). FirstCell cannot be
 /// reversed into a law of the same kind; callers reverse its node parameters instead.
 DistributionLaw reversedLaw(const DistributionLaw& law);
 } // namespace blockforge

@@ -1,60 +1,35 @@
 /**
  * @file LargeAllocator.h
- * @brief An allocator for the large arrays of a grid (tens to hundreds of MB): blocks of
- * 2 MiB or more are 2 MiB aligned and marked for transparent huge pages, so filling them
- * costs a page fault per 2 MiB instead of per 4 kiB. On virtual machines the faults, not
- * the arithmetic, dominate building a million-cell polyMesh (about 2.5x faster with them).
- * Elements are default-initialized (no zero fill): every user writes before reading.
+ * @brief An allocator for the large arrays of a grid (tens to hundreds of MB) that leaves
+ * new elements default-initialized: resize() does not zero-fill memory that is written
+ * right after (the mesher's node arrays, point numbers). On virtual machines touching
+ * memory costs more than the arithmetic, so each array is touched once, by its writer.
+ * (Transparent huge pages were tried: their zeroing made a run after another large writer
+ * slower, not faster.)
  */
 #pragma once
 
-#include <cstddef>
-#include <cstdlib>
-#include <new>
+#include <memory>
+#include <utility>
 #include <vector>
-
-#include <sys/mman.h>
 
 namespace blockforge
 {
 namespace exporting
 {
 template <typename T>
-struct LargeAllocator
+struct LargeAllocator : std::allocator<T>
 {
   using value_type = T;
+  template <typename U>
+  struct rebind
+  {
+    using other = LargeAllocator<U>;
+  };
   LargeAllocator() noexcept = default;
   template <typename U>
   LargeAllocator(const LargeAllocator<U>&) noexcept
   {
-  }
-
-  static constexpr std::size_t HugePage = std::size_t(2) << 20;
-
-  T* allocate(std::size_t count)
-  {
-    const std::size_t bytes = count * sizeof(T);
-    if (bytes < HugePage)
-    {
-      return static_cast<T*>(::operator new(bytes));
-    }
-    const std::size_t rounded = (bytes + HugePage - 1) / HugePage * HugePage;
-    void* memory = std::aligned_alloc(HugePage, rounded);
-    if (!memory)
-    {
-      throw std::bad_alloc();
-    }
-    ::madvise(memory, rounded, MADV_HUGEPAGE); // a hint: ignored where unsupported
-    return static_cast<T*>(memory);
-  }
-  void deallocate(T* pointer, std::size_t count) noexcept
-  {
-    if (count * sizeof(T) < HugePage)
-    {
-      ::operator delete(pointer);
-      return;
-    }
-    std::free(pointer);
   }
   /// Default-initialize: resize() leaves the values to be written.
   template <typename U>
@@ -66,16 +41,6 @@ struct LargeAllocator
   void construct(U* pointer, Args&&... args)
   {
     ::new (static_cast<void*>(pointer)) U(std::forward<Args>(args)...);
-  }
-  template <typename U>
-  bool operator==(const LargeAllocator<U>&) const noexcept
-  {
-    return true;
-  }
-  template <typename U>
-  bool operator!=(const LargeAllocator<U>&) const noexcept
-  {
-    return false;
   }
 };
 

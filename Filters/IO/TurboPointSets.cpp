@@ -1219,7 +1219,10 @@ TurboPointSets readTurboPointSets(
         "' is not one (expected X, Y, Z or three numbers)");
   }
 
+  sets.bladeCountFromFiles = bladeCountKnown;
+  sets.axisFromFiles = axisEntry != nullptr;
   const Entry* unitEntry = description ? findEntry(*description, unitKeys()) : nullptr;
+  sets.unitsFromFiles = unitEntry != nullptr;
   if (unitEntry)
   {
     // "cm" or "cm (centimetres)": the whole value, else its first word.

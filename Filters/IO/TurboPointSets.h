@@ -126,6 +126,8 @@ struct TurboPointSets
   std::string axisName = "Z";            ///< "X", "-Y", ... or "(ax, ay, az)"
   std::string units = "M";               ///< canonical unit of the files: M, CM, MM, IN, FT
   double scale = 1.0;                    ///< metres per file unit
+  /// Whether the files gave the blade count, axis and unit (false: ReadOptions' value).
+  bool bladeCountFromFiles = false, axisFromFiles = false, unitsFromFiles = false;
 
   /// The file given to readTurboPointSets and the description file used (.inf or
   /// Info.txt, empty if none), for provenance.

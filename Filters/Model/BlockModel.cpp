@@ -1,5 +1,7 @@
 #include "BlockModel.h"
 
+#include <algorithm>
+
 namespace blockforge
 {
 namespace model
@@ -117,6 +119,32 @@ const std::array<int, 4> FaceEdgeTable[6] = { { 3, 7, 8, 11 }, { 1, 5, 9, 10 },
   { 0, 4, 8, 9 }, { 2, 6, 11, 10 }, { 0, 2, 3, 1 }, { 4, 6, 7, 5 } };
 const std::array<int, 2> FaceDirectionTable[6] = { { 1, 2 }, { 1, 2 }, { 0, 2 }, { 0, 2 },
   { 0, 1 }, { 0, 1 } };
+}
+
+const std::vector<std::string>& edgeKindNames()
+{
+  static const std::vector<std::string> names = { "line", "arc", "spline", "on_curve",
+    "on_surface", "project", "periodic", "follow" };
+  return names;
+}
+
+bool edgeKindFromName(const std::string& name, Edge::Kind& kind)
+{
+  const std::vector<std::string>& names = edgeKindNames();
+  const auto found = std::find(names.begin(), names.end(), name);
+  if (found == names.end())
+  {
+    return false;
+  }
+  kind = static_cast<Edge::Kind>(found - names.begin());
+  return true;
+}
+
+const std::vector<std::string>& carrierEdgeKindNames()
+{
+  static const std::vector<std::string> names(
+    edgeKindNames().begin() + static_cast<int>(Edge::Kind::OnCurve), edgeKindNames().end());
+  return names;
 }
 
 VertexRule impliedRule(const VertexConstraint& constraint)

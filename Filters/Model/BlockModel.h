@@ -192,6 +192,13 @@ struct Edge
   SourceLocation where;
 };
 
+/// The names of the edge kinds in templates and model documents, in Edge::Kind order.
+const std::vector<std::string>& edgeKindNames();
+/// The edge kind named `name` (edgeKindNames()); false when there is none.
+bool edgeKindFromName(const std::string& name, Edge::Kind& kind);
+/// The kinds a format-2 template gives as an edge's key (on_curve .. follow).
+const std::vector<std::string>& carrierEdgeKindNames();
+
 /// A hexahedral subvolume, possibly degenerate (repeated vertices: wedges, prisms).
 struct Block
 {

@@ -1,6 +1,7 @@
 #include "MeshInternals.h"
 
 #include "../Core/Carriers.h"
+#include "../Core/Parallel.h"
 #include "../Core/Projection.h"
 #include "../Core/Transfinite.h"
 
@@ -599,10 +600,16 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
     for (int a = 1; a + 1 < na; ++a)
     {
       const std::size_t i = static_cast<std::size_t>(b) * na + a;
-      double s = parameters[3 * i], t = parameters[3 * i + 1];
-      closestNear(geometry, carrier, Vec3(targets[3 * i], targets[3 * i + 1], targets[3 * i + 2]),
-        s, t);
-      const Vec3 p = geometry.point(carrier, s, t);
+      const double s0 = parameters[3 * i], t0 = parameters[3 * i + 1];
+      const Vec3 target(targets[3 * i], targets[3 * i + 1], targets[3 * i + 2]);
+      double s = s0, t = t0;
+      closestNear(geometry, carrier, target, s, t);
+      Vec3 p = geometry.point(carrier, s, t);
+      const Vec3 p0 = geometry.point(carrier, s0, t0);
+      if (!((p - target).norm() <= (p0 - target).norm()))
+      {
+        p = p0; // no better than the (s, t) node: keep that
+      }
       std::copy_n(p.data(), 3, &out[3 * i]);
     }
   }
@@ -716,13 +723,15 @@ void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geomet
     isImage[entry.image] = true;
   }
   const std::map<int, int> onSurface = surfaceFaceCarriers(model, topology);
-  for (std::size_t f = 0; f < topology.faces.size(); ++f)
-  {
+  // Faces are computed from their edges alone, each into its own grid: on threads when a
+  // runner is installed (Core/Parallel.h), with the same bits, and the error of the first
+  // failing face in face order.
+  forEachChunk(static_cast<long>(topology.faces.size()), [&](long f) {
     if (!isImage[f])
     {
       computeFaceGrid(model, geometry, onSurface, topology, static_cast<int>(f));
     }
-  }
+  });
   for (const PeriodicPair& entry : images)
   {
     periodicFace(model, topology, entry, topology.faces[entry.image].xyz);

@@ -446,9 +446,7 @@ private:
     }
     else if (kindName == "on_curve" || kindName == "on_surface" || kindName == "project")
     {
-      edge.kind = kindName == "on_curve" ? Edge::Kind::OnCurve
-        : kindName == "on_surface"       ? Edge::Kind::OnSurface
-                                         : Edge::Kind::Project;
+      edgeKindFromName(kindName, edge.kind);
       const MapEntry& carrier = required(keys, "carrier", node, entityText);
       edge.carrier = carrierRef(carrier.value, carrier.line, entityText);
       if (const MapEntry* at = syntax::findEntry(keys, "at"))
@@ -465,7 +463,7 @@ private:
     }
     else if (kindName == "periodic" || kindName == "follow")
     {
-      edge.kind = kindName == "periodic" ? Edge::Kind::Periodic : Edge::Kind::Follow;
+      edgeKindFromName(kindName, edge.kind);
       const MapEntry& source = required(keys, "source", node, entityText);
       const std::string sourceName = text(source.value, source.line, entityText, "source");
       for (std::size_t e = 0; e < Model.edges.size(); ++e)
@@ -488,8 +486,7 @@ private:
     else
     {
       fail(kind.line, entityText,
-        "unknown edge kind '" + kindName +
-          "' (line, arc, spline, on_curve, on_surface, project, periodic, follow)");
+        "unknown edge kind '" + kindName + "' (" + syntax::joinNames(edgeKindNames()) + ")");
     }
     Model.edges.push_back(edge);
   }
@@ -1007,9 +1004,7 @@ std::string writeModelDocument(const BlockModel& model)
     const std::string user = entity("edge", edge.name);
     out << YAML::Flow << YAML::BeginMap;
     out << YAML::Key << "name" << YAML::Value << edge.name;
-    static const char* const edgeKinds[] = { "line", "arc", "spline", "on_curve", "on_surface",
-      "project", "periodic", "follow" };
-    out << YAML::Key << "kind" << YAML::Value << edgeKinds[static_cast<int>(edge.kind)];
+    out << YAML::Key << "kind" << YAML::Value << edgeKindNames()[static_cast<int>(edge.kind)];
     out << YAML::Key << "from" << YAML::Value << vertexName(model, edge.from, user);
     out << YAML::Key << "to" << YAML::Value << vertexName(model, edge.to, user);
     if (edge.kind == Edge::Kind::Arc)

@@ -264,7 +264,8 @@ std::string shortNumber(double value)
 namespace
 {
 const char* const LawSyntax =
-  "uniform, {geometric: k}, {two_sided: k} or {first_cell: h, ratio: r}";
+  "uniform, {geometric: k}, {two_sided: k}, {first_cell: h, ratio: r} or "
+  "{ends: [a, b]}";
 }
 
 DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entityText,
@@ -286,7 +287,28 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
     reporter.fail(here, entityText, what + ": expected " + LawSyntax);
   }
   const std::vector<MapEntry> entries = mapEntries(node, here, entityText, what, reporter);
-  checkKeys(entries, { "geometric", "two_sided", "first_cell", "ratio" }, entityText, reporter);
+  checkKeys(
+    entries, { "geometric", "two_sided", "first_cell", "ratio", "ends" }, entityText, reporter);
+  if (const MapEntry* ends = findEntry(entries, "ends"))
+  {
+    if (entries.size() != 1 || !ends->value.IsSequence() || ends->value.size() != 2)
+    {
+      reporter.fail(ends->line, entityText,
+        what + ": expected {ends: [a, b]}: the first and last cells a and b times the mean "
+               "cell of the edge");
+    }
+    law.kind = DistributionLaw::Kind::Ends;
+    law.firstCellSize = number(ends->value[0], ends->line, what + " ends a");
+    law.lastCellSize = number(ends->value[1], ends->line, what + " ends b");
+    if (!(law.firstCellSize > 0.0) || !(law.lastCellSize > 0.0) ||
+      !std::isfinite(law.firstCellSize) || !std::isfinite(law.lastCellSize))
+    {
+      reporter.fail(ends->line, entityText,
+        what + ": the end cell sizes must be positive, got " +
+          formatNumber(law.firstCellSize) + " and " + formatNumber(law.lastCellSize));
+    }
+    return law;
+  }
   const MapEntry* geometric = findEntry(entries, "geometric");
   const MapEntry* twoSided = findEntry(entries, "two_sided");
   const MapEntry* firstCell = findEntry(entries, "first_cell");
@@ -351,6 +373,11 @@ void emitLaw(YAML::Emitter& out, const DistributionLaw& law)
         out << YAML::Key << "ratio" << YAML::Value << formatNumber(law.expansionRatio);
       }
       out << YAML::EndMap;
+      return;
+    case DistributionLaw::Kind::Ends:
+      out << YAML::Flow << YAML::BeginMap << YAML::Key << "ends" << YAML::Value
+          << YAML::Flow << YAML::BeginSeq << formatNumber(law.firstCellSize)
+          << formatNumber(law.lastCellSize) << YAML::EndSeq << YAML::EndMap;
       return;
   }
 }

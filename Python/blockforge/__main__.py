@@ -68,7 +68,7 @@ def summary_lines(quality):
     for row in range(classes.GetNumberOfRows()):
         label = classes.GetValue(row, 0).ToString()
         count = classes.GetValue(row, 1).ToInt()
-        percent = classes.GetValue(row, 2).ToDouble()
+        percent = 100.0 * count / cells if cells else 0.0
         lines.append(f"  {label:>8}              {count:8d}   {percent:6.2f}")
     lines.extend(optimizer_lines(quality))
     lines.append("measure                 min        mean         max")

@@ -294,3 +294,55 @@ TEST(Distribution, ImpossibleLawsThrow)
     EXPECT_NE(message.find("edge length"), std::string::npos) << message;
   }
 }
+
+TEST(Distribution, EndsGiveTheEndCellsRelativeToTheMeanAtEveryCount)
+{
+  DistributionLaw ends;
+  ends.kind = DistributionLaw::Kind::Ends;
+  ends.firstCellSize = 0.1;
+  ends.lastCellSize = 0.4;
+  for (int cells : { 4, 8, 16, 64 })
+  {
+    const std::vector<double> s = distributeNodes(ends, cells + 1);
+    ASSERT_EQ(s.size(), static_cast<std::size_t>(cells + 1));
+    EXPECT_EQ(s.front(), 0.0);
+    EXPECT_EQ(s.back(), 1.0);
+    // first and last cells 0.1 and 0.4 times the mean cell 1 / cells, whatever the count
+    EXPECT_NEAR((s[1] - s[0]) * cells, 0.1, 1e-9) << cells;
+    EXPECT_NEAR((s[cells] - s[cells - 1]) * cells, 0.4, 1e-9) << cells;
+    double worst = 1.0;
+    for (int i = 1; i < cells; ++i)
+    {
+      ASSERT_GT(s[i + 1], s[i]);
+      const double ratio = (s[i + 1] - s[i]) / (s[i] - s[i - 1]);
+      worst = std::max({ worst, ratio, 1.0 / ratio });
+    }
+    // smooth once there are enough cells to grow from 0.1 to the middle and back
+    if (cells >= 64)
+    {
+      EXPECT_LT(worst, 1.2) << cells;
+    }
+  }
+  // Reversed: the ends swap, the nodes mirror.
+  const DistributionLaw back = reversedLaw(ends);
+  EXPECT_EQ(back.firstCellSize, 0.4);
+  EXPECT_EQ(back.lastCellSize, 0.1);
+  const std::vector<double> s = distributeNodes(ends, 11), r = distributeNodes(back, 11);
+  for (int i = 0; i <= 10; ++i)
+  {
+    EXPECT_NEAR(r[i], 1.0 - s[10 - i], 1e-14);
+  }
+  // [1, 1] is uniform; too few cells keep the ratio of the ends.
+  ends.firstCellSize = ends.lastCellSize = 1.0;
+  const std::vector<double> u = distributeNodes(ends, 9);
+  for (int i = 0; i <= 8; ++i)
+  {
+    EXPECT_NEAR(u[i], i / 8.0, 1e-13);
+  }
+  ends.firstCellSize = 1.0;
+  ends.lastCellSize = 3.0;
+  const std::vector<double> two = distributeNodes(ends, 3);
+  EXPECT_NEAR(two[1], 0.25, 1e-15);
+  ends.firstCellSize = 0.0;
+  EXPECT_THROW(distributeNodes(ends, 5), GeometryError);
+}

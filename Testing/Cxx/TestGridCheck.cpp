@@ -53,3 +53,23 @@ TEST(GridCheck, ExampleTemplatesPassAtSeveralDensities)
     }
   }
 }
+
+// A density multiplier refines a graded block without changing its shape: the geometric
+// law's overall expansion (last over first cell) stays, so the first cell is the template's
+// divided by the multiplier (not by k^(n' - n) more).
+TEST(GridCheck, DensityKeepsTheOverallExpansionOfGradedLaws)
+{
+  const model::BlockModel model =
+    model::loadTemplate(templatePath("cylinder_in_box.yaml"), { { "n_radial", "8" } });
+  const Grid coarse = meshAll(model, 1.0), fine = meshAll(model, 4.0);
+  // block 0, the j line at i = 0, k = 0: from the cylinder wall outwards
+  auto sizes = [](const Grid& grid) {
+    const int n = grid.nodes[0][1];
+    return std::make_pair((grid.at(0, 0, 1, 0) - grid.at(0, 0, 0, 0)).norm(),
+      (grid.at(0, 0, n - 1, 0) - grid.at(0, 0, n - 2, 0)).norm());
+  };
+  const auto [firstCoarse, lastCoarse] = sizes(coarse);
+  const auto [firstFine, lastFine] = sizes(fine);
+  EXPECT_NEAR(lastCoarse / firstCoarse, lastFine / firstFine, 0.02 * lastCoarse / firstCoarse);
+  EXPECT_NEAR(firstFine / firstCoarse, 0.25, 0.05);
+}

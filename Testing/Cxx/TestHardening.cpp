@@ -2,6 +2,7 @@
 // densities instead of clamps or aborts, bounded work in the iterative geometry, and the
 // template reader's small cases (lone CR, folders, endless files, second YAML documents,
 // blade counts).
+#include "Distribution.h"
 #include "MemoryBudget.h"
 #include "PrintableText.h"
 #include "TestHelpers.h"
@@ -138,6 +139,20 @@ TEST(MemoryBudget, HugeTemplateBlockIsRefusedBeforeAllocating)
     message([&] { model::checkGridMemory(nodes, 0.0, "lower the cell counts"); });
   EXPECT_NE(refused.find("the grid would need 51 TB for 2e+12 nodes"), std::string::npos)
     << refused;
+}
+
+TEST(MemoryBudget, ExtremeGradingIsAnErrorNotCollapsedCells)
+{
+  // the fuzzer's case: a growth ratio of 2147483647 over 12 cells made cells of no volume
+  DistributionLaw law;
+  law.kind = DistributionLaw::Kind::Geometric;
+  law.expansionRatio = 2147483647.0;
+  const std::string text = message([&] { distributeNodes(law, 13); });
+  EXPECT_NE(text.find("below 1e-12 of the edge"), std::string::npos) << text;
+  // a strong but representable grading: smallest cell 1e-9 of the largest
+  law.expansionRatio = 0.1;
+  const std::vector<double> s = distributeNodes(law, 10);
+  EXPECT_NEAR((s[9] - s[8]) / (s[1] - s[0]), 1e-8, 1e-15); // rounding of the small cell
 }
 
 // --- bounded iterative geometry ---------------------------------------------------------------

@@ -16,6 +16,7 @@
 
 #include <Eigen/Geometry>
 #include "TestHelpers.h"
+#include "TestPassageGeometry.h"
 #include "TestTurboInputs.h"
 
 #include <gtest/gtest.h>
@@ -58,76 +59,8 @@ using test::Grid;
 using test::meshAll;
 using test::readTemplateInputs;
 
-/// The nodes of one block face (0..5 = i0 i1 j0 j1 k0 k1).
-std::vector<Vec3> faceNodes(const Grid& grid, const BlockFace& face)
-{
-  const auto& n = grid.nodes[face.block];
-  std::vector<Vec3> result;
-  const int axis = face.face / 2;
-  const int fixed = face.face % 2 == 0 ? 0 : n[axis] - 1;
-  const int a = axis == 0 ? 1 : 0, b = axis == 2 ? 1 : 2;
-  for (int v = 0; v < n[b]; ++v)
-  {
-    for (int u = 0; u < n[a]; ++u)
-    {
-      std::array<int, 3> ijk{};
-      ijk[axis] = fixed;
-      ijk[a] = u;
-      ijk[b] = v;
-      result.push_back(grid.at(face.block, ijk[0], ijk[1], ijk[2]));
-    }
-  }
-  return result;
-}
-
-double tetVolume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
-{
-  return (b - a).dot((c - a).cross(d - a)) / 6.0;
-}
-
-/// Volume of a hexahedron (VTK order) with possibly warped faces: every face is split
-/// into four triangles about its centre, each joined to the cell centre.
-double hexVolume(const std::array<Vec3, 8>& p)
-{
-  static const int faces[6][4] = { { 0, 3, 2, 1 }, { 4, 5, 6, 7 }, { 0, 1, 5, 4 }, { 1, 2, 6, 5 },
-    { 2, 3, 7, 6 }, { 3, 0, 4, 7 } };
-  Vec3 centre = Vec3::Zero();
-  for (const Vec3& q : p)
-  {
-    centre += q / 8.0;
-  }
-  double volume = 0.0;
-  for (const auto& f : faces)
-  {
-    const Vec3 fc = (p[f[0]] + p[f[1]] + p[f[2]] + p[f[3]]) / 4.0;
-    for (int e = 0; e < 4; ++e)
-    {
-      // faces listed with outward normals by the right-hand rule
-      volume += tetVolume(centre, fc, p[f[e]], p[f[(e + 1) % 4]]);
-    }
-  }
-  return volume;
-}
-
-double gridVolume(const Grid& grid)
-{
-  double total = 0.0;
-  for (std::size_t b = 0; b < grid.nodes.size(); ++b)
-  {
-    const auto& n = grid.nodes[b];
-    const int B = static_cast<int>(b);
-    for (int k = 0; k + 1 < n[2]; ++k)
-      for (int j = 0; j + 1 < n[1]; ++j)
-        for (int i = 0; i + 1 < n[0]; ++i)
-        {
-          total += hexVolume({ grid.at(B, i, j, k), grid.at(B, i + 1, j, k),
-            grid.at(B, i + 1, j + 1, k), grid.at(B, i, j + 1, k), grid.at(B, i, j, k + 1),
-            grid.at(B, i + 1, j, k + 1), grid.at(B, i + 1, j + 1, k + 1),
-            grid.at(B, i, j + 1, k + 1) });
-        }
-  }
-  return total;
-}
+using test::faceNodes;
+using test::gridVolume;
 
 /// Radius of a meridional contour (z increasing) at z, linear between its points.
 double contourRadius(const std::vector<Vec3>& contour, double z)
@@ -480,4 +413,37 @@ TEST(PassageTemplates, AnyPlaceAroundTheAxis)
       }
     }
   }
+}
+
+// Short hub and shroud contours (the turbine row's end 10 % of a chord from the blade):
+// the inlet and outlet go where the contours start and end, and the template says so;
+// with `extend` the contours continue along their end tangents and the planes are where
+// asked.
+TEST(PassageTemplates, ShortContoursInletAndOutletAtTheirEndsOrExtended)
+{
+  const TemplateInputs inputs =
+    readTemplateInputs(std::string(BLOCKFORGE_SOURCE_DIR) + "/Data/turbine/Info.txt");
+  for (const std::string name : { "axial_passage_h", "axial_passage_oh" })
+  {
+    SCOPED_TRACE(name);
+    const BlockModel model = loadTemplate(templatePath(name), {}, &inputs);
+    ASSERT_EQ(model.notes.size(), 2u);
+    EXPECT_NE(model.notes[0].find("the inlet is where the hub and shroud contours start"),
+      std::string::npos)
+      << model.notes[0];
+    EXPECT_NE(model.notes[1].find("the outlet is where the hub and shroud contours end"),
+      std::string::npos)
+      << model.notes[1];
+    // the inlet plane is a hair inside the contours' start (axis X, contours from
+    // x = -0.0195219 m)
+    const double inlet = model.vertices[model.findVertex("lo_in_h")].position.x();
+    EXPECT_NEAR(inlet, -0.0195219, 1e-6);
+    const BlockModel extended = loadTemplate(templatePath(name), { { "extend", "1" } }, &inputs);
+    EXPECT_TRUE(extended.notes.empty());
+    EXPECT_LT(extended.vertices[extended.findVertex("lo_in_h")].position.x(), -0.025);
+    EXPECT_FALSE(test::meshAll(extended, 0.5).xyz.empty());
+  }
+  // Long contours: nothing to say.
+  const TemplateInputs rotor = readTemplateInputs(dataSets()[0].inf);
+  EXPECT_TRUE(loadTemplate(templatePath("axial_passage_oh"), {}, &rotor).notes.empty());
 }

@@ -147,7 +147,11 @@ class GridQualityTest(unittest.TestCase):
         self.assertEqual(table.GetNumberOfRows(), 5)
         self.assertEqual([table.GetValue(r, 0).ToString() for r in range(5)],
                          list(blockforge.MIN_ANGLE_CLASSES))
-        self.assertAlmostEqual(sum(table.GetValue(r, 2).ToDouble() for r in range(5)), 100.0)
+        self.assertEqual(sum(table.GetValue(r, 1).ToInt() for r in range(5)), total)
+        self.assertEqual([table.GetValue(r, 2).ToDouble() for r in range(5)],
+                         [10.0, 30.0, 50.0, 70.0, 85.0])
+        percent = grid.GetFieldData().GetArray("MinAngleClassPercent")
+        self.assertAlmostEqual(sum(percent.GetValue(i) for i in range(5)), 100.0)
         statistics = quality.GetOutputDataObject(2)
         self.assertEqual(statistics.GetNumberOfRows(), 6)
         summary = grid.GetFieldData().GetArray("ScaledJacobianSummary")

@@ -33,7 +33,9 @@ CASES = [("cylinder_in_box", "cylinder_in_box", None),
          ("wedge_sector", "wedge_sector", None)] + [
     (f"{name}_{machine}", name, inf)
     for name in ("axial_passage_h", "axial_passage_oh")
-    for machine, inf in (("distributor", DISTRIBUTOR_INF), ("rotor37", ROTOR37_INF))]
+    for machine, inf in (("distributor", DISTRIBUTOR_INF), ("rotor37", ROTOR37_INF),
+                         ("compressor", os.path.join(SOURCE, "Data", "compressor", "rotor.inf")),
+                         ("turbine", os.path.join(SOURCE, "Data", "turbine", "Info.txt")))]
 
 # Checks that -allGeometry -allTopology may fail, and why (the grid, not the writer).
 ALLOWED_FAILURES = {
@@ -44,6 +46,12 @@ ALLOWED_FAILURES = {
     # length along the blade jumps (uniform spacing in each block): low interpolation weights.
     "axial_passage_oh_distributor": {"determinant", "interpolation weight"},
     "axial_passage_oh_rotor37": {"determinant", "interpolation weight"},
+    "axial_passage_oh_turbine": {"determinant", "interpolation weight"},
+    # The same on the transonic compressor, whose sharp leading edge also leaves concave
+    # cells and cell volumes jumping by more than 100 between neighbours at the O-grid's
+    # corners (the template's grid, reported; every cell is valid: Mesh OK).
+    "axial_passage_oh_compressor": {"determinant", "interpolation weight", "concave",
+                                    "volume ratio"},
 }
 
 
@@ -118,6 +126,10 @@ class CheckMeshTest(unittest.TestCase):
                         kinds.add("determinant")
                     elif "interpolation weight" in line:
                         kinds.add("interpolation weight")
+                    elif "Concave cells" in line:
+                        kinds.add("concave")
+                    elif "small volume ratio" in line:
+                        kinds.add("volume ratio")
                     else:
                         kinds.add(line)
                 self.assertLessEqual(kinds, ALLOWED_FAILURES.get(name, set()), failed)
