@@ -1,9 +1,8 @@
 """Client-server mode: pvpython connects to a pvserver on localhost (2 MPI ranks), loads
 the plugin on the server, runs reader -> BlockTemplate -> BlockOptimizer -> BlockMesher ->
-GridQuality there
-and fetches the result: every array of every cell equals the serial run in this process,
-the class table arrives, and errors come back to the client with the template's file and
-line. The first look is Surface With Edges coloured by block (not Outline).
+GridQuality there and fetches the result: every array of every cell equals the serial run
+in this process, the class table arrives, and errors come back to the client with the
+template's file and line. The first look is Surface With Edges coloured by block (not Outline).
 
 Run by pvpython; starts `mpiexec -n 2 pvserver` itself and stops it at the end.
 """
