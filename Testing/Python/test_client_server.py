@@ -1,8 +1,8 @@
 """Client-server mode: pvpython connects to a pvserver on localhost (2 MPI ranks), loads
-the plugin on the server, runs reader -> BlockTemplate -> BlockOptimizer -> BlockMesher -> GridQuality there
-and fetches the result: every array of every cell equals the serial run in this process,
-the class table arrives, and errors come back to the client with the template's file and
-line. The first look is Surface With Edges coloured by block (not Outline).
+the plugin on the server, runs reader -> BlockTemplate -> BlockOptimizer -> BlockMesher ->
+GridQuality there and fetches the result: every array of every cell equals the serial run
+in this process, the class table arrives, and errors come back to the client with the
+template's file and line. The first look is Surface With Edges coloured by block (not Outline).
 
 Run by pvpython; starts `mpiexec -n 2 pvserver` itself and stops it at the end.
 """
@@ -74,16 +74,13 @@ class ClientServer(unittest.TestCase):
     def test_pipeline_on_server_equals_serial(self):
         reader = TurboPointSetsReader(FileName=bftest.DISTRIBUTOR_INF)  # noqa: F821
         model = BlockTemplate(Input=reader, TemplateFile=TEMPLATE)  # noqa: F821
-        # The optimizer runs on the server too, as in the serial run (mesh_template
-        # optimizes by default): both must give the same grid.
-        model = BlockOptimizer(Input=model)  # noqa: F821
-        grid = BlockMesher(Input=model)  # noqa: F821
+        # The serial run (mesh_template) optimizes by default: so does the server.
+        optimized = BlockOptimizer(Input=model)  # noqa: F821
+        grid = BlockMesher(Input=optimized)  # noqa: F821
         quality = GridQuality(Input=grid)  # noqa: F821
         quality.UpdatePipeline()
         fetched = servermanager.Fetch(quality)
-        # the server pipeline does not optimize; neither may the serial reference
-        serial = blockforge.mesh_template(TEMPLATE, input_file=bftest.DISTRIBUTOR_INF,
-                                          optimize=False)
+        serial = blockforge.mesh_template(TEMPLATE, input_file=bftest.DISTRIBUTOR_INF)
         reference = dict(bftest.named_leaves(serial.GetOutputDataObject(0)))
         blocks = dict(bftest.named_leaves(fetched))
         self.assertEqual(sorted(blocks), sorted(reference))
@@ -98,7 +95,7 @@ class ClientServer(unittest.TestCase):
         classes = servermanager.Fetch(quality, idx=1)
         self.assertEqual(classes.GetNumberOfRows(), 5)
         self.assertEqual(sum(classes.GetValue(r, 1).ToInt() for r in range(5)), 9600)
-        for proxy in (quality, grid, model, reader):
+        for proxy in (quality, grid, optimized, model, reader):
             simple.Delete(proxy)
 
     def test_error_reaches_the_client(self):
