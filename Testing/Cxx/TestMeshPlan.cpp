@@ -125,7 +125,7 @@ TEST(Placement, ProjectedVertexFollowsItsSource)
   const CarrierGeometry& carriers = rotor37Passage().carriers;
   const int oa = vertexIndex(model, "oa_f_h"), a = vertexIndex(model, "a_f_h");
   const Vec3 before = model.vertices[a].position;
-  const FreeParameter& s = sParameter(freeParameters(model, carriers), oa);
+  const FreeParameter s = sParameter(freeParameters(model, carriers), oa);
   const std::vector<int> moved = moveParameter(model, carriers, s, model.vertices[oa].constraint.s + 0.01);
   EXPECT_EQ(moved.front(), oa);
   EXPECT_NE(std::find(moved.begin(), moved.end(), a), moved.end());
