@@ -18,6 +18,7 @@
 #include <vtkNew.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStringArray.h>
 
 #include <cmath>
@@ -173,6 +174,20 @@ void attachModel(vtkFieldData* fieldData, const std::string& document)
   array->SetValue(0, document);
   fieldData->RemoveArray(model::ModelDocumentArrayName);
   fieldData->AddArray(array);
+}
+
+RequestedPiece requestedPiece(vtkInformation* outInfo)
+{
+  RequestedPiece request;
+  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()))
+  {
+    request.piece = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER());
+  }
+  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()))
+  {
+    request.count = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
+  }
+  return request;
 }
 
 std::string findModelDocument(vtkDataObject* object)

@@ -13,6 +13,7 @@
 
 class vtkDataObject;
 class vtkFieldData;
+class vtkInformation;
 
 namespace blockforge
 {
@@ -36,6 +37,15 @@ void readTemplateInputs(vtkDataObject* input, model::TemplateInputs& inputs);
 void attachModel(vtkFieldData* fieldData, const std::string& document);
 /// The model document carried by `object`'s field data, or "" if none.
 std::string findModelDocument(vtkDataObject* object);
+
+/// The piece an output request asks for and of how many: (0, 1) when the request does
+/// not say (a plain VTK pipeline), as ParaView's ranks each ask for their own.
+struct RequestedPiece
+{
+  int piece = 0;
+  int count = 1;
+};
+RequestedPiece requestedPiece(vtkInformation* outInfo);
 } // namespace vtkglue
 } // namespace blockforge
 

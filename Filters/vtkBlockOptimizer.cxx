@@ -168,12 +168,8 @@ int vtkBlockOptimizer::RequestData(
     output->Initialize();
     return 0;
   }
-  const int piece = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-    : 0;
-  const int pieceCount = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
-    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
-    : 1;
+  const blockforge::vtkglue::RequestedPiece request = blockforge::vtkglue::requestedPiece(outInfo);
+  const int piece = request.piece, pieceCount = request.count;
   try
   {
     this->UpdateProgress(0.0);

@@ -268,9 +268,7 @@ int vtkTurboPointSetsReader::RequestData(
 {
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   auto* output = vtkMultiBlockDataSet::GetData(outInfo);
-  const int piece = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-    ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-    : 0;
+  const int piece = blockforge::vtkglue::requestedPiece(outInfo).piece;
   this->UpdateProgress(0.0);
   vtkNew<vtkMultiBlockDataSet> result;
   try
