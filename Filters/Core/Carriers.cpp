@@ -707,6 +707,72 @@ Vec3 GordonSurface::point(double s, double t) const
   return result;
 }
 
+// point() at the five parameters, each section and t-curve evaluated once per parameter
+// it is needed at; every sum runs in point()'s order, so the bits are point()'s.
+void GordonSurface::crossPoints(double s, double sPlus, double sMinus, double t, double tPlus,
+  double tMinus, Vec3 out[5]) const
+{
+  const int n = static_cast<int>(TNodes.size());
+  const int m = static_cast<int>(SNodes.size());
+  const double sAt[3] = { s, sPlus, sMinus };
+  const double tAt[3] = { t, tPlus, tMinus };
+  const BlendAt b[3] = { { TheBlending, TNodes, TBlendCoefficients, t },
+    { TheBlending, TNodes, TBlendCoefficients, tPlus },
+    { TheBlending, TNodes, TBlendCoefficients, tMinus } };
+  const BlendAt a[3] = { { TheBlending, SNodes, SBlendCoefficients, s },
+    { TheBlending, SNodes, SBlendCoefficients, sPlus },
+    { TheBlending, SNodes, SBlendCoefficients, sMinus } };
+  static const int at[5][2] = { { 0, 0 }, { 1, 0 }, { 2, 0 }, { 0, 1 }, { 0, 2 } }; // (s, t)
+  for (int k = 0; k < 5; ++k)
+  {
+    out[k].setZero();
+  }
+  for (int j = 0; j < n; ++j)
+  {
+    Vec3 bracket[3];
+    bool have[3] = { false, false, false };
+    for (int k = 0; k < 5; ++k)
+    {
+      const int si = at[k][0];
+      const double bj = b[at[k][1]].value(j);
+      if (bj == 0.0)
+      {
+        continue;
+      }
+      if (!have[si])
+      {
+        bracket[si] = extendedCurvePoint(*SCurves[j], sAt[si]);
+        for (int i = 0; i < m; ++i)
+        {
+          bracket[si] -= a[si].value(i) * NodePoints[i + j * m];
+        }
+        have[si] = true;
+      }
+      out[k] += bj * bracket[si];
+    }
+  }
+  for (int i = 0; i < m; ++i)
+  {
+    Vec3 curve[3];
+    bool have[3] = { false, false, false };
+    for (int k = 0; k < 5; ++k)
+    {
+      const int ti = at[k][1];
+      const double ai = a[at[k][0]].value(i);
+      if (ai == 0.0)
+      {
+        continue;
+      }
+      if (!have[ti])
+      {
+        curve[ti] = extendedCurvePoint(*TCurves[i], tAt[ti]);
+        have[ti] = true;
+      }
+      out[k] += ai * curve[ti];
+    }
+  }
+}
+
 void GordonSurface::derivatives(double s, double t, SurfaceDerivatives& out) const
 {
   const int n = static_cast<int>(TNodes.size());

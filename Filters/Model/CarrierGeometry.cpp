@@ -551,6 +551,28 @@ Vec3 CarrierGeometry::point(int index, double s, double t) const
   return entry.curve->point(ws);
 }
 
+void CarrierGeometry::crossPoints(int index, double s, double t, double h, Vec3 out[5]) const
+{
+  const Entry& entry = Entries.at(index);
+  if (!entry.surface)
+  {
+    out[0] = point(index, s, t);
+    out[1] = point(index, s + h, t);
+    out[2] = point(index, s - h, t);
+    out[3] = point(index, s, t + h);
+    out[4] = point(index, s, t - h);
+    return;
+  }
+  // as point() wraps or limits each parameter
+  auto inS = [&](double u) { return entry.closedS ? wrapUnit(u) : clampUnit(u); };
+  auto inT = [&](double u) {
+    return entry.closedT ? wrapUnit(u)
+      : entry.extendT    ? std::max(-1.0, std::min(2.0, u))
+                         : clampUnit(u);
+  };
+  entry.surface->crossPoints(inS(s), inS(s + h), inS(s - h), inT(t), inT(t + h), inT(t - h), out);
+}
+
 void CarrierGeometry::project(
   int index, const Vec3& p, double& s, double& t, double& distance) const
 {

@@ -130,6 +130,9 @@ public:
 
   /// Curve point at u or surface point at (s, t); wraps on closed carriers.
   Vec3 point(int index, double s, double t = 0.0) const;
+  /// point() at (s, t), (s + h, t), (s - h, t), (s, t + h) and (s, t - h), the same bits,
+  /// with the curves of Gordon surfaces evaluated once per parameter (central differences).
+  void crossPoints(int index, double s, double t, double h, Vec3 out[5]) const;
   /// Parameters of the closest point of carrier `index` to p (t = 0 for curves).
   void project(int index, const Vec3& p, double& s, double& t, double& distance) const;
   /**

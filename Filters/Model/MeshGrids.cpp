@@ -477,16 +477,23 @@ std::size_t ProjectionCache::KeyHash::operator()(const Key& key) const
  * surface's own parameters (derivatives by central differences through geometry.point,
  * which wraps closed and extends Gordon carriers), steps limited so the node stays on
  * the part of the surface it started on (a thin trailing edge has another side close by).
+ * `start` gets the surface point at the (s, t) it starts from.
  */
 void closestNear(const CarrierGeometry& geometry, int carrier, const Vec3& target, double& s,
-  double& t)
+  double& t, Vec3& start)
 {
   const double h = 1e-6, largest = 0.02;
   for (int iteration = 0; iteration < 8; ++iteration)
   {
-    const Vec3 p = geometry.point(carrier, s, t);
-    const Vec3 ps = (geometry.point(carrier, s + h, t) - geometry.point(carrier, s - h, t)) / (2 * h);
-    const Vec3 pt = (geometry.point(carrier, s, t + h) - geometry.point(carrier, s, t - h)) / (2 * h);
+    Vec3 around[5];
+    geometry.crossPoints(carrier, s, t, h, around);
+    const Vec3& p = around[0];
+    if (iteration == 0)
+    {
+      start = p;
+    }
+    const Vec3 ps = (around[1] - around[2]) / (2 * h);
+    const Vec3 pt = (around[3] - around[4]) / (2 * h);
     const Vec3 r = target - p;
     const double a = ps.dot(ps), b = ps.dot(pt), c = pt.dot(pt);
     const double det = a * c - b * b;
@@ -603,9 +610,9 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
       const double s0 = parameters[3 * i], t0 = parameters[3 * i + 1];
       const Vec3 target(targets[3 * i], targets[3 * i + 1], targets[3 * i + 2]);
       double s = s0, t = t0;
-      closestNear(geometry, carrier, target, s, t);
+      Vec3 p0;
+      closestNear(geometry, carrier, target, s, t, p0); // p0: the point at (s0, t0)
       Vec3 p = geometry.point(carrier, s, t);
-      const Vec3 p0 = geometry.point(carrier, s0, t0);
       if (!((p - target).norm() <= (p0 - target).norm()))
       {
         p = p0; // no better than the (s, t) node: keep that
