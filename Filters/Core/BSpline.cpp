@@ -480,6 +480,38 @@ BSplineCurve::BSplineCurve(int degree, std::vector<double> knots,
   requireDegree(degree, "B-spline curve");
   validateKnots(degree, Knots, static_cast<int>(ControlPoints.size()), "B-spline curve");
   requireFinitePoints(ControlPoints, "B-spline curve control points");
+  const int count = static_cast<int>(ControlPoints.size());
+  const int bins = 4 * count;
+  const double first = Knots[Degree], range = Knots[count] - first;
+  SpanTable.resize(bins + 1);
+  for (int bin = 0; bin <= bins; ++bin)
+  {
+    SpanTable[bin] = bspline::findSpan(Degree, Knots, count, first + range * bin / bins);
+  }
+}
+
+int BSplineCurve::span(double t) const
+{
+  const int count = static_cast<int>(ControlPoints.size());
+  const int n = count - 1;
+  if (!(t > Knots[Degree] && t < Knots[n + 1]))
+  {
+    return bspline::findSpan(Degree, Knots, count, t); // ends, NaN
+  }
+  // Inside, exactly one span k has Knots[k] <= t < Knots[k + 1]: walk to it from the
+  // table (a step or two), the same span the bisection finds.
+  const int bins = static_cast<int>(SpanTable.size()) - 1;
+  const double place = (t - Knots[Degree]) / (Knots[n + 1] - Knots[Degree]) * bins;
+  int k = SpanTable[std::max(0, std::min(bins - 1, static_cast<int>(place)))];
+  while (t < Knots[k])
+  {
+    --k;
+  }
+  while (t >= Knots[k + 1])
+  {
+    ++k;
+  }
+  return k;
 }
 
 namespace
@@ -574,8 +606,7 @@ BSplineCurve BSplineCurve::interpolateAt(const std::vector<Vec3>& points,
 Vec3 BSplineCurve::point(double t) const
 {
   t = clampUnit(t);
-  const int count = static_cast<int>(ControlPoints.size());
-  const int span = bspline::findSpan(Degree, Knots, count, t);
+  const int span = this->span(t);
   double basis[MaxBasis];
   bspline::basisFunctions(span, t, Degree, Knots, basis);
   Vec3 result = Vec3::Zero();
@@ -604,8 +635,7 @@ Vec3 BSplineCurve::derivative(double t, int order) const
 void BSplineCurve::derivatives(double t, int order, Vec3* out) const
 {
   t = clampUnit(t);
-  const int count = static_cast<int>(ControlPoints.size());
-  const int span = bspline::findSpan(Degree, Knots, count, t);
+  const int span = this->span(t);
   const int computed = std::min(order, Degree);
   double ders[MaxBasis * MaxBasis];
   bspline::basisDerivatives(span, t, Degree, computed, Knots, ders);
