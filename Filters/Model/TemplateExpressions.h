@@ -78,6 +78,17 @@ public:
 
   const std::vector<std::string>& names() const { return Names; }
 
+  /// Every named constant: parameters, definitions, machine values, queries, pi, deg.
+  std::map<std::string, double> constants() const
+  {
+    std::map<std::string, double> values;
+    for (const auto& constant : Parser.GetConst())
+    {
+      values[constant.first] = constant.second;
+    }
+    return values;
+  }
+
   double evaluate(const std::string& expression)
   {
     const std::string expanded = prepare(expression);

@@ -40,6 +40,7 @@ BlockModel TemplateReader::readModel()
   readFaces();
   readPatches();
   readNotes();
+  recordExpressionScope();
   return std::move(Model);
 }
 

@@ -104,7 +104,9 @@ void TemplateReader::ensureVertex(int index)
   resolveOnce(VertexState, VertexEntries, index, "vertex",
     [&](const MapEntry& entry, const std::string& entityText) {
       Vertex vertex = Model.vertices[index];
+      Referenced.emplace_back(); // what its expressions refer to (not its referrer's)
       readVertexV2(entry, entityText, vertex);
+      Referenced.pop_back();
       if (!vertex.position.allFinite())
       {
         fail(entry.line, entityText, "the position is not finite");
@@ -418,75 +420,13 @@ double TemplateReader::curveSurfaceIntersection(int curve, int surface, const Ma
 void TemplateReader::onRevolutionAt(int surface, double axial, double theta, const std::string& entityText,
   int line, double& s, double& t)
 {
-  const SurfaceOfRevolution* revolution = Geometry.revolution(surface);
-  const Machine& machine = Model.machine;
-  const double size = std::max(Geometry.size(surface), 1e-300);
-  if (!revolution || revolution->axisDirection().cross(machine.axis).norm() > 1e-12 ||
-    (revolution->axisPoint() - machine.axisPoint).cross(machine.axis).norm() > 1e-12 * size)
+  try
   {
-    fail(line, entityText,
-      "'axial' and 'theta' place a vertex on a surface of revolution about the machine "
-      "axis; '" + Model.carriers[surface].name + "' is not one");
+    revolutionParametersAt(Model, Geometry, referenceDirection(), surface, axial, theta, s, t);
   }
-  auto f = [&](double u) {
-    double a = 0.0, r = 0.0, th = 0.0;
-    cylindrical(Geometry.point(surface, u, 0.5), a, r, th);
-    return a - axial;
-  };
-  const int samples = 256;
-  double a = 0.0, fa = f(0.0);
-  bool found = fa == 0.0;
-  double root = 0.0;
-  for (int k = 1; k <= samples && !found; ++k)
+  catch (const GeometryError& error)
   {
-    const double b = static_cast<double>(k) / samples, fb = f(b);
-    if (fb == 0.0)
-    {
-      root = b;
-      found = true;
-    }
-    else if ((fa < 0.0) != (fb < 0.0))
-    {
-      double low = a, high = b, flow = fa;
-      for (int iteration = 0; iteration < 200 && high - low > 1e-16; ++iteration)
-      {
-        const double middle = 0.5 * (low + high), fm = f(middle);
-        if ((fm < 0.0) == (flow < 0.0))
-        {
-          low = middle;
-          flow = fm;
-        }
-        else
-        {
-          high = middle;
-        }
-      }
-      root = 0.5 * (low + high);
-      found = true;
-    }
-    a = b;
-    fa = fb;
-  }
-  if (!found)
-  {
-    double a0 = 0.0, a1 = 0.0, r = 0.0, th = 0.0;
-    cylindrical(Geometry.point(surface, 0.0, 0.5), a0, r, th);
-    cylindrical(Geometry.point(surface, 1.0, 0.5), a1, r, th);
-    fail(line, entityText,
-      "surface '" + Model.carriers[surface].name + "' does not reach axial = " +
-        shortNumber(axial) + " (its contour spans axial " + shortNumber(std::min(a0, a1)) +
-        " to " + shortNumber(std::max(a0, a1)) + ")");
-  }
-  double ignored = 0.0, radius = 0.0;
-  cylindrical(Geometry.point(surface, root, 0.5), ignored, radius, ignored);
-  double distance = 0.0;
-  const Vec3 target = fromCylindrical(axial, radius, theta);
-  Geometry.project(surface, target, s, t, distance);
-  if ((Geometry.point(surface, s, t) - target).norm() > 1e-9 * size)
-  {
-    fail(line, entityText,
-      "theta = " + shortNumber(theta) + " is outside the angle range of surface '" +
-        Model.carriers[surface].name + "'");
+    fail(line, entityText, error.what());
   }
 }
 
@@ -577,6 +517,20 @@ double TemplateReader::curveParameterQuery(const MapEntry& at, int curve, const 
   return extremum(curve, value, extreme.key == "min" ? 1.0 : -1.0, from, to);
 }
 
+void TemplateReader::recordPlacementExpressions(
+  Vertex& vertex, PlacementExpressions::Form form, const std::vector<std::string>& texts)
+{
+  const std::set<int>& followed = Referenced.back();
+  if (followed.empty())
+  {
+    return; // numbers and parameters only: nothing to follow
+  }
+  PlacementExpressions& expressions = vertex.rule.expressions;
+  expressions.form = form;
+  expressions.texts = texts;
+  expressions.follows.assign(followed.begin(), followed.end());
+}
+
 void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& entityText, Vertex& vertex)
 {
   if (entry.value.IsSequence())
@@ -629,7 +583,10 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
     }
     else
     {
+      Referenced.back().clear();
       u = number(at->value, at->line, entityText, "at");
+      recordPlacementExpressions(
+        vertex, PlacementExpressions::Form::CurveParameter, { at->value.Scalar() });
       if (Geometry.closedS(curve))
       {
         u = wrapUnit(u);
@@ -643,6 +600,7 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
     constraint.carrier = curve;
     constraint.s = u;
     vertex.rule.kind = VertexRule::Kind::OnCarrier;
+    vertex.rule.expressions.base = { { u, 0.0 } };
     placeVertex(Model, Geometry, vertex);
     return;
   }
@@ -657,13 +615,17 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
     {
       fail(entry.line, entityText, "on_surface with 'axial' needs 'theta' too");
     }
+    Referenced.back().clear();
     const double axial = number(axialEntry->value, axialEntry->line, entityText, "axial");
     const double theta = number(thetaEntry->value, thetaEntry->line, entityText, "theta");
+    recordPlacementExpressions(vertex, PlacementExpressions::Form::AxialTheta,
+      { axialEntry->value.Scalar(), thetaEntry->value.Scalar() });
     double s = 0.0, t = 0.0;
     onRevolutionAt(surface, axial, theta, entityText, axialEntry->line, s, t);
     constraint.carrier = surface;
     constraint.s = s;
     constraint.t = t;
+    vertex.rule.expressions.base = { { s, t } };
     vertex.rule.kind = VertexRule::Kind::OnCarrier;
     placeVertex(Model, Geometry, vertex);
     return;

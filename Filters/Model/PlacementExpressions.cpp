@@ -1,0 +1,217 @@
+// Vertex placement by template expressions that refer to other vertices: evaluated again,
+// in the template's scope, with the current positions of those vertices.
+#include "Placement.h"
+
+#include "../Core/Carriers.h"
+#include "../Core/RootFinding.h"
+#include "ModelSyntax.h"
+#include "TemplateExpressions.h"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <map>
+#include <set>
+
+namespace blockforge
+{
+namespace model
+{
+void cylindricalAbout(const Machine& machine, const Vec3& thetaZero, const Vec3& p, double& axial,
+  double& radius, double& theta)
+{
+  const Vec3& axis = machine.axis;
+  const Vec3 q = p - machine.axisPoint;
+  axial = q.dot(axis);
+  const Vec3 radial = q - axial * axis;
+  radius = radial.norm();
+  const Vec3 e2 = axis.cross(thetaZero);
+  theta = std::atan2(radial.dot(e2), radial.dot(thetaZero));
+}
+
+Vec3 fromCylindricalAbout(
+  const Machine& machine, const Vec3& thetaZero, double axial, double radius, double theta)
+{
+  const Vec3& axis = machine.axis;
+  const Vec3 e2 = axis.cross(thetaZero);
+  return machine.axisPoint + axial * axis +
+    radius * (std::cos(theta) * thetaZero + std::sin(theta) * e2);
+}
+
+void revolutionParametersAt(const BlockModel& model, const CarrierGeometry& geometry,
+  const Vec3& thetaZero, int surface, double axial, double theta, double& s, double& t)
+{
+  const SurfaceOfRevolution* revolution = geometry.revolution(surface);
+  const Machine& machine = model.machine;
+  const std::string& name = model.carriers[surface].name;
+  const double size = std::max(geometry.size(surface), 1e-300);
+  if (!revolution || revolution->axisDirection().cross(machine.axis).norm() > 1e-12 ||
+    (revolution->axisPoint() - machine.axisPoint).cross(machine.axis).norm() > 1e-12 * size)
+  {
+    throw GeometryError("'axial' and 'theta' place a vertex on a surface of revolution about "
+                        "the machine axis; '" + name + "' is not one");
+  }
+  auto f = [&](double u) {
+    double a = 0.0, r = 0.0, th = 0.0;
+    cylindricalAbout(machine, thetaZero, geometry.point(surface, u, 0.5), a, r, th);
+    return a - axial;
+  };
+  // The contour's first crossing of the axial plane: the sign change in 256 samples,
+  // then bisection to rounding.
+  const int samples = 256;
+  double a = 0.0, fa = f(0.0);
+  bool found = fa == 0.0;
+  double root = 0.0;
+  for (int k = 1; k <= samples && !found; ++k)
+  {
+    const double b = static_cast<double>(k) / samples, fb = f(b);
+    if (fb == 0.0)
+    {
+      root = b;
+      found = true;
+    }
+    else if ((fa < 0.0) != (fb < 0.0))
+    {
+      root = bisectedRoot(f, a, b, fa, 1e-16);
+      found = true;
+    }
+    a = b;
+    fa = fb;
+  }
+  if (!found)
+  {
+    double a0 = 0.0, a1 = 0.0, r = 0.0, th = 0.0;
+    cylindricalAbout(machine, thetaZero, geometry.point(surface, 0.0, 0.5), a0, r, th);
+    cylindricalAbout(machine, thetaZero, geometry.point(surface, 1.0, 0.5), a1, r, th);
+    throw GeometryError("surface '" + name + "' does not reach axial = " +
+      syntax::shortNumber(axial) + " (its contour spans axial " +
+      syntax::shortNumber(std::min(a0, a1)) + " to " + syntax::shortNumber(std::max(a0, a1)) + ")");
+  }
+  double ignored = 0.0, radius = 0.0;
+  cylindricalAbout(machine, thetaZero, geometry.point(surface, root, 0.5), ignored, radius, ignored);
+  double distance = 0.0;
+  const Vec3 target = fromCylindricalAbout(machine, thetaZero, axial, radius, theta);
+  geometry.project(surface, target, s, t, distance);
+  if ((geometry.point(surface, s, t) - target).norm() > 1e-9 * size)
+  {
+    throw GeometryError("theta = " + syntax::shortNumber(theta) +
+      " is outside the angle range of surface '" + name + "'");
+  }
+}
+
+namespace
+{
+/// The template's expression scope, evaluating definitions when first used and vertex
+/// queries from the current positions: the same values and the same operations as when
+/// the template was read, so the same bits for the same positions.
+class PlacementScope
+{
+public:
+  explicit PlacementScope(const BlockModel& model)
+    : Model(model)
+  {
+    for (const auto& value : model.expressionScope.values)
+    {
+      Evaluator.defineQuery(value.first, value.second);
+    }
+    for (const auto& definition : model.expressionScope.definitions)
+    {
+      Definitions[definition.first] = &definition.second;
+    }
+    Evaluator.OnReference = [this](const std::string& name, const std::string& attribute) {
+      resolve(name, attribute);
+    };
+  }
+
+  double evaluate(const std::string& text) { return Evaluator.evaluate(text); }
+
+private:
+  void resolve(const std::string& name, const std::string& attribute)
+  {
+    if (!Resolved.insert(name).second)
+    {
+      return;
+    }
+    if (attribute.empty())
+    {
+      const auto definition = Definitions.find(name);
+      if (definition != Definitions.end())
+      {
+        Evaluator.define(name, Evaluator.evaluate(*definition->second));
+      }
+      return;
+    }
+    const int index = Model.findVertex(name);
+    if (index < 0)
+    {
+      Resolved.erase(name); // a carrier query: among the values already
+      return;
+    }
+    const Vertex& vertex = Model.vertices[index];
+    double axial = 0.0, radius = 0.0, theta = 0.0;
+    cylindricalAbout(Model.machine, Model.expressionScope.thetaZero, vertex.position, axial,
+      radius, theta);
+    Evaluator.defineQuery(name + ".x", vertex.position.x());
+    Evaluator.defineQuery(name + ".y", vertex.position.y());
+    Evaluator.defineQuery(name + ".z", vertex.position.z());
+    Evaluator.defineQuery(name + ".axial", axial);
+    Evaluator.defineQuery(name + ".radius", radius);
+    Evaluator.defineQuery(name + ".theta", theta);
+    if (vertex.constraint.carrier >= 0)
+    {
+      Evaluator.defineQuery(name + ".s", vertex.constraint.s);
+      Evaluator.defineQuery(name + ".t", vertex.constraint.t);
+    }
+  }
+
+  const BlockModel& Model;
+  detail::ExpressionEvaluator Evaluator;
+  std::map<std::string, const std::string*> Definitions;
+  std::set<std::string> Resolved;
+};
+} // namespace
+
+Eigen::Vector2d evaluatePlacementExpressions(
+  const BlockModel& model, const CarrierGeometry& geometry, int index)
+{
+  const Vertex& vertex = model.vertices[index];
+  const PlacementExpressions& expressions = vertex.rule.expressions;
+  const int carrier = vertex.constraint.carrier;
+  PlacementScope scope(model);
+  std::vector<double> values;
+  for (const std::string& text : expressions.texts)
+  {
+    try
+    {
+      values.push_back(scope.evaluate(text));
+    }
+    catch (const detail::ExpressionError& error)
+    {
+      throw GeometryError(error.message);
+    }
+  }
+  if (expressions.form == PlacementExpressions::Form::AxialTheta && values.size() == 2)
+  {
+    double s = 0.0, t = 0.0;
+    revolutionParametersAt(
+      model, geometry, model.expressionScope.thetaZero, carrier, values[0], values[1], s, t);
+    return Eigen::Vector2d(s, t);
+  }
+  if (expressions.form == PlacementExpressions::Form::CurveParameter && values.size() == 1)
+  {
+    double u = values[0];
+    if (geometry.closedS(carrier))
+    {
+      u = wrapUnit(u);
+    }
+    else if (u < 0.0 || u > 1.0)
+    {
+      throw GeometryError("at = " + syntax::shortNumber(u) +
+        " is outside the curve's parameter range [0, 1]");
+    }
+    return Eigen::Vector2d(u, 0.0);
+  }
+  throw GeometryError("its placement expressions are incomplete");
+}
+} // namespace model
+} // namespace blockforge
