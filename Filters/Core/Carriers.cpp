@@ -374,6 +374,7 @@ SurfaceOfRevolution::SurfaceOfRevolution(CurvePtr contour, const Vec3& axisPoint
       " to " + format(angleEnd) + " rad is empty or not finite");
   }
   AxisDirection = axisDirection / norm;
+  ContourSpline = dynamic_cast<const BSplineCurve*>(Contour.get());
   Meridional = std::make_shared<MeridionalCurve>(Contour, AxisPoint, AxisDirection);
   // 256 samples: hub/shroud contours are smooth; candidates are refined by Newton anyway.
   MeridionalProjector = std::make_shared<CurveProjector>(Meridional, 256);
@@ -392,9 +393,9 @@ Vec3 SurfaceOfRevolution::point(double s, double t) const
 
 void SurfaceOfRevolution::contourJet(double s, int order, Vec3 (&c)[3]) const
 {
-  if (const auto* spline = dynamic_cast<const BSplineCurve*>(Contour.get()))
+  if (ContourSpline)
   {
-    spline->derivatives(s, order, c);
+    ContourSpline->derivatives(s, order, c);
     return;
   }
   c[0] = Contour->point(s);

@@ -72,6 +72,7 @@ private:
   void firstOrder(const Vec3 (&c)[3], double t, Vec3& P, Vec3& Ps, Vec3& Pt, double& cs,
     double& sn, Vec3& arm) const;
   CurvePtr Contour;
+  const BSplineCurve* ContourSpline = nullptr; ///< Contour when it is a B-spline (one basis evaluation per jet)
   Vec3 AxisPoint, AxisDirection;
   double AngleStart, AngleEnd;
   // The contour mapped to (axial, radius, 0) and its projector: the closest meridional

@@ -541,69 +541,154 @@ SurfaceProjector::SurfaceProjector(SurfacePtr surface, int samplesS, int samples
       SamplePoints[i + static_cast<std::size_t>(j) * samplesS] = TheSurface->point(s, t);
     }
   }
+  auto at = [&](int i, int j) -> const Vec3& {
+    return SamplePoints[i + static_cast<std::size_t>(j) * samplesS];
+  };
+  Spacing.assign(SamplePoints.size(), 0.0);
+  for (int j = 0; j < samplesT; ++j)
+  {
+    for (int i = 0; i < samplesS; ++i)
+    {
+      double& spacing = Spacing[i + static_cast<std::size_t>(j) * samplesS];
+      for (int dj = -1; dj <= 1; ++dj)
+      {
+        for (int di = -1; di <= 1; ++di)
+        {
+          const int ii = i + di, jj = j + dj;
+          if (ii >= 0 && jj >= 0 && ii < samplesS && jj < samplesT)
+          {
+            spacing = std::max(spacing, (at(ii, jj) - at(i, j)).norm());
+          }
+        }
+      }
+    }
+  }
+  const int size = 8;
+  for (int j0 = 0; j0 < samplesT; j0 += size)
+  {
+    for (int i0 = 0; i0 < samplesS; i0 += size)
+    {
+      Tile tile;
+      tile.i0 = i0;
+      tile.j0 = j0;
+      tile.i1 = std::min(samplesS, i0 + size);
+      tile.j1 = std::min(samplesT, j0 + size);
+      tile.low = Vec3::Constant(std::numeric_limits<double>::infinity());
+      tile.high = -tile.low;
+      for (int j = tile.j0; j < tile.j1; ++j)
+      {
+        for (int i = tile.i0; i < tile.i1; ++i)
+        {
+          tile.low = tile.low.cwiseMin(at(i, j));
+          tile.high = tile.high.cwiseMax(at(i, j));
+          tile.spacing = std::max(tile.spacing, Spacing[i + static_cast<std::size_t>(j) * samplesS]);
+        }
+      }
+      Tiles.push_back(tile);
+    }
+  }
 }
 
 SurfaceProjection SurfaceProjector::project(const Vec3& p, double tolerance) const
 {
   requireFinite(p);
   const int ns = SamplesS, nt = SamplesT;
-  auto at = [&](int i, int j) -> const Vec3& {
-    return SamplePoints[i + static_cast<std::size_t>(j) * ns];
-  };
+  const std::size_t count = SamplePoints.size();
 
   // Per-thread scratch: projection runs in inner loops and must not allocate each call.
+  // Distances are computed when first needed, each with the same formula, so the search
+  // sees the same numbers as one computing them all.
   thread_local std::vector<double> distances;
-  distances.resize(SamplePoints.size());
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < SamplePoints.size(); ++k)
-  {
-    distances[k] = (SamplePoints[k] - p).norm();
-    best = std::min(best, distances[k]);
-  }
-  CandidateList candidates;
-  for (int j = 0; j < nt; ++j)
-  {
-    for (int i = 0; i < ns; ++i)
+  thread_local std::vector<char> known;
+  distances.resize(count);
+  known.assign(count, 0);
+  auto distance = [&](std::size_t k) {
+    if (!known[k])
     {
-      const std::size_t index = i + static_cast<std::size_t>(j) * ns;
-      const double d = distances[index];
-      bool localMinimum = true;
-      for (int dj = -1; dj <= 1 && localMinimum; ++dj)
+      distances[k] = (SamplePoints[k] - p).norm();
+      known[k] = 1;
+    }
+    return distances[k];
+  };
+  // The nearest sample: tiles nearest first, until a tile's box is farther than the best
+  // sample so far (its samples cannot be nearer). Bounds are lowered by a margin far above
+  // rounding, so no tile that might hold the nearest sample is left out.
+  const std::size_t tileCount = Tiles.size();
+  thread_local std::vector<std::pair<double, std::size_t>> byBound;
+  byBound.clear();
+  for (std::size_t k = 0; k < tileCount; ++k)
+  {
+    const Tile& tile = Tiles[k];
+    const Vec3 gap = (tile.low - p).cwiseMax(p - tile.high).cwiseMax(Vec3::Zero());
+    byBound.emplace_back(gap.norm() * (1.0 - 1e-12), k);
+  }
+  std::sort(byBound.begin(), byBound.end());
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& entry : byBound)
+  {
+    if (entry.first > best)
+    {
+      break;
+    }
+    const Tile& tile = Tiles[entry.second];
+    for (int j = tile.j0; j < tile.j1; ++j)
+    {
+      for (int i = tile.i0; i < tile.i1; ++i)
       {
-        for (int di = -1; di <= 1; ++di)
-        {
-          const int ii = i + di, jj = j + dj;
-          if (ii >= 0 && jj >= 0 && ii < ns && jj < nt &&
-            distances[ii + static_cast<std::size_t>(jj) * ns] < d)
-          {
-            localMinimum = false;
-            break;
-          }
-        }
-      }
-      if (!localMinimum)
-      {
-        continue;
-      }
-      // A local minimum farther than the best sample by more than its cell size cannot
-      // hold the closest point.
-      double spacing = 0.0;
-      for (int dj = -1; dj <= 1; ++dj)
-      {
-        for (int di = -1; di <= 1; ++di)
-        {
-          const int ii = i + di, jj = j + dj;
-          if (ii >= 0 && jj >= 0 && ii < ns && jj < nt)
-          {
-            spacing = std::max(spacing, (at(ii, jj) - at(i, j)).norm());
-          }
-        }
-      }
-      if (d - spacing <= best)
-      {
-        candidates.offer({ d, static_cast<int>(index) });
+        best = std::min(best, distance(i + static_cast<std::size_t>(j) * ns));
       }
     }
+  }
+  // Candidates: local minima no farther than the best sample by more than their cell size
+  // (Spacing); only tiles near enough to hold one are searched, and candidates are offered
+  // in sample order.
+  thread_local std::vector<std::size_t> found;
+  found.clear();
+  for (const auto& entry : byBound)
+  {
+    const Tile& tile = Tiles[entry.second];
+    if (entry.first > (best + tile.spacing) * (1.0 + 1e-12))
+    {
+      continue;
+    }
+    for (int j = tile.j0; j < tile.j1; ++j)
+    {
+      for (int i = tile.i0; i < tile.i1; ++i)
+      {
+        const std::size_t index = i + static_cast<std::size_t>(j) * ns;
+        const double d = distance(index);
+        if (!(d - Spacing[index] <= best))
+        {
+          continue;
+        }
+        // A local minimum farther than the best sample by more than its cell size cannot
+        // hold the closest point.
+        bool localMinimum = true;
+        for (int dj = -1; dj <= 1 && localMinimum; ++dj)
+        {
+          for (int di = -1; di <= 1; ++di)
+          {
+            const int ii = i + di, jj = j + dj;
+            if (ii >= 0 && jj >= 0 && ii < ns && jj < nt &&
+              distance(ii + static_cast<std::size_t>(jj) * ns) < d)
+            {
+              localMinimum = false;
+              break;
+            }
+          }
+        }
+        if (localMinimum)
+        {
+          found.push_back(index);
+        }
+      }
+    }
+  }
+  std::sort(found.begin(), found.end());
+  CandidateList candidates;
+  for (const std::size_t index : found)
+  {
+    candidates.offer({ distances[index], static_cast<int>(index) });
   }
 
   // A step may cross at most two sample cells; beyond that the sample is a better guide.

@@ -56,6 +56,16 @@ private:
   SurfacePtr TheSurface;
   int SamplesS, SamplesT;
   std::vector<Vec3> SamplePoints; // s fastest
+  /// Per sample, the largest distance to a neighbour (the sample cell's size).
+  std::vector<double> Spacing;
+  /// Blocks of 8 x 8 samples with their bounding boxes: the search skips the far ones.
+  struct Tile
+  {
+    int i0 = 0, i1 = 0, j0 = 0, j1 = 0;
+    Vec3 low, high;
+    double spacing = 0.0;
+  };
+  std::vector<Tile> Tiles;
 };
 
 /**
