@@ -68,26 +68,4 @@ private:
   std::vector<Tile> Tiles;
 };
 
-/**
- * @class ArcLength
- * @brief Arc-length parametrisation of a curve: length(t) by adaptive Gauss-Legendre
- * quadrature, and its inverse by Newton with bisection fallback.
- */
-class ArcLength
-{
-public:
-  explicit ArcLength(CurvePtr curve, int segments = 64);
-  double totalLength() const { return Total; }
-  /// Length of the curve from 0 to t.
-  double lengthAt(double t) const;
-  /// Parameter t at which lengthAt(t) == fraction * totalLength(), |error| < 1e-12 * total.
-  double parameterAtFraction(double fraction) const;
-
-private:
-  CurvePtr TheCurve;
-  std::vector<double> Breaks;     // segment boundaries in t
-  std::vector<double> Cumulative; // length up to each break
-  double Total = 0.0;
-  double segmentLength(double a, double b) const;
-};
 } // namespace blockforge

@@ -300,9 +300,8 @@ void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& cu
     else
     {
       const double fraction = curveReversed ? 1.0 - edge.params[i] : edge.params[i];
-      const double t = named->lengthTable ? named->lengthTable->parameterAtFraction(fraction)
-        : named->arcLength                ? named->arcLength->parameterAtFraction(fraction)
-                                          : fraction;
+      const double t =
+        named->lengthTable ? named->lengthTable->parameterAtFraction(fraction) : fraction;
       point = named->curve->point(t);
     }
     for (int c = 0; c < 3; ++c)

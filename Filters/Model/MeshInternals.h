@@ -46,8 +46,8 @@ inline std::string blockEntity(const BlockModel& model, int block)
 struct NamedCurve
 {
   CurvePtr curve;
-  std::shared_ptr<const ArcLength> arcLength; ///< splines only: arcs are arc-length already
-  std::shared_ptr<const ArcLengthTable> lengthTable; ///< curves on carriers
+  /// Curves on carriers, splines and follow edges (arcs and lines are arc-length already).
+  std::shared_ptr<const ArcLength> lengthTable;
   double length = 0.0;
   int projectOnto = -1; ///< Project: the nodes of the straight line are projected onto it
 };

@@ -452,7 +452,7 @@ double TemplateReader::curveParameterQuery(const MapEntry& at, int curve, const 
     {
       fail(length->line, entityText, "the length fraction must be in [0, 1]");
     }
-    return ArcLengthTable(Geometry.curve(curve)).parameterAtFraction(fraction);
+    return ArcLength(Geometry.curve(curve)).parameterAtFraction(fraction);
   }
   const MapEntry& extreme = minimum ? *minimum : *maximum;
   const bool closed = Geometry.closedS(curve);
