@@ -1,8 +1,9 @@
 /**
  * @file RootFinding.h
- * @brief The 1-D root finders of BlockForge, on a sign-changing bracket: Brent's method
- * (blade/hub intersections, curve/surface intersections) and bisection to rounding
- * (vertices on axial planes: the bits of the grids made before they were unified).
+ * @brief The 1-D solvers of BlockForge's geometry: roots on a sign-changing bracket by
+ * Brent's method (blade/hub intersections, curves meeting surfaces) or by bisection to
+ * rounding (vertices on axial planes: the bits of the grids made before they were
+ * unified), and minima on a bracket by golden-section search (extreme points of curves).
  */
 #pragma once
 
@@ -109,5 +110,35 @@ inline double bisectedRoot(const F& f, double a, double b, double fa, double wid
     }
   }
   return 0.5 * (low + high);
+}
+/// Golden-section search for the minimum of f on [a, b], until the bracket is no wider
+/// than `width` (at most 200 steps; far from 0 the bracket stops shrinking at the spacing
+/// of doubles); the midpoint of the last bracket.
+template <typename F>
+inline double goldenSectionMinimum(const F& f, double a, double b, double width)
+{
+  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
+  double c = b - ratio * (b - a), d = a + ratio * (b - a);
+  double fc = f(c), fd = f(d);
+  for (int iteration = 0; b - a > width && iteration < 200; ++iteration)
+  {
+    if (fc < fd)
+    {
+      b = d;
+      d = c;
+      fd = fc;
+      c = b - ratio * (b - a);
+      fc = f(c);
+    }
+    else
+    {
+      a = c;
+      c = d;
+      fc = fd;
+      d = a + ratio * (b - a);
+      fd = f(d);
+    }
+  }
+  return 0.5 * (a + b);
 }
 } // namespace blockforge

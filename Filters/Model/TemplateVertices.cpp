@@ -1,6 +1,8 @@
 // The template reader: vertices, their placement rules and the queries on points and carriers (extrema, intersections, axial/theta on surfaces).
 #include "TemplateReader.h"
 
+#include "../Core/RootFinding.h"
+
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -250,30 +252,7 @@ double TemplateReader::extremum(const std::function<Vec3(double)>& point, bool c
     a = std::max(a, from);
     b = std::min(b, to);
   }
-  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-  double c = b - ratio * (b - a), d = a + ratio * (b - a);
-  double fc = f(c), fd = f(d);
-  // bounded: far from 0 the bracket stops shrinking at the spacing of doubles
-  for (int iteration = 0; b - a > 1e-14 && iteration < 200; ++iteration)
-  {
-    if (fc < fd)
-    {
-      b = d;
-      d = c;
-      fd = fc;
-      c = b - ratio * (b - a);
-      fc = f(c);
-    }
-    else
-    {
-      a = c;
-      c = d;
-      fc = fd;
-      d = a + ratio * (b - a);
-      fd = f(d);
-    }
-  }
-  double u = 0.5 * (a + b);
+  double u = goldenSectionMinimum(f, a, b, 1e-14);
   if (!whole && f(from) <= f(u))
   {
     u = from;
@@ -292,34 +271,6 @@ double TemplateReader::curveSurfaceIntersection(int curve, int surface, const Ma
   const int samples = 512;
   const SurfaceOfRevolution* revolution = Geometry.revolution(surface);
   std::vector<double> roots;
-  auto refine = [&](auto&& f, double a, double b) {
-    double fa = f(a), fb = f(b);
-    for (int iteration = 0; iteration < 200 && b - a > 1e-15; ++iteration)
-    {
-      // Illinois-style regula falsi with bisection safeguard.
-      double m = fb != fa ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
-      if (!(m > a && m < b) || iteration % 3 == 2)
-      {
-        m = 0.5 * (a + b);
-      }
-      const double fm = f(m);
-      if (fm == 0.0)
-      {
-        return m;
-      }
-      if ((fm < 0.0) == (fa < 0.0))
-      {
-        a = m;
-        fa = fm;
-      }
-      else
-      {
-        b = m;
-        fb = fm;
-      }
-    }
-    return std::abs(fa) < std::abs(fb) ? a : b;
-  };
   if (revolution)
   {
     auto f = [&](double u) { return revolution->signedMeridionalDistance(Geometry.point(curve, u)); };
@@ -338,7 +289,7 @@ double TemplateReader::curveSurfaceIntersection(int curve, int surface, const Ma
       }
       else if (previous != 0.0 && (value < 0.0) != (previous < 0.0))
       {
-        roots.push_back(refine(f, static_cast<double>(k - 1) / samples, u));
+        roots.push_back(brentRoot(f, static_cast<double>(k - 1) / samples, u, previous, value, 1e-15));
       }
       previous = value;
     }
@@ -361,21 +312,8 @@ double TemplateReader::curveSurfaceIntersection(int curve, int surface, const Ma
         best = k;
       }
     }
-    double a = std::max(0.0, (best - 1.0) / samples), b = std::min(1.0, (best + 1.0) / samples);
-    const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-    for (int iteration = 0; b - a > 1e-15 && iteration < 200; ++iteration)
-    {
-      const double c = b - ratio * (b - a), d = a + ratio * (b - a);
-      if (f(c) < f(d))
-      {
-        b = d;
-      }
-      else
-      {
-        a = c;
-      }
-    }
-    const double u = 0.5 * (a + b);
+    const double u = goldenSectionMinimum(
+      f, std::max(0.0, (best - 1.0) / samples), std::min(1.0, (best + 1.0) / samples), 1e-15);
     const double distance = f(u);
     if (distance > onTolerance(surface))
     {
