@@ -524,13 +524,12 @@ private:
     const MapEntry& to = required(keys, "to", node, entityText);
     edge.from = vertexRef(from.value, from.line, entityText);
     edge.to = vertexRef(to.value, to.line, entityText);
-    if (kindName == "line")
+    const bool known = edgeKindFromName(kindName, edge.kind); // the one table of edge kinds
+    if (known && edge.kind == Edge::Kind::Line)
     {
-      edge.kind = Edge::Kind::Line;
     }
-    else if (kindName == "arc")
+    else if (known && edge.kind == Edge::Kind::Arc)
     {
-      edge.kind = Edge::Kind::Arc;
       const MapEntry* centre = syntax::findEntry(keys, "centre");
       const MapEntry* through = syntax::findEntry(keys, "through");
       if ((centre != nullptr) == (through != nullptr))
@@ -547,9 +546,8 @@ private:
         edge.arcThrough = vector3(through->value, through->line, entityText, "through");
       }
     }
-    else if (kindName == "spline")
+    else if (known && edge.kind == Edge::Kind::Spline)
     {
-      edge.kind = Edge::Kind::Spline;
       const MapEntry& points = required(keys, "points", node, entityText);
       if (!points.value.IsSequence())
       {
@@ -560,9 +558,10 @@ private:
         edge.splinePoints.push_back(vector3(point, points.line, entityText, "point"));
       }
     }
-    else if (kindName == "on_curve" || kindName == "on_surface" || kindName == "project")
+    else if (known &&
+      (edge.kind == Edge::Kind::OnCurve || edge.kind == Edge::Kind::OnSurface ||
+        edge.kind == Edge::Kind::Project))
     {
-      edgeKindFromName(kindName, edge.kind);
       const MapEntry& carrier = required(keys, "carrier", node, entityText);
       edge.carrier = carrierRef(carrier.value, carrier.line, entityText);
       if (const MapEntry* at = syntax::findEntry(keys, "at"))
@@ -577,9 +576,8 @@ private:
         }
       }
     }
-    else if (kindName == "periodic" || kindName == "follow")
+    else if (known && (edge.kind == Edge::Kind::Periodic || edge.kind == Edge::Kind::Follow))
     {
-      edgeKindFromName(kindName, edge.kind);
       const MapEntry& source = required(keys, "source", node, entityText);
       const std::string sourceName = text(source.value, source.line, entityText, "source");
       for (std::size_t e = 0; e < Model.edges.size(); ++e)

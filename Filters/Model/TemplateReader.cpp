@@ -698,18 +698,20 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
   }
   const MapEntry* at = syntax::findEntry(keys, "at");
   const MapEntry* pitches = syntax::findEntry(keys, "pitches");
-  if (pitches && kind->key != "periodic")
+  Edge::Kind edgeKind = Edge::Kind::Line;
+  edgeKindFromName(kind->key, edgeKind); // one of carrierEdgeKindNames(), found above
+  if (pitches && edgeKind != Edge::Kind::Periodic)
   {
     fail(pitches->line, entityText, "'pitches' belongs to periodic edges");
   }
-  if (kind->key == "periodic" || kind->key == "follow")
+  if (edgeKind == Edge::Kind::Periodic || edgeKind == Edge::Kind::Follow)
   {
     if (at)
     {
       fail(at->line, entityText,
         "a " + kind->key + " edge takes its shape from its source edge, not from 'at'");
     }
-    edge.kind = kind->key == "periodic" ? Edge::Kind::Periodic : Edge::Kind::Follow;
+    edge.kind = edgeKind;
     const std::string sourceName = name(kind->value, kind->line, entityText, kind->key);
     for (std::size_t e = 0; e < Model.edges.size(); ++e)
     {
@@ -732,7 +734,7 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
           "; the source edge must be defined above this one");
     }
   }
-  if (kind->key == "periodic")
+  if (edgeKind == Edge::Kind::Periodic)
   {
     edge.pitches = 1;
     if (pitches)
@@ -750,11 +752,11 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
         "a periodic edge needs the blade count: " + Evaluator.Unavailable["pitch"]);
     }
   }
-  else if (kind->key != "follow") // a follow edge is its source's shape at its own ends
+  else if (edgeKind != Edge::Kind::Follow) // a follow edge is its source's shape at its own ends
   {
-    const Want want = kind->key == "on_curve" ? Want::Curve : Want::Surface;
+    const Want want = edgeKind == Edge::Kind::OnCurve ? Want::Curve : Want::Surface;
     edge.carrier = carrierRef(kind->value, kind->line, entityText, kind->key, want);
-    edgeKindFromName(kind->key, edge.kind);
+    edge.kind = edgeKind;
     if (at)
     {
       if (edge.kind == Edge::Kind::Project)
