@@ -178,6 +178,29 @@ struct PlacementGraph
   int vertexCount = 0;
   std::vector<std::vector<int>> followers;
   std::vector<int> order; ///< every node after the nodes it follows
+
+  /// The nodes reached from `starts` (included) along followers; with `stopAtVertices`
+  /// the walk goes on only through carriers.
+  std::vector<char> reach(const std::vector<int>& starts, bool stopAtVertices) const
+  {
+    std::vector<char> reached(followers.size(), 0);
+    std::vector<int> stack(starts.begin(), starts.end());
+    while (!stack.empty())
+    {
+      const int node = stack.back();
+      stack.pop_back();
+      if (reached[node])
+      {
+        continue;
+      }
+      reached[node] = 1;
+      if (!stopAtVertices || node >= vertexCount)
+      {
+        stack.insert(stack.end(), followers[node].begin(), followers[node].end());
+      }
+    }
+    return reached;
+  }
 };
 
 PlacementGraph placementGraph(const BlockModel& model)
@@ -322,26 +345,15 @@ std::vector<std::vector<int>> vertexDependents(const BlockModel& model)
   std::vector<std::vector<int>> dependents(vertexCount);
   for (int v = 0; v < vertexCount; ++v)
   {
-    // followers, through carriers to the vertices on them
-    std::vector<int> stack(graph.followers[v].begin(), graph.followers[v].end());
-    std::vector<char> seen(graph.followers.size(), 0);
-    while (!stack.empty())
+    // followers, through carriers to the vertices on them (not further)
+    const std::vector<char> reached = graph.reach(graph.followers[v], true);
+    for (int w = 0; w < vertexCount; ++w)
     {
-      const int node = stack.back();
-      stack.pop_back();
-      if (seen[node])
+      if (reached[w])
       {
-        continue;
+        dependents[v].push_back(w);
       }
-      seen[node] = 1;
-      if (node < vertexCount)
-      {
-        dependents[v].push_back(node);
-        continue;
-      }
-      stack.insert(stack.end(), graph.followers[node].begin(), graph.followers[node].end());
     }
-    std::sort(dependents[v].begin(), dependents[v].end());
   }
   return dependents;
 }
@@ -365,26 +377,15 @@ std::vector<int> applyPlacement(
 {
   const PlacementGraph graph = placementGraph(model);
   const int vertexCount = graph.vertexCount;
-  std::vector<char> affected(graph.followers.size(), 0);
-  std::vector<int> stack;
+  std::vector<int> starts;
   for (const int v : moved)
   {
     if (v >= 0 && v < vertexCount)
     {
-      stack.push_back(v);
+      starts.push_back(v);
     }
   }
-  while (!stack.empty())
-  {
-    const int node = stack.back();
-    stack.pop_back();
-    if (affected[node])
-    {
-      continue;
-    }
-    affected[node] = 1;
-    stack.insert(stack.end(), graph.followers[node].begin(), graph.followers[node].end());
-  }
+  const std::vector<char> affected = graph.reach(starts, false);
   std::vector<int> applied;
   std::vector<char> changedCarrier(model.carriers.size(), 0);
   for (const int node : graph.order)

@@ -148,20 +148,12 @@ private:
       return;
     }
     const Vertex& vertex = Model.vertices[index];
-    double axial = 0.0, radius = 0.0, theta = 0.0;
-    cylindricalAbout(Model.machine, Model.expressionScope.thetaZero, vertex.position, axial,
-      radius, theta);
-    Evaluator.defineQuery(name + ".x", vertex.position.x());
-    Evaluator.defineQuery(name + ".y", vertex.position.y());
-    Evaluator.defineQuery(name + ".z", vertex.position.z());
-    Evaluator.defineQuery(name + ".axial", axial);
-    Evaluator.defineQuery(name + ".radius", radius);
-    Evaluator.defineQuery(name + ".theta", theta);
-    if (vertex.constraint.carrier >= 0)
-    {
-      Evaluator.defineQuery(name + ".s", vertex.constraint.s);
-      Evaluator.defineQuery(name + ".t", vertex.constraint.t);
-    }
+    double cylindrical[3] = { 0.0, 0.0, 0.0 };
+    cylindricalAbout(Model.machine, Model.expressionScope.thetaZero, vertex.position,
+      cylindrical[0], cylindrical[1], cylindrical[2]);
+    const double st[2] = { vertex.constraint.s, vertex.constraint.t };
+    Evaluator.defineVertexQueries(
+      name, vertex.position.data(), cylindrical, vertex.constraint.carrier >= 0 ? st : nullptr);
   }
 
   const BlockModel& Model;

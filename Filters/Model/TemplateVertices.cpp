@@ -124,21 +124,13 @@ void TemplateReader::defineVertexQueries(const Vertex& vertex)
   {
     return; // names with '-' cannot appear in expressions
   }
-  double axial = 0.0, radius = 0.0, theta = 0.0;
-  cylindrical(vertex.position, axial, radius, theta);
+  double cylindricalValues[3] = { 0.0, 0.0, 0.0 };
+  cylindrical(vertex.position, cylindricalValues[0], cylindricalValues[1], cylindricalValues[2]);
   const std::string& n = vertex.name;
-  Evaluator.defineQuery(n + ".x", vertex.position.x());
-  Evaluator.defineQuery(n + ".y", vertex.position.y());
-  Evaluator.defineQuery(n + ".z", vertex.position.z());
-  Evaluator.defineQuery(n + ".axial", axial);
-  Evaluator.defineQuery(n + ".radius", radius);
-  Evaluator.defineQuery(n + ".theta", theta);
-  if (vertex.constraint.carrier >= 0)
-  {
-    Evaluator.defineQuery(n + ".s", vertex.constraint.s);
-    Evaluator.defineQuery(n + ".t", vertex.constraint.t);
-  }
-  else
+  const double st[2] = { vertex.constraint.s, vertex.constraint.t };
+  Evaluator.defineVertexQueries(
+    n, vertex.position.data(), cylindricalValues, vertex.constraint.carrier >= 0 ? st : nullptr);
+  if (vertex.constraint.carrier < 0)
   {
     const std::string why = "vertex '" + n + "' is not attached to a carrier, so it has no "
                                              "parameters s, t";
