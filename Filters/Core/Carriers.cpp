@@ -391,6 +391,31 @@ Vec3 SurfaceOfRevolution::point(double s, double t) const
     rotateVector(Contour->point(s) - AxisPoint, AxisDirection, std::cos(angle), std::sin(angle));
 }
 
+// point() at the five parameters: three contour points and three angles, each once.
+void SurfaceOfRevolution::crossPoints(double s, double sPlus, double sMinus, double t,
+  double tPlus, double tMinus, Vec3 out[5]) const
+{
+  const Vec3 contour[3] = { Contour->point(s), Contour->point(sPlus), Contour->point(sMinus) };
+  double angle[3], cs[3], sn[3];
+  const double at[3] = { t, tPlus, tMinus };
+  for (int k = 0; k < 3; ++k)
+  {
+    angle[k] = AngleStart + at[k] * (AngleEnd - AngleStart);
+    cs[k] = std::cos(angle[k]);
+    sn[k] = std::sin(angle[k]);
+  }
+  auto rotated = [&](int c, int a) {
+    return angle[a] == 0.0
+      ? contour[c]
+      : Vec3(AxisPoint + rotateVector(contour[c] - AxisPoint, AxisDirection, cs[a], sn[a]));
+  };
+  out[0] = rotated(0, 0);
+  out[1] = rotated(1, 0);
+  out[2] = rotated(2, 0);
+  out[3] = rotated(0, 1);
+  out[4] = rotated(0, 2);
+}
+
 void SurfaceOfRevolution::contourJet(double s, int order, Vec3 (&c)[3]) const
 {
   if (ContourSpline)

@@ -43,6 +43,8 @@ public:
   Vec3 point(double s, double t) const override;
   void derivatives(double s, double t, SurfaceDerivatives& out) const override;
   void firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const override;
+  void crossPoints(double s, double sPlus, double sMinus, double t, double tPlus, double tMinus,
+    Vec3 out[5]) const override;
 
   const Vec3& axisPoint() const { return AxisPoint; }
   const Vec3& axisDirection() const { return AxisDirection; } ///< unit vector
