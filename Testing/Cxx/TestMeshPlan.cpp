@@ -2,6 +2,7 @@
 // plan recomputes only the blocks that depend on it, the result is the grid a fresh mesher
 // makes of the moved model bit for bit, and infeasible moves come back as values.
 #include "MeshPlan.h"
+#include "ControlProblem.h"
 
 #include <cstdio>
 #include "ModelDocument.h"
@@ -312,6 +313,39 @@ TEST(Placement, ExpressionAndCurveChainsFollowMovesAsTheTemplateWould)
   const std::vector<int>& updated = plan.updatedBlocks();
   EXPECT_NE(std::find(updated.begin(), updated.end(), plan.model().findBlock("M_L")), updated.end());
   expectSameAsFreshMesher(plan);
+}
+
+TEST(Placement, ManualMovesThroughTheDocumentFollowAsTheTemplateWould)
+{
+  // ControlPointMoves as BlockOptimizer applies them, on the model read back from its
+  // document (what travels between the pipeline's filters).
+  const Passage& passage = rotor37Passage();
+  BlockModel model = readModelDocument(writeModelDocument(passage.model));
+  CarrierGeometry geometry(model);
+  const int ob = vertexIndex(model, "ob_r_s");
+  const double moved = model.vertices[ob].constraint.s - 0.003;
+  optimize::applyMoves(model, geometry, { { "ob_r_s", { moved } } });
+  CarrierGeometry carriers;
+  const std::string text = test::readText(test::templatePath("axial_passage_oh.yaml"));
+  const std::size_t at = text.find("  ob_r_s: {on_curve: o_s, at: ");
+  ASSERT_NE(at, std::string::npos);
+  const BlockModel expected = rotor37With(text.substr(at, text.find('\n', at) - at),
+    "  ob_r_s: {on_curve: o_s, at: " + exactNumber(moved) + "}", carriers);
+  int followed = 0;
+  for (std::size_t v = 0; v < model.vertices.size(); ++v)
+  {
+    EXPECT_TRUE(test::sameBits(model.vertices[v].position, expected.vertices[v].position))
+      << model.vertices[v].name;
+    followed += model.vertices[v].position != passage.model.vertices[v].position ? 1 : 0;
+  }
+  EXPECT_GE(followed, 5); // ob_r_s, b_r_s, lo_r_s, hi_r_s, b_out_s, lo_out_s, ...
+  const int line = model.findCarrier("lo_s");
+  EXPECT_EQ(model.carriers[line].parameterPoints, expected.carriers[line].parameterPoints);
+  const test::Grid grid = test::meshAll(model), reference = test::meshAll(expected);
+  for (std::size_t b = 0; b < grid.xyz.size(); ++b)
+  {
+    EXPECT_TRUE(test::sameBits(grid.xyz[b], reference.xyz[b])) << model.blocks[b].name;
+  }
 }
 
 TEST(Placement, CyclesAreReported)
