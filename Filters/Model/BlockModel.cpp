@@ -58,6 +58,13 @@ int BlockModel::requiredFormat() const
       return 4;
     }
   }
+  for (const Edge& edge : edges)
+  {
+    if (!edge.atFollows.empty())
+    {
+      return 4;
+    }
+  }
   for (const Carrier& carrier : carriers)
   {
     for (const int vertex : carrier.throughVertices)

@@ -226,6 +226,11 @@ struct Edge
   /// the end vertices (their constraint on this carrier, else their projection). Values
   /// outside [0, 1] wrap around a closed carrier.
   std::vector<double> at;
+  /// `at` given by expressions that refer to vertices (format 4): one text per value of
+  /// `at`, and the vertices they refer to (directly or through definitions); the values
+  /// are evaluated again when those vertices move (Placement.h).
+  std::vector<std::string> atExpressions;
+  std::vector<int> atFollows;
   int source = -1; ///< Periodic: the edge this one is the image of; Follow: the one it follows
   int pitches = 0; ///< Periodic
   SourceLocation where;

@@ -292,9 +292,10 @@ void followEdgeEnds(
   BlockModel& model, const CarrierGeometry& geometry, int index, const std::vector<char>& movedVertex)
 {
   Edge& edge = model.edges[index];
-  if (edge.at.empty() || (edge.kind != Edge::Kind::OnCurve && edge.kind != Edge::Kind::OnSurface))
+  if (edge.at.empty() || !edge.atExpressions.empty() ||
+    (edge.kind != Edge::Kind::OnCurve && edge.kind != Edge::Kind::OnSurface))
   {
-    return;
+    return; // ends given by expressions: the placement evaluates them again
   }
   const bool surface = edge.kind == Edge::Kind::OnSurface;
   const std::size_t per = surface ? 2 : 1;

@@ -66,7 +66,8 @@ std::vector<NamedCurve> buildNamedCurves(const BlockModel& model, const CarrierG
  * Keeps the explicit end parameters (`at`) of an on_curve or on_surface edge on its end
  * vertices after they moved: each moved end takes its vertex's parameters on the edge's
  * carrier; on closed carriers the change is taken the short way round, so an edge that
- * ran across the seam (ends outside [0, 1]) still does.
+ * ran across the seam (ends outside [0, 1]) still does. Ends given by expressions of
+ * vertices are left to the placement (applyPlacement evaluates them again).
  */
 void followEdgeEnds(
   BlockModel& model, const CarrierGeometry& geometry, int edge, const std::vector<char>& movedVertex);

@@ -33,6 +33,8 @@ struct MeshPlan::Impl
   /// The curve and surface of every carrier as last meshed: a carrier whose shape is no
   /// longer these was drawn again by the placement (a curve through moved vertices).
   std::vector<std::pair<const void*, const void*>> CarrierShapes;
+  /// The `at` of every edge as last meshed: the placement evaluates `at` expressions again.
+  std::vector<std::vector<double>> EdgeEnds;
 
   std::pair<const void*, const void*> shape(int c) const
   {
@@ -165,6 +167,10 @@ MeshPlan::MeshPlan(const BlockModel& model, const CarrierGeometry& carriers, dou
   {
     P->CarrierShapes.push_back(P->shape(c));
   }
+  for (const Edge& edge : P->Model.edges)
+  {
+    P->EdgeEnds.push_back(edge.at);
+  }
   P->Nodes.resize(P->Model.blocks.size());
   for (int b = 0; b < blockCount(); ++b)
   {
@@ -249,10 +255,9 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
   for (std::size_t e = 0; e < model.edges.size(); ++e)
   {
     const int carrier = model.edges[e].carrier;
-    rebuilt[e] = carrier >= 0 && carrier < static_cast<int>(changedCarrier.size()) &&
-        changedCarrier[carrier]
-      ? 1
-      : 0;
+    const bool onChanged = carrier >= 0 && carrier < static_cast<int>(changedCarrier.size()) &&
+      changedCarrier[carrier];
+    rebuilt[e] = onChanged || model.edges[e].at != EdgeEnds[e] ? 1 : 0;
   }
   for (const int v : moved)
   {
@@ -392,6 +397,10 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
   for (std::size_t c = 0; c < model.carriers.size(); ++c)
   {
     CarrierShapes[c] = shape(static_cast<int>(c));
+  }
+  for (std::size_t e = 0; e < model.edges.size(); ++e)
+  {
+    EdgeEnds[e] = model.edges[e].at;
   }
 }
 

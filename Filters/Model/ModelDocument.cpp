@@ -515,7 +515,8 @@ private:
   {
     Edge edge;
     const auto keys = entries(node, "edge",
-      { "kind", "from", "to", "centre", "through", "points", "carrier", "at", "source", "pitches" },
+      { "kind", "from", "to", "centre", "through", "points", "carrier", "at", "at_expressions",
+        "at_follows", "source", "pitches" },
       edge.name, edge.where);
     const std::string entityText = entity("edge", edge.name);
     const MapEntry& kind = required(keys, "kind", node, entityText);
@@ -573,6 +574,29 @@ private:
         for (const YAML::Node& value : at->value)
         {
           edge.at.push_back(number(value, at->line, entityText, "at"));
+        }
+      }
+      const MapEntry* texts = syntax::findEntry(keys, "at_expressions");
+      const MapEntry* follows = syntax::findEntry(keys, "at_follows");
+      if ((texts != nullptr) != (follows != nullptr))
+      {
+        fail((texts ? texts : follows)->line, entityText,
+          "'at_expressions' and 'at_follows' come together");
+      }
+      if (texts)
+      {
+        if (!texts->value.IsSequence() || texts->value.size() != edge.at.size() ||
+          !follows->value.IsSequence())
+        {
+          fail(texts->line, entityText, "'at_expressions' gives one expression per value of 'at'");
+        }
+        for (const YAML::Node& text : texts->value)
+        {
+          edge.atExpressions.push_back(this->text(text, texts->line, entityText, "at_expressions"));
+        }
+        for (const YAML::Node& vertex : follows->value)
+        {
+          edge.atFollows.push_back(vertexRef(vertex, follows->line, entityText));
         }
       }
     }
@@ -1205,6 +1229,21 @@ std::string writeModelDocument(const BlockModel& model)
         for (double value : edge.at)
         {
           out << formatNumber(value);
+        }
+        out << YAML::EndSeq;
+      }
+      if (!edge.atFollows.empty())
+      {
+        out << YAML::Key << "at_expressions" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+        for (const std::string& text : edge.atExpressions)
+        {
+          out << YAML::DoubleQuoted << text;
+        }
+        out << YAML::EndSeq;
+        out << YAML::Key << "at_follows" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+        for (const int vertex : edge.atFollows)
+        {
+          out << vertexName(model, vertex, user);
         }
         out << YAML::EndSeq;
       }

@@ -403,6 +403,23 @@ std::vector<int> applyPlacement(
     applyRule(model, geometry, node);
     applied.push_back(node);
   }
+  for (std::size_t e = 0; e < model.edges.size(); ++e)
+  {
+    const Edge& edge = model.edges[e];
+    if (std::any_of(edge.atFollows.begin(), edge.atFollows.end(),
+          [&](int v) { return v >= 0 && v < vertexCount && affected[v]; }))
+    {
+      try
+      {
+        evaluateEdgeEnds(model, static_cast<int>(e));
+      }
+      catch (const GeometryError& error)
+      {
+        throw TemplateError(edge.where.file, edge.where.line, syntax::entity("edge", edge.name),
+          std::string("its 'at' expressions no longer place its ends: ") + error.what());
+      }
+    }
+  }
   return applied;
 }
 

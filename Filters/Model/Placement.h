@@ -49,6 +49,10 @@ Vec3 fromCylindricalAbout(
 void revolutionParametersAt(const BlockModel& model, const CarrierGeometry& geometry,
   const Vec3& thetaZero, int surface, double axial, double theta, double& s, double& t);
 
+/// Evaluates the `at` expressions of edge `index` again with the current positions of
+/// the vertices they refer to (Edge::atExpressions). Throws GeometryError.
+void evaluateEdgeEnds(BlockModel& model, int index);
+
 /// The parameters (s, t) vertex `index`'s placement expressions give with the current
 /// positions of the vertices they refer to. Throws GeometryError.
 Eigen::Vector2d evaluatePlacementExpressions(
@@ -87,7 +91,8 @@ std::vector<int> placementOrder(const BlockModel& model);
 std::vector<int> applyPlacement(
   BlockModel& model, CarrierGeometry& geometry, const std::vector<int>& moved);
 /// (applyPlacement: curves drawn through moved vertices are drawn again in `geometry`,
-/// with the carriers built on them, before the vertices on them are placed.)
+/// with the carriers built on them, before the vertices on them are placed; edge ends
+/// given by expressions of moved vertices are evaluated again.)
 
 /// A parameter the optimizer (or a manual move) may change: component 0 (s) or 1 (t) of
 /// a control point's carrier parameters, within [low, high]; `wraps` on closed carriers.

@@ -163,6 +163,29 @@ private:
 };
 } // namespace
 
+void evaluateEdgeEnds(BlockModel& model, int index)
+{
+  Edge& edge = model.edges[index];
+  if (edge.atExpressions.size() != edge.at.size())
+  {
+    return;
+  }
+  PlacementScope scope(model);
+  std::vector<double> at;
+  for (const std::string& text : edge.atExpressions)
+  {
+    try
+    {
+      at.push_back(scope.evaluate(text));
+    }
+    catch (const detail::ExpressionError& error)
+    {
+      throw GeometryError(error.message);
+    }
+  }
+  edge.at = at;
+}
+
 Eigen::Vector2d evaluatePlacementExpressions(
   const BlockModel& model, const CarrierGeometry& geometry, int index)
 {

@@ -297,8 +297,11 @@ Vec3 TemplateReader::fromCylindrical(double axial, double radius, double theta) 
 
 void TemplateReader::recordExpressionScope()
 {
-  const bool follows = std::any_of(Model.vertices.begin(), Model.vertices.end(),
-    [](const Vertex& v) { return v.rule.expressions.form != PlacementExpressions::Form::None; });
+  const bool follows =
+    std::any_of(Model.vertices.begin(), Model.vertices.end(),
+      [](const Vertex& v) { return v.rule.expressions.form != PlacementExpressions::Form::None; }) ||
+    std::any_of(Model.edges.begin(), Model.edges.end(),
+      [](const Edge& e) { return !e.atFollows.empty(); });
   if (!follows)
   {
     return;

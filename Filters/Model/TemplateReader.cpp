@@ -769,12 +769,15 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
           edge.kind == Edge::Kind::OnCurve ? "'at' expects [u_a, u_b]"
                                            : "'at' expects [[s_a, t_a], [s_b, t_b]]");
       }
+      Referenced.emplace_back(); // the vertices the ends follow
+      std::vector<std::string> texts;
       for (int end = 0; end < 2; ++end)
       {
         const YAML::Node item = at->value[end];
         if (edge.kind == Edge::Kind::OnCurve)
         {
           edge.at.push_back(number(item, at->line, entityText, "at"));
+          texts.push_back(item.Scalar());
         }
         else
         {
@@ -784,8 +787,16 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
           }
           edge.at.push_back(number(item[0], at->line, entityText, "at s"));
           edge.at.push_back(number(item[1], at->line, entityText, "at t"));
+          texts.push_back(item[0].Scalar());
+          texts.push_back(item[1].Scalar());
         }
       }
+      if (!Referenced.back().empty())
+      {
+        edge.atExpressions = texts;
+        edge.atFollows.assign(Referenced.back().begin(), Referenced.back().end());
+      }
+      Referenced.pop_back();
     }
   }
   addEdge(edge, entry.line, entityText);

@@ -158,6 +158,11 @@ TEST(Placement, RulesTravelInTheModelDocument)
     EXPECT_EQ(reread.vertices[v].rule.expressions.texts, rule.expressions.texts);
     EXPECT_EQ(reread.vertices[v].rule.expressions.follows, rule.expressions.follows);
   }
+  const int arc = reread.findEdge(vertexIndex(model, "oa_f_h"), vertexIndex(model, "oa_r_h"));
+  ASSERT_GE(arc, 0);
+  EXPECT_EQ(reread.edges[arc].atExpressions, model.edges[arc].atExpressions);
+  EXPECT_EQ(reread.edges[arc].atFollows, model.edges[arc].atFollows);
+  EXPECT_FALSE(reread.edges[arc].atFollows.empty()); // ol_a_h: at: [oa_f_h.s, ...]
   EXPECT_EQ(writeModelDocument(reread), document);
   // The reread model places its vertices as the template did, bit for bit.
   BlockModel replaced = reread;
@@ -183,6 +188,11 @@ TEST(Placement, RulesTravelInTheModelDocument)
   for (Carrier& carrier : withoutExpressions.carriers)
   {
     carrier.throughVertices.clear();
+  }
+  for (Edge& edge : withoutExpressions.edges)
+  {
+    edge.atExpressions.clear();
+    edge.atFollows.clear();
   }
   withoutExpressions.expressionScope = ExpressionScope();
   const std::string format3 = writeModelDocument(withoutExpressions);
@@ -254,42 +264,53 @@ TEST(Placement, ExpressionAndCurveChainsFollowMovesAsTheTemplateWould)
   EXPECT_TRUE(std::binary_search(dependents[lo].begin(), dependents[lo].end(), loIn));
   EXPECT_TRUE(std::binary_search(dependents[lo].begin(), dependents[lo].end(), hi));
 
-  // oa_f_h moved through the mesh plan, against the template with oa_f_h given there.
+  // oa_f_h moved through the mesh plan, against the template with oa_f_h given there (the
+  // plan moved on from one place to the next; 0.0013 once differed in an O-grid arc whose
+  // end is given by an expression, before `at` expressions were evaluated again).
   MeshPlan plan(model, passage.carriers);
   const FreeParameter s = sParameter(freeParameters(plan.model(), plan.carriers()), oa);
-  const double moved = model.vertices[oa].constraint.s + 0.004;
-  const Feasibility feasibility = plan.update(moveParameter(plan.model(), plan.carriers(), s, moved));
-  ASSERT_TRUE(feasibility.feasible()) << feasibility.message;
-  CarrierGeometry carriers;
   const std::string corner = test::readText(test::templatePath("axial_passage_oh.yaml"));
   const std::size_t at = corner.find("  oa_f_h: {on_curve: o_h, at: ");
   ASSERT_NE(at, std::string::npos);
   const std::string line0 = corner.substr(at, corner.find('\n', at) - at);
-  const BlockModel expected = rotor37With(
-    line0, "  oa_f_h: {on_curve: o_h, at: " + exactNumber(moved) + "}", carriers);
-  ASSERT_EQ(expected.vertices[oa].constraint.s, moved);
-  const BlockModel& followed = plan.model();
-  for (std::size_t v = 0; v < model.vertices.size(); ++v)
+  for (const double delta : { 0.004, 0.0013, -0.003 })
   {
-    EXPECT_TRUE(test::sameBits(followed.vertices[v].position, expected.vertices[v].position))
-      << model.vertices[v].name;
-    EXPECT_EQ(followed.vertices[v].constraint.s, expected.vertices[v].constraint.s);
-    EXPECT_EQ(followed.vertices[v].constraint.t, expected.vertices[v].constraint.t);
-  }
-  EXPECT_GT((followed.vertices[lo].position - model.vertices[lo].position).norm(), 1e-6);
-  EXPECT_GT((followed.vertices[loIn].position - model.vertices[loIn].position).norm(), 1e-6);
-  EXPECT_EQ(followed.carriers[line].parameterPoints, expected.carriers[line].parameterPoints);
-  // The curve drawn again is the template's, and the plan's grid is the grid of the moved
-  // model (expectSameAsFreshMesher) and, bit for bit, the template's.
-  for (const double u : { 0.0, 0.3, 0.5, 1.0 })
-  {
-    EXPECT_TRUE(test::sameBits(plan.carriers().point(line, u), carriers.point(line, u)));
-  }
-  expectSameAsFreshMesher(plan);
-  const test::Grid grid = test::meshAll(expected);
-  for (int b = 0; b < plan.blockCount(); ++b)
-  {
-    EXPECT_TRUE(test::sameBits(plan.blockNodes(b), grid.xyz[b])) << model.blocks[b].name;
+    SCOPED_TRACE(delta);
+    const double moved = model.vertices[oa].constraint.s + delta;
+    const Feasibility feasibility =
+      plan.update(moveParameter(plan.model(), plan.carriers(), s, moved));
+    ASSERT_TRUE(feasibility.feasible()) << feasibility.message;
+    CarrierGeometry carriers;
+    const BlockModel expected = rotor37With(
+      line0, "  oa_f_h: {on_curve: o_h, at: " + exactNumber(moved) + "}", carriers);
+    ASSERT_EQ(expected.vertices[oa].constraint.s, moved);
+    const BlockModel& followed = plan.model();
+    for (std::size_t v = 0; v < model.vertices.size(); ++v)
+    {
+      EXPECT_TRUE(test::sameBits(followed.vertices[v].position, expected.vertices[v].position))
+        << model.vertices[v].name;
+      EXPECT_EQ(followed.vertices[v].constraint.s, expected.vertices[v].constraint.s);
+      EXPECT_EQ(followed.vertices[v].constraint.t, expected.vertices[v].constraint.t);
+    }
+    for (std::size_t e = 0; e < model.edges.size(); ++e)
+    {
+      EXPECT_EQ(followed.edges[e].at, expected.edges[e].at) << model.edges[e].name;
+    }
+    EXPECT_GT((followed.vertices[lo].position - model.vertices[lo].position).norm(), 1e-6);
+    EXPECT_GT((followed.vertices[loIn].position - model.vertices[loIn].position).norm(), 1e-6);
+    EXPECT_EQ(followed.carriers[line].parameterPoints, expected.carriers[line].parameterPoints);
+    // The curve drawn again is the template's, and the plan's grid is the grid of the
+    // moved model (expectSameAsFreshMesher) and, bit for bit, the template's.
+    for (const double u : { 0.0, 0.3, 0.5, 1.0 })
+    {
+      EXPECT_TRUE(test::sameBits(plan.carriers().point(line, u), carriers.point(line, u)));
+    }
+    expectSameAsFreshMesher(plan);
+    const test::Grid grid = test::meshAll(expected);
+    for (int b = 0; b < plan.blockCount(); ++b)
+    {
+      EXPECT_TRUE(test::sameBits(plan.blockNodes(b), grid.xyz[b])) << model.blocks[b].name;
+    }
   }
 
   // The middle point of the periodic line moved alone (no edge ends there): the line is
