@@ -89,7 +89,24 @@ void periodicParameters(const BlockModel& model, const CarrierGeometry& geometry
 }
 } // namespace
 
+namespace
+{
+void applyRuleIn(BlockModel& model, const CarrierGeometry& geometry, int index,
+  std::unique_ptr<PlacementScope>& scope);
+}
+
 void applyRule(BlockModel& model, const CarrierGeometry& geometry, int index)
+{
+  std::unique_ptr<PlacementScope> scope;
+  applyRuleIn(model, geometry, index, scope);
+}
+
+namespace
+{
+/// applyRule with the expression scope of the placement it is part of (made when first
+/// needed).
+void applyRuleIn(BlockModel& model, const CarrierGeometry& geometry, int index,
+  std::unique_ptr<PlacementScope>& scope)
 {
   Vertex& vertex = model.vertices[index];
   const PlacementExpressions& expressions = vertex.rule.expressions;
@@ -99,7 +116,11 @@ void applyRule(BlockModel& model, const CarrierGeometry& geometry, int index)
     Eigen::Vector2d st;
     try
     {
-      st = evaluatePlacementExpressions(model, geometry, index);
+      if (!scope)
+      {
+        scope.reset(new PlacementScope(model));
+      }
+      st = evaluatePlacementExpressions(model, geometry, index, *scope);
     }
     catch (const GeometryError& error)
     {
@@ -124,7 +145,12 @@ void applyRule(BlockModel& model, const CarrierGeometry& geometry, int index)
     }
   }
   placeVertex(model, geometry, vertex);
+  if (scope)
+  {
+    scope->moved(index);
+  }
 }
+} // namespace
 
 void placeVertex(const BlockModel& model, const CarrierGeometry& geometry, Vertex& vertex)
 {
@@ -388,6 +414,7 @@ std::vector<int> applyPlacement(
   const std::vector<char> affected = graph.reach(starts, false);
   std::vector<int> applied;
   std::vector<char> changedCarrier(model.carriers.size(), 0);
+  std::unique_ptr<PlacementScope> scope; // one for every expression, made when needed
   for (const int node : graph.order)
   {
     if (!affected[node])
@@ -400,7 +427,7 @@ std::vector<int> applyPlacement(
       changedCarrier[c] = redrawCarrier(model, geometry, c, changedCarrier) ? 1 : 0;
       continue;
     }
-    applyRule(model, geometry, node);
+    applyRuleIn(model, geometry, node, scope);
     applied.push_back(node);
   }
   for (std::size_t e = 0; e < model.edges.size(); ++e)
@@ -411,7 +438,11 @@ std::vector<int> applyPlacement(
     {
       try
       {
-        evaluateEdgeEnds(model, static_cast<int>(e));
+        if (!scope)
+        {
+          scope.reset(new PlacementScope(model));
+        }
+        evaluateEdgeEnds(model, static_cast<int>(e), *scope);
       }
       catch (const GeometryError& error)
       {

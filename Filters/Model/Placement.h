@@ -17,6 +17,8 @@
 #include "BlockModel.h"
 #include "CarrierGeometry.h"
 
+#include <memory>
+#include <string>
 #include <vector>
 
 namespace blockforge
@@ -49,14 +51,41 @@ Vec3 fromCylindricalAbout(
 void revolutionParametersAt(const BlockModel& model, const CarrierGeometry& geometry,
   const Vec3& thetaZero, int surface, double axial, double theta, double& s, double& t);
 
+/**
+ * @class PlacementScope
+ * @brief The template's expressions evaluated again (parameters, machine values and
+ * carrier queries kept in the model, definitions evaluated when first used, vertex
+ * queries from the current positions), kept through one application of the placement:
+ * a definition is evaluated again only after a vertex it refers to moved (moved()).
+ */
+class PlacementScope
+{
+public:
+  explicit PlacementScope(const BlockModel& model);
+  ~PlacementScope();
+  PlacementScope(const PlacementScope&) = delete;
+  PlacementScope& operator=(const PlacementScope&) = delete;
+  /// The value of `text`; GeometryError saying why there is none.
+  double evaluate(const std::string& text);
+  /// Vertex `vertex` moved: its queries and the definitions referring to it are stale.
+  void moved(int vertex);
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> P;
+};
+
 /// Evaluates the `at` expressions of edge `index` again with the current positions of
 /// the vertices they refer to (Edge::atExpressions). Throws GeometryError.
 void evaluateEdgeEnds(BlockModel& model, int index);
+void evaluateEdgeEnds(BlockModel& model, int index, PlacementScope& scope);
 
 /// The parameters (s, t) vertex `index`'s placement expressions give with the current
 /// positions of the vertices they refer to. Throws GeometryError.
 Eigen::Vector2d evaluatePlacementExpressions(
   const BlockModel& model, const CarrierGeometry& geometry, int index);
+Eigen::Vector2d evaluatePlacementExpressions(
+  const BlockModel& model, const CarrierGeometry& geometry, int index, PlacementScope& scope);
 
 /**
  * Places `vertex` by its rule, from its parameters and the positions of the vertices of

@@ -99,15 +99,12 @@ void revolutionParametersAt(const BlockModel& model, const CarrierGeometry& geom
   }
 }
 
-namespace
-{
 /// The template's expression scope, evaluating definitions when first used and vertex
 /// queries from the current positions: the same values and the same operations as when
 /// the template was read, so the same bits for the same positions.
-class PlacementScope
+struct PlacementScope::Impl
 {
-public:
-  explicit PlacementScope(const BlockModel& model)
+  explicit Impl(const BlockModel& model)
     : Model(model)
   {
     for (const auto& value : model.expressionScope.values)
@@ -123,87 +120,126 @@ public:
     };
   }
 
-  double evaluate(const std::string& text) { return Evaluator.evaluate(text); }
-
-private:
   void resolve(const std::string& name, const std::string& attribute)
   {
-    if (!Resolved.insert(name).second)
-    {
-      return;
-    }
     if (attribute.empty())
     {
       const auto definition = Definitions.find(name);
-      if (definition != Definitions.end())
+      if (definition == Definitions.end())
       {
-        Evaluator.define(name, Evaluator.evaluate(*definition->second));
+        return; // a parameter or machine value: among the values
+      }
+      auto known = DefinitionVertices.find(name);
+      if (known == DefinitionVertices.end())
+      {
+        Collecting.emplace_back();
+        const double value = Evaluator.evaluate(*definition->second);
+        known = DefinitionVertices.emplace(name, std::move(Collecting.back())).first;
+        Collecting.pop_back();
+        Evaluator.define(name, value);
+      }
+      if (!Collecting.empty())
+      {
+        Collecting.back().insert(known->second.begin(), known->second.end());
       }
       return;
     }
     const int index = Model.findVertex(name);
     if (index < 0)
     {
-      Resolved.erase(name); // a carrier query: among the values already
-      return;
+      return; // a carrier query: among the values
     }
-    const Vertex& vertex = Model.vertices[index];
-    double cylindrical[3] = { 0.0, 0.0, 0.0 };
-    cylindricalAbout(Model.machine, Model.expressionScope.thetaZero, vertex.position,
-      cylindrical[0], cylindrical[1], cylindrical[2]);
-    const double st[2] = { vertex.constraint.s, vertex.constraint.t };
-    Evaluator.defineVertexQueries(
-      name, vertex.position.data(), cylindrical, vertex.constraint.carrier >= 0 ? st : nullptr);
+    if (Queried.insert(index).second)
+    {
+      const Vertex& vertex = Model.vertices[index];
+      double cylindrical[3] = { 0.0, 0.0, 0.0 };
+      cylindricalAbout(Model.machine, Model.expressionScope.thetaZero, vertex.position,
+        cylindrical[0], cylindrical[1], cylindrical[2]);
+      const double st[2] = { vertex.constraint.s, vertex.constraint.t };
+      Evaluator.defineVertexQueries(
+        name, vertex.position.data(), cylindrical, vertex.constraint.carrier >= 0 ? st : nullptr);
+    }
+    if (!Collecting.empty())
+    {
+      Collecting.back().insert(index);
+    }
   }
 
   const BlockModel& Model;
   detail::ExpressionEvaluator Evaluator;
   std::map<std::string, const std::string*> Definitions;
-  std::set<std::string> Resolved;
+  /// Definitions evaluated, with the vertices they refer to (directly or through others).
+  std::map<std::string, std::set<int>> DefinitionVertices;
+  std::vector<std::set<int>> Collecting;
+  std::set<int> Queried; ///< vertices whose queries are defined
 };
-} // namespace
 
-void evaluateEdgeEnds(BlockModel& model, int index)
+PlacementScope::PlacementScope(const BlockModel& model)
+  : P(new Impl(model))
+{
+}
+
+PlacementScope::~PlacementScope() = default;
+
+double PlacementScope::evaluate(const std::string& text)
+{
+  try
+  {
+    return P->Evaluator.evaluate(text);
+  }
+  catch (const detail::ExpressionError& error)
+  {
+    throw GeometryError(error.message);
+  }
+}
+
+void PlacementScope::moved(int vertex)
+{
+  P->Queried.erase(vertex);
+  for (auto it = P->DefinitionVertices.begin(); it != P->DefinitionVertices.end();)
+  {
+    it = it->second.count(vertex) ? P->DefinitionVertices.erase(it) : std::next(it);
+  }
+}
+
+void evaluateEdgeEnds(BlockModel& model, int index, PlacementScope& scope)
 {
   Edge& edge = model.edges[index];
   if (edge.atExpressions.size() != edge.at.size())
   {
     return;
   }
-  PlacementScope scope(model);
   std::vector<double> at;
   for (const std::string& text : edge.atExpressions)
   {
-    try
-    {
-      at.push_back(scope.evaluate(text));
-    }
-    catch (const detail::ExpressionError& error)
-    {
-      throw GeometryError(error.message);
-    }
+    at.push_back(scope.evaluate(text));
   }
   edge.at = at;
+}
+
+void evaluateEdgeEnds(BlockModel& model, int index)
+{
+  PlacementScope scope(model);
+  evaluateEdgeEnds(model, index, scope);
 }
 
 Eigen::Vector2d evaluatePlacementExpressions(
   const BlockModel& model, const CarrierGeometry& geometry, int index)
 {
+  PlacementScope scope(model);
+  return evaluatePlacementExpressions(model, geometry, index, scope);
+}
+
+Eigen::Vector2d evaluatePlacementExpressions(
+  const BlockModel& model, const CarrierGeometry& geometry, int index, PlacementScope& scope)
+{
   const Vertex& vertex = model.vertices[index];
   const PlacementExpressions& expressions = vertex.rule.expressions;
   const int carrier = vertex.constraint.carrier;
-  PlacementScope scope(model);
   std::vector<double> values;
   for (const std::string& text : expressions.texts)
   {
-    try
-    {
-      values.push_back(scope.evaluate(text));
-    }
-    catch (const detail::ExpressionError& error)
-    {
-      throw GeometryError(error.message);
-    }
+    values.push_back(scope.evaluate(text));
   }
   if (expressions.form == PlacementExpressions::Form::AxialTheta && values.size() == 2)
   {
