@@ -454,6 +454,13 @@ std::vector<int> applyPlacement(
   return applied;
 }
 
+std::vector<int> applyPlacement(
+  BlockModel& model, const CarrierGeometry& geometry, const std::vector<int>& moved)
+{
+  CarrierGeometry redrawn = geometry;
+  return applyPlacement(model, redrawn, moved);
+}
+
 std::vector<FreeParameter> freeParameters(const BlockModel& model, const CarrierGeometry& geometry)
 {
   std::vector<FreeParameter> parameters;
@@ -534,6 +541,13 @@ std::vector<int> moveParameter(BlockModel& model, CarrierGeometry& geometry,
                                          : std::max(parameter.low, std::min(parameter.high, value));
   setParameter(model, geometry, parameter.vertex, parameter.component, bounded);
   return applyPlacement(model, geometry, { parameter.vertex });
+}
+
+std::vector<int> moveParameter(BlockModel& model, const CarrierGeometry& geometry,
+  const FreeParameter& parameter, double value)
+{
+  CarrierGeometry redrawn = geometry;
+  return moveParameter(model, redrawn, parameter, value);
 }
 } // namespace model
 } // namespace blockforge

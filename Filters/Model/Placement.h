@@ -119,6 +119,11 @@ std::vector<int> placementOrder(const BlockModel& model);
  */
 std::vector<int> applyPlacement(
   BlockModel& model, CarrierGeometry& geometry, const std::vector<int>& moved);
+/// The same with carriers that stay as they are: curves through moved vertices are drawn
+/// again in a copy (the vertices on them are placed on the new curves; callers that keep
+/// carriers for later, such as a mesh plan, pass theirs to be changed).
+std::vector<int> applyPlacement(
+  BlockModel& model, const CarrierGeometry& geometry, const std::vector<int>& moved);
 /// (applyPlacement: curves drawn through moved vertices are drawn again in `geometry`,
 /// with the carriers built on them, before the vertices on them are placed; edge ends
 /// given by expressions of moved vertices are evaluated again.)
@@ -156,6 +161,8 @@ void rebasePlacementExpressions(BlockModel& model, const CarrierGeometry& geomet
 /// clamped into the bounds otherwise) and applies the placement; returns what
 /// applyPlacement returns.
 std::vector<int> moveParameter(BlockModel& model, CarrierGeometry& geometry,
+  const FreeParameter& parameter, double value);
+std::vector<int> moveParameter(BlockModel& model, const CarrierGeometry& geometry,
   const FreeParameter& parameter, double value);
 } // namespace model
 } // namespace blockforge
