@@ -30,15 +30,18 @@ using test::Pi;
 
 /**
  * Largest neighbour cell size ratio across block interfaces accepted, per template (see
- * checkFitness). Issue 8 asks for 1.5; measured on the four machines at densities 0.5-4:
- * axial_passage_h 1.6-7.1 (its blade blocks against the downstream ones), axial_passage_oh
- * 30-570 (its leading- and trailing-edge O blocks against the blade sides; worst on the
- * compressor's sharp trailing edge, growing with the density). These bounds only keep
- * them from getting worse.
+ * checkFitness). Issue 8 asks for about 1.5. axial_passage_h grades every edge with the
+ * `match` law (end cells from the edges continuing it across interfaces), measured on
+ * the four machines at densities 0.5-4: 1.10-1.73; above 1.5 only where a blade side
+ * leaves the round leading edge (distributor, density 4) or the blunt trailing edge
+ * (turbine, density 0.5) across the axial direction of the neighbour block, so its cell
+ * is thin across the interface however long it is along the blade. axial_passage_oh is
+ * not graded yet (30-570: its leading- and trailing-edge O blocks against the blade
+ * sides); these bounds keep both from getting worse.
  */
 double maxNeighbourRatio(const std::string& templateName)
 {
-  return templateName == "axial_passage_h" ? 8.0 : 600.0;
+  return templateName == "axial_passage_h" ? 1.75 : 600.0;
 }
 
 struct Machine
@@ -335,12 +338,13 @@ void checkFitness(const std::string& templateName, const Machine& machine)
     EXPECT_GT(jump.pairs, 0u);
     EXPECT_LE(jump.ratio, maxNeighbourRatio(templateName)) << jump.where;
 
+    const double expansion = test::maxExpansionInBlocks(grid);
     std::printf("FITNESS %s %s density %.1f cells %lld MinAngle %lld %lld %lld %lld %lld "
-                "minScaledJacobian %.4f maxNeighbourRatio %.3f (%s) volumeError %.2e "
-                "offSurface %.1e periodic %.1e templateSeconds %.3f\n",
+                "minScaledJacobian %.4f maxNeighbourRatio %.3f (%s) maxExpansion %.3f "
+                "volumeError %.2e offSurface %.1e periodic %.1e templateSeconds %.3f\n",
       templateName.c_str(), machine.name.c_str(), density, cells, classes[0], classes[1],
       classes[2], classes[3], classes[4], minJacobian, jump.ratio, jump.where.c_str(),
-      volumeError, offSurface, periodic, templateSeconds);
+      expansion, volumeError, offSurface, periodic, templateSeconds);
   }
 }
 
