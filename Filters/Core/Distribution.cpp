@@ -447,8 +447,25 @@ std::vector<double> matchedNodes(double first, double last, double length, int n
   const double mean = length / cells;
   if (first > mean || last > mean)
   {
-    return endSizes(first > 0.0 ? first / mean : std::min(1.0, last / mean),
-      last > 0.0 ? last / mean : std::min(1.0, first / mean), nodeCount);
+    if (first <= 0.0 || last <= 0.0)
+    {
+      // one end given: cells shrink geometrically from it towards the free end
+      const std::vector<double> s =
+        firstCellSolvedRatio(std::max(first, last), length, nodeCount);
+      if (first > 0.0)
+      {
+        return s;
+      }
+      std::vector<double> reversed(s.size());
+      for (std::size_t i = 0; i < s.size(); ++i)
+      {
+        reversed[i] = 1.0 - s[s.size() - 1 - i];
+      }
+      reversed.front() = 0.0;
+      reversed.back() = 1.0;
+      return reversed;
+    }
+    return endSizes(first / mean, last / mean, nodeCount);
   }
   // Cells grown by the ratio must reach the length, else the ratio is raised (bisection
   // on the growing total, deterministic).

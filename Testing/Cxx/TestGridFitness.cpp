@@ -31,17 +31,17 @@ using test::Pi;
 /**
  * Largest neighbour cell size ratio across block interfaces accepted, per template (see
  * checkFitness). Issue 8 asks for about 1.5. axial_passage_h grades every edge with the
- * `match` law (end cells from the edges continuing it across interfaces), measured on
- * the four machines at densities 0.5-4: 1.10-1.73; above 1.5 only where a blade side
- * leaves the round leading edge (distributor, density 4) or the blunt trailing edge
- * (turbine, density 0.5) across the axial direction of the neighbour block, so its cell
- * is thin across the interface however long it is along the blade. axial_passage_oh is
- * not graded yet (30-570: its leading- and trailing-edge O blocks against the blade
- * sides); these bounds keep both from getting worse.
+ * `match` law (end cells from the edges continuing it across interfaces); measured on the
+ * four machines at densities 0.5-4: 1.11-1.48, but 1.76 on the distributor at density 4,
+ * across the leading-edge plane between the upstream and blade blocks away from the
+ * vertices (the interior of a face blends its edges' distributions, which match at the
+ * vertices only). axial_passage_oh is not graded (30-570: its leading- and trailing-edge
+ * O blocks against the blade sides, see README); these bounds keep both from getting
+ * worse.
  */
 double maxNeighbourRatio(const std::string& templateName)
 {
-  return templateName == "axial_passage_h" ? 1.75 : 600.0;
+  return templateName == "axial_passage_h" ? 1.8 : 600.0;
 }
 
 struct Machine
@@ -328,9 +328,7 @@ void checkFitness(const std::string& templateName, const Machine& machine)
       a1 += cyl.axial(p) / outlet.size();
     const double volumeError =
       test::gridVolume(grid) / passageVolume(inputs, cyl, pitch, a0, a1) - 1.0;
-    // 0.5 %; at density 0.5 the turbine's thick round leading edge has 4 cells per half
-    // chord, and the polygon misses 0.84 % (H) of the passage: 1 % there.
-    EXPECT_LT(std::abs(volumeError), density < 1.0 ? 0.01 : 0.005);
+    EXPECT_LT(std::abs(volumeError), 0.005);
 
     // neighbour cells across block interfaces
     const test::NeighbourRatio jump =
