@@ -2,6 +2,7 @@
 // boundary nodes, bit-identical shared faces, density multiplier and preview cap,
 // determinism, periodicity, degenerate wedges and total volume.
 #include "Mesher.h"
+#include "ModelDocument.h"
 #include "Quality.h"
 #include "Template.h"
 
@@ -563,6 +564,12 @@ TEST(Mesher, MatchedEdgesTakeTheirEndCellsFromTheirNeighbours)
         EXPECT_NEAR(first, expected, 1e-12);
       }
     }
+  }
+  // The law travels in the model document (the pipeline's stages pass the model so).
+  const BlockModel reread = readModelDocument(writeModelDocument(model));
+  for (std::size_t b = 0; b < model.blocks.size(); ++b)
+  {
+    EXPECT_EQ(reread.blocks[b].laws, model.blocks[b].laws) << b;
   }
   // A block that shares a matched edge must match it too.
   BlockModel mixed = loadTemplate(test::sourcePath("Testing/Data/two_blocks.yaml"));
