@@ -1,8 +1,8 @@
 /**
  * @file RootFinding.h
- * @brief The 1-D solvers of BlockForge's geometry: roots on a sign-changing bracket by
- * Brent's method (blade/hub intersections, curves meeting surfaces) or by bisection to
- * rounding (vertices on axial planes: the bits of the grids made before they were
+ * @brief The 1-D solvers of BlockForge: roots on a sign-changing bracket by Brent's method
+ * (blade/hub intersections, curves meeting surfaces) or by bisection (vertices on axial
+ * planes, the ratios of distribution laws: the bits of the grids made before these were
  * unified), and minima on a bracket by golden-section search (extreme points of curves).
  */
 #pragma once
@@ -90,27 +90,36 @@ inline double brentRoot(const F& f, double a, double b, double fa, double fb, do
   return b;
 }
 
-/// Bisection of the sign-changing bracket [a, b] (f(a) = fa) until it is no wider than
-/// `width` (at most 200 halvings); the midpoint of the last bracket.
+/**
+ * Bisection on a predicate that holds below a threshold and fails above it: [low, high]
+ * (below(low), !below(high)) shrinks around the threshold until it is no wider than
+ * `width` (0: until low and high are adjacent doubles) or after `iterations` halvings.
+ * Deterministic and, with width 0, as accurate as doubles allow.
+ */
+template <typename P>
+inline void bisect(const P& below, double& low, double& high, double width, int iterations)
+{
+  for (int iteration = 0; iteration < iterations && high - low > width; ++iteration)
+  {
+    const double middle = 0.5 * (low + high);
+    if (!(middle > low && middle < high))
+    {
+      break;
+    }
+    (below(middle) ? low : high) = middle;
+  }
+}
+
+/// The root of f in the sign-changing bracket [a, b] (f(a) = fa) by bisection until the
+/// bracket is no wider than `width` (at most 200 halvings): the midpoint of the last one.
 template <typename F>
 inline double bisectedRoot(const F& f, double a, double b, double fa, double width)
 {
-  double low = a, high = b, flow = fa;
-  for (int iteration = 0; iteration < 200 && high - low > width; ++iteration)
-  {
-    const double middle = 0.5 * (low + high), fm = f(middle);
-    if ((fm < 0.0) == (flow < 0.0))
-    {
-      low = middle;
-      flow = fm;
-    }
-    else
-    {
-      high = middle;
-    }
-  }
-  return 0.5 * (low + high);
+  const bool negative = fa < 0.0;
+  bisect([&](double x) { return (f(x) < 0.0) == negative; }, a, b, width, 200);
+  return 0.5 * (a + b);
 }
+
 /// Golden-section search for the minimum of f on [a, b], until the bracket is no wider
 /// than `width` (at most 200 steps; far from 0 the bracket stops shrinking at the spacing
 /// of doubles); the midpoint of the last bracket.
