@@ -438,9 +438,13 @@ std::vector<double> matchedNodes(double first, double last, double length, int n
   {
     if (first <= 0.0 || last <= 0.0)
     {
-      // one end given: cells shrink geometrically from it towards the free end
+      // one end given: cells shrink geometrically from it towards the free end, by at
+      // most the ratio to the fourth (an end cell near the whole edge would leave the
+      // others no room)
+      const double q = std::pow(ratio, -4.0);
+      const double largest = length * (1.0 - q) / (1.0 - std::pow(q, cells));
       const std::vector<double> s =
-        firstCellSolvedRatio(std::max(first, last), length, nodeCount);
+        firstCellSolvedRatio(std::min(std::max(first, last), largest), length, nodeCount);
       if (first > 0.0)
       {
         return s;
