@@ -300,8 +300,9 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
       }
     }
 
-    vtkNew<vtkPoints> points;
-    points->SetData(coordinates);
+    // With its bounds (and the coordinates' ranges) computed now, on threads: ParaView
+    // asks for them after every update.
+    vtkSmartPointer<vtkPoints> points = pointsWithKnownBounds(coordinates);
     vtkNew<vtkStructuredGrid> grid;
     grid->SetDimensions(nodes[0], nodes[1], nodes[2]);
     grid->SetPoints(points);
@@ -311,8 +312,6 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
     blockId->SetNumberOfTuples(grid->GetNumberOfCells());
     blockId->FillValue(b);
     grid->GetCellData()->AddArray(blockId);
-    // Ranges ParaView asks for after every update, computed now while cheap.
-    cacheRanges(coordinates);
     cacheConstantRange(blockId, b);
     // The active scalars are what ParaView colours by at first: the decomposition.
     grid->GetCellData()->SetActiveScalars("BlockId");
