@@ -30,7 +30,8 @@ is valid (the mesher refuses folded grids; here it must not have to).
 
 Usage: source build/blockforge-env.sh; Benchmark/scale.py [--runs N] [--sizes 1e5,1e6,1e7]
        [--parameters n_span=24] [--quiet 1.0] [--output Benchmark/SCALE.md]
-       Benchmark/scale.py --largest 5e7 (one serial run at that size: time and memory)
+       Benchmark/scale.py --largest 5e7 [--density 8 --parameters n_span=120]
+       (one run, 1 rank with 2 threads, at that size: time and memory)
 """
 import argparse
 import json
@@ -244,13 +245,17 @@ def main():
     parser.add_argument("--wait", type=float, default=300.0)
     parser.add_argument("--largest", type=float, default=0.0,
                         help="one serial run (1 rank, 2 threads) at about this many nodes")
+    parser.add_argument("--density", type=float, default=0.0,
+                        help="with --largest: this density instead (more nodes through the "
+                             "parameters, e.g. n_span, where the density would fold cells)")
     parser.add_argument("--output", default=str(HERE / "SCALE.md"))
     arguments = parser.parse_args()
     if arguments.worker is not None:
         worker(arguments.worker, parse_parameters(arguments.parameters), arguments.token)
         return
     if arguments.largest > 0:
-        density = round((arguments.largest / NODES_AT_DENSITY_1) ** (1.0 / 3.0), 3)
+        density = arguments.density or \
+            round((arguments.largest / NODES_AT_DENSITY_1) ** (1.0 / 3.0), 3)
         result = run("1 rank, 2 threads", density, arguments)
         print(json.dumps(dict(result, density=density)))
         return

@@ -15,6 +15,8 @@ Properties panel, with Auto Apply on, the way a user does:
    optimizer projects the handle's position onto the carrier, and the mesher's grid
    follows.
 4. Automatic on: the automatic run holds the moved point and fills the history table.
+5. The first look of a small grid (Surface With Edges) and of one above 250,000 cells
+   (Surface).
 
 The steps run from a timer of the render window's interactor (Qt's event loop runs between
 them: Auto Apply, renders). Results go to gui_optimizer_result.txt ("key value..." lines);
@@ -182,6 +184,19 @@ def step():
             record("history_last_min_angle", minimum.GetValue(minimum.GetNumberOfTuples() - 1))
         record("history_shown_after", int(representation_of(optimizer, 1, "SpreadSheetView")
                                           is not None))
+        # The first look (Plugin/pqBlockForgeFirstLook): the small grid with its edges, a
+        # grid above 250,000 cells as Surface.
+        record("small_grid_representation", representation_of(mesher, 0, "RenderView")
+               .SMProxy.GetProperty("Representation").GetElement(0).replace(" ", "_"))
+        large = BlockMesher(  # noqa: F821
+            Input=BlockTemplateSource(  # noqa: F821
+                TemplateFile=os.path.join(source_dir, "Templates", "cylinder_in_box.yaml")),
+            DensityMultiplier=4.0)
+        controller.ShowInPreferredView(large.SMProxy, 0, view.SMProxy)
+        shown = representation_of(large, 0, "RenderView")
+        record("large_grid_cells", large.GetDataInformation().GetNumberOfCells())
+        record("large_grid_representation",
+               shown.SMProxy.GetProperty("Representation").GetElement(0).replace(" ", "_"))
         return "done"
     return "next"
 

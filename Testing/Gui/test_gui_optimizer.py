@@ -13,13 +13,14 @@ it reports:
   blocks are (x, 0, 0) with x the dropped handle's x (to round-off), the field data
   MinAngleAfter is the analytic corner angle atan(1 / |x - 1|);
 - the automatic run then holds the moved point, and the history table has a row per
-  evaluation, the last one's MinAngle that angle.
+  evaluation, the last one's MinAngle that angle;
+- the first look: Surface With Edges for the small grid, Surface for a grid above
+  250,000 cells (Plugin/pqBlockForgeFirstLook).
 
 Run by /usr/bin/python3 (CTest).
 """
 import math
 import os
-import subprocess
 import unittest
 
 import bftest
@@ -36,31 +37,10 @@ class GuiOptimizerTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.output = bftest.output_path("gui_optimizer")
-        os.makedirs(cls.output, exist_ok=True)
-        environment = dict(os.environ)
-        environment["BLOCKFORGE_GUI_OUTPUT"] = cls.output
-        environment["PV_PLUGIN_PATH"] = os.path.dirname(os.environ["BLOCKFORGE_PLUGIN"])
-        result = os.path.join(cls.output, "gui_optimizer_result.txt")
-        cls.log = ""
-        for _ in range(3):  # xvfb-run -a can lose a race for a display number
-            if os.path.exists(result):
-                os.remove(result)
-            try:
-                run = subprocess.run(
-                    ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24", "paraview", "--dr",
-                     f"--script={SCRIPT}"], cwd=bftest.SOURCE, env=environment,
-                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=300)
-                cls.log = run.stdout
-            except subprocess.TimeoutExpired as error:
-                cls.log = str(error.output)
-            if os.path.exists(result):
-                break
-        cls.values = {}
-        if os.path.exists(result):
-            with open(result) as stream:
-                for line in stream:
-                    key, _, rest = line.strip().partition(" ")
-                    cls.values[key] = rest.split(" ")
+        # The script ends the process itself once its steps are done.
+        cls.log, lines = bftest.run_gui(SCRIPT, cls.output, "gui_optimizer_result.txt",
+                                        exit_after_script=False)
+        cls.values = {key: rest.split(" ") for key, rest in lines}
 
     def number(self, key, index=0):
         self.assertIn(key, self.values, f"{key} not reported: {self.values} {self.log[-2000:]}")
@@ -113,6 +93,11 @@ class GuiOptimizerTest(unittest.TestCase):
         self.assertAlmostEqual(self.number("history_last_min_angle"),
                                corner_angle(self.number("handle_dropped")), delta=1e-9)
         self.assertEqual(self.number("history_shown_after"), 1)
+
+    def test_first_look_of_small_and_large_grids(self):
+        self.assertEqual(self.values.get("small_grid_representation"), ["Surface_With_Edges"])
+        self.assertGreater(self.number("large_grid_cells"), 250000)
+        self.assertEqual(self.values.get("large_grid_representation"), ["Surface"])
 
 
 if __name__ == "__main__":
