@@ -16,7 +16,10 @@ turns, so a change of load on a shared machine hits them alike) of
 - nodes per second of mesh + mesh info, and the peak RSS of the process (of all ranks
   together under MPI);
 and the speed-ups of 2 threads and 2 ranks over 1 rank with 1 thread (of mesh + mesh info
-+ quality + quality info, and of meshing alone), plus the time per node across sizes and
++ quality + quality info, and of meshing alone), measured and, since on a shared machine
+other sessions take the cores, estimated from CPU times (the process's and its main
+thread's: what ran on one core plus half of what ran on threads; rank 0's share), plus
+the time per node across sizes and
 a least-squares line time = a + b * nodes through the 1-thread runs (linear growth: the
 per-node time falls to b as the fixed part a is spread). Every run checks that the grid
 and quality arrays are the same bits as the first configuration's (a hash of them all,
@@ -88,7 +91,7 @@ def worker(density, parameters, token):
     mesher = BlockMesher(Input=model, DensityMultiplier=density)  # noqa: F821
     quality = GridQuality(Input=mesher)  # noqa: F821
     times = {}
-    cpu = time.process_time()
+    cpu, main_cpu = time.process_time(), time.thread_time()
     start = time.perf_counter()
     mesher.UpdatePipeline()
     times["mesh"] = time.perf_counter() - start
@@ -102,7 +105,11 @@ def worker(density, parameters, token):
     start = time.perf_counter()
     quality.GetDataInformation().GetNumberOfCells()
     times["quality_info"] = time.perf_counter() - start
+    # CPU time of the process (all its threads) and of this thread alone: the threads of
+    # vtkSMPTools' STDThread backend do the chunks while this one waits, so this thread's
+    # CPU time is the part that ran on one core.
     times["cpu"] = time.process_time() - cpu
+    times["main_cpu"] = time.thread_time() - main_cpu
     peak = max(process_peaks(token),
                resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
     digest = ""
@@ -206,17 +213,24 @@ def table(rows, sizes, runs):
             f"{row['process']:.2f} | {row['peak_mib']:.0f} | {row['load']:.1f} | "
             f"{row['same'] or '-'} |")
     lines += ["", "| nodes | speed-up, 2 threads: all (mesh) | 2 ranks: all (mesh) | "
-              "time per node [ns], 1 thread: mesh + info | all |", "|---|---|---|---|---|"]
+              "from CPU times: 2 threads | 2 ranks | "
+              "time per node [ns], 1 thread: mesh + info | all |",
+              "|---|---|---|---|---|---|---|"]
     serial = []
     for size in sizes:
         by = {r["configuration"]: r for r in rows if r["size"] == size}
         base = by["1 rank, 1 thread"]
         mesh = lambda r: r["mesh"] + r["mesh_info"]  # noqa: E731
         threads, ranks = by["1 rank, 2 threads"], by["2 ranks, 1 thread"]
+        # What 2 cores give without other load, from CPU times (all four phases): the
+        # one-core part of the threaded run plus half of the rest; rank 0's CPU time
+        # (its share; time spent waiting for rank 1 in MPI counts as well).
+        threads_cpu = threads["main_cpu"] + (threads["cpu"] - threads["main_cpu"]) / 2.0
         lines.append(
             f"| {base['nodes']:,} | {total(base) / total(threads):.2f} "
             f"({mesh(base) / mesh(threads):.2f}) | {total(base) / total(ranks):.2f} "
-            f"({mesh(base) / mesh(ranks):.2f}) | {1e9 * mesh(base) / base['nodes']:.0f} | "
+            f"({mesh(base) / mesh(ranks):.2f}) | {base['cpu'] / threads_cpu:.2f} | "
+            f"{base['cpu'] / ranks['cpu']:.2f} | {1e9 * mesh(base) / base['nodes']:.0f} | "
             f"{1e9 * total(base) / base['nodes']:.0f} |")
         serial.append((base["nodes"], total(base)))
     if len(serial) >= 2:
@@ -274,7 +288,7 @@ def main():
         for configuration, runs in results.items():
             median = {key: statistics.median(r[key] for r in runs)
                       for key in ("mesh", "mesh_info", "quality", "quality_info", "process",
-                                  "peak_mib", "load", "cpu")}
+                                  "peak_mib", "load", "cpu", "main_cpu")}
             same = ""
             if reference:
                 same = "yes" if all(r["digest"] == reference for r in runs) else "NO"

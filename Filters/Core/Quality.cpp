@@ -1312,22 +1312,31 @@ StructuredBlock sideLayer(const StructuredBlock& block, int side, std::vector<do
 
 void prepareOutputMemory(void* begin, std::size_t bytes)
 {
-  // The kernel zeroes the pages it faults in: in 2 MiB-aligned pieces of at least 32 MiB
-  // on threads, so a large grid's memory is not prepared by one core alone.
-  const auto start = reinterpret_cast<std::uintptr_t>(begin);
-  constexpr std::uintptr_t piece = std::uintptr_t(1) << 21;
-  const long pieces = static_cast<long>(bytes / piece);
-  const long chunks = chunkCount(pieces, 16, 64);
-  forEachChunk(chunks, [&](long chunk) {
-    const std::uintptr_t from =
-      chunk == 0 ? start : (start + piece * (pieces * chunk / chunks)) & ~(piece - 1);
-    const std::uintptr_t to = chunk + 1 == chunks
-      ? start + bytes
-      : (start + piece * (pieces * (chunk + 1) / chunks)) & ~(piece - 1);
-    if (to > from)
+  prepareOutputMemory({ { begin, bytes } });
+}
+
+void prepareOutputMemory(const std::vector<std::pair<void*, std::size_t>>& buffers)
+{
+  // The kernel zeroes the pages it faults in: in 2 MiB-aligned pieces of about 4 MiB on
+  // threads, so a large output is not prepared by one core alone.
+  constexpr std::uintptr_t hugePage = std::uintptr_t(1) << 21;
+  constexpr std::uintptr_t pieceSize = 2 * hugePage;
+  std::vector<std::pair<std::uintptr_t, std::uintptr_t>> pieces;
+  for (const auto& buffer : buffers)
+  {
+    const auto start = reinterpret_cast<std::uintptr_t>(buffer.first);
+    const std::uintptr_t end = start + buffer.second;
+    std::uintptr_t from = start;
+    while (from < end)
     {
-      prefault(from, to);
+      std::uintptr_t to = ((from + pieceSize) & ~(hugePage - 1));
+      to = to >= end || end - to < hugePage ? end : to;
+      pieces.emplace_back(from, to);
+      from = to;
     }
+  }
+  forEachChunk(static_cast<long>(pieces.size()), [&](long piece) {
+    prefault(pieces[piece].first, pieces[piece].second);
   });
 }
 
