@@ -232,9 +232,21 @@ std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopolo
 void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
   const std::map<int, int>& onSurface, MeshTopology& topology, int f,
   ProjectionCache* cache = nullptr);
-/// Every edge and face grid of the model (computeBoundaries), after buildMeshTopology.
+/// The unique edges and faces whose grids the blocks marked in `meshed` need: their own
+/// edges and faces, the edges the faces are made from, and the sources of periodic
+/// images among them (faces and edges), followed to their end.
+struct BoundaryNeeds
+{
+  std::vector<char> edges, faces;
+};
+BoundaryNeeds boundaryNeeds(const MeshTopology& topology, const std::vector<EdgeCopy>& copies,
+  const std::vector<char>& meshed);
+/// Every edge and face grid of the model (computeBoundaries), after buildMeshTopology;
+/// with `meshed`, only those the marked blocks need (BoundaryNeeds), the corner cells of
+/// those blocks checked. Grids computed either way are the same bits.
 void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geometry,
-  const std::vector<NamedCurve>& curves, MeshTopology& topology);
+  const std::vector<NamedCurve>& curves, MeshTopology& topology,
+  const std::vector<char>* meshed = nullptr);
 /// The nodes of block b by transfinite interpolation from its face and edge grids.
 void meshBlockNodes(const BlockModel& model, const MeshTopology& topology, int block, double* out);
 
