@@ -8,11 +8,15 @@ of Testing/Data/openfoam/distributor_passage (swirling inlet at 1 m/s, outlet pr
 walls, cyclic periodic sides, k-omega SST, water) and simpleFoam runs a fixed number of
 iterations. The force and moment come from the case's `forces` function object on the
 vane (patch blade, CofR on the axis): axial force = F_z, torque = M_z, per vane, each the
-mean of the last quarter of the iterations (their spread is shown too). Grids are
-unoptimized (the optimizer does not exist yet).
+mean of the last quarter of the iterations (their spread is shown too).
+
+Two series, as the paper's Fig. 14: the template's own grids (unoptimized, the native
+command line) and the grids as the Python command line gives them by default, after the
+BlockOptimizer moved the control points (`python3 -m blockforge`, which optimizes on the
+template's grid and meshes at the density asked).
 
 Writes doc/fig14_distributor.png and Benchmark/FIG14.md. Needs a build and OpenFOAM.
-Usage: fig14.py [--densities 0.5,0.75,1,1.5,2] [--iterations 500]
+Usage: fig14.py [--densities 0.5,0.75,1,1.5,2] [--iterations 500] [--series unoptimized,optimized]
 """
 import argparse
 import os
@@ -46,14 +50,38 @@ def read_vectors(path):
     return np.array(rows)
 
 
-def run_density(cli, density, iterations, work):
-    case = work / f"d{density:g}"
+SERIES = {"unoptimized": "unoptimized grids (template as placed)",
+          "optimized": "optimized grids (BlockOptimizer, the default)"}
+
+
+def mesh_command(build, series, density, case):
+    """The command line writing the case's grid: the native one for the template's own
+    grid, the Python one (which runs the BlockOptimizer by default) for the optimized."""
+    arguments = [str(TEMPLATE), "-i", str(INPUT), "-d", str(density),
+                 "-o", str(case / "distributor.foam")]
+    if series == "unoptimized":
+        return [str(Path(build) / "bin" / "blockforge")] + arguments
+    return ["/usr/bin/python3", "-m", "blockforge"] + arguments
+
+
+def python_environment(build):
+    """The environment in which /usr/bin/python3 imports the build's blockforge."""
+    environment = dict(os.environ)
+    packages = sorted(Path(build, "lib").glob("python3*/*-packages"))
+    if packages:
+        environment["PYTHONPATH"] = os.pathsep.join(
+            [str(packages[0])] + ([environment["PYTHONPATH"]] if "PYTHONPATH" in environment else []))
+    return environment
+
+
+def run_density(build, series, density, iterations, work):
+    case = work / f"{series}_d{density:g}"
     shutil.copytree(CASE, case)
     control = case / "system" / "controlDict"
     control.write_text(re.sub(r"endTime\s+\d+;", f"endTime         {iterations};",
                               control.read_text()))
-    mesh = subprocess.run([str(cli), str(TEMPLATE), "-i", str(INPUT), "-d", str(density),
-                           "-o", str(case / "distributor.foam")], capture_output=True, text=True)
+    mesh = subprocess.run(mesh_command(build, series, density, case), capture_output=True,
+                          text=True, env=python_environment(build))
     if mesh.returncode != 0:
         raise RuntimeError(mesh.stderr)
     cells = int(re.search(r"cells: (\d+)", mesh.stdout).group(1))
@@ -68,11 +96,23 @@ def run_density(cli, density, iterations, work):
     moment = read_vectors(folder / "moment.dat")
     tail = max(1, len(force) // 4)
     residual = re.findall(r"Solving for p, Initial residual = ([0-9.eE+-]+)", solve.stdout)
-    return {"density": density, "cells": cells, "seconds": seconds,
+    return {"series": series, "density": density, "cells": cells,
+            "settled": settled_iteration(force[:, 0], force[:, 3], force[-tail:, 3].mean()), "seconds": seconds,
             "axial": force[-tail:, 3].mean(), "axial_spread": np.ptp(force[-tail:, 3]),
             "torque": moment[-tail:, 3].mean(), "torque_spread": np.ptp(moment[-tail:, 3]),
             "p_residual": float(residual[-1]) if residual else float("nan"),
             "history": (force[:, 0], force[:, 3], moment[:, 3])}
+
+
+def settled_iteration(iterations, values, final, tolerance=0.005):
+    """The first iteration from which *values* stay within *tolerance* (relative) of
+    *final*: how fast the force converges on the grid (the paper's point of Fig. 14)."""
+    outside = np.nonzero(np.abs(values - final) > tolerance * abs(final))[0]
+    if len(outside) == 0:
+        return int(iterations[0])
+    if outside[-1] + 1 >= len(iterations):
+        return None
+    return int(iterations[outside[-1] + 1])
 
 
 def main():
@@ -80,6 +120,8 @@ def main():
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--densities", default="0.5,0.75,1,1.5,2")
     parser.add_argument("--iterations", type=int, default=500)
+    parser.add_argument("--series", default="unoptimized,optimized",
+                        help="comma-separated, of: " + ", ".join(SERIES))
     parser.add_argument("--build", default=str(ROOT / "build"))
     parser.add_argument("--png", default=str(ROOT / "doc" / "fig14_distributor.png"))
     parser.add_argument("--table", default=str(HERE / "FIG14.md"))
@@ -88,16 +130,21 @@ def main():
     if not cli.exists() or not Path(BASHRC).exists():
         sys.exit("needs build/bin/blockforge and OpenFOAM (scripts/setup.sh)")
     densities = [float(d) for d in args.densities.split(",")]
+    series = args.series.split(",")
+    unknown = sorted(set(series) - set(SERIES))
+    if unknown:
+        sys.exit(f"unknown series {unknown} (known: {', '.join(SERIES)})")
     work = Path(tempfile.mkdtemp(prefix="blockforge-fig14-"))
     started = time.time()
     try:
-        results = []
+        results = {name: [] for name in series}
         for density in densities:
-            result = run_density(cli, density, args.iterations, work)
-            results.append(result)
-            print(f"density {density:g}: {result['cells']} cells, axial force "
-                  f"{result['axial']:.2f} N, torque {result['torque']:.2f} N m "
-                  f"({result['seconds']:.0f} s)", file=sys.stderr, flush=True)
+            for name in series:
+                result = run_density(args.build, name, density, args.iterations, work)
+                results[name].append(result)
+                print(f"{name}, density {density:g}: {result['cells']} cells, axial force "
+                      f"{result['axial']:.2f} N, torque {result['torque']:.2f} N m "
+                      f"({result['seconds']:.0f} s)", file=sys.stderr, flush=True)
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
@@ -105,39 +152,59 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    cells = [r["cells"] for r in results]
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for axis, key, label in ((axes[0], "axial", "axial force on a vane F_z [N]"),
                              (axes[1], "torque", "torque about the axis M_z [N m]")):
-        axis.errorbar(cells, [r[key] for r in results],
-                      yerr=[r[key + "_spread"] / 2 for r in results], marker="o", capsize=3,
-                      label="unoptimized grids")
+        for name, marker in zip(series, "os"):
+            rows = results[name]
+            axis.errorbar([r["cells"] for r in rows], [r[key] for r in rows],
+                          yerr=[r[key + "_spread"] / 2 for r in rows], marker=marker,
+                          capsize=3, label=SERIES[name])
         axis.set_xscale("log")
         axis.set_xlabel("cells (one passage)")
         axis.set_ylabel(label)
         axis.grid(True, which="both", alpha=0.3)
-        axis.legend()
+        axis.legend(loc="best", fontsize="small")
     fig.suptitle("Distributor passage, axial_passage_oh, simpleFoam k-omega SST "
                  f"({args.iterations} iterations)")
     fig.tight_layout()
     Path(args.png).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.png, dpi=110)
 
-    finest = results[-1]
+    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
+                            capture_output=True, text=True).stdout.strip()
     lines = ["# Fig. 14, ours: vane force and torque against grid density", "",
              f"Distributor passage (Templates/axial_passage_oh.yaml on Data/distributor, 16 "
              f"vanes), simpleFoam k-omega SST, {args.iterations} iterations, values per vane "
-             f"(whole row: x{VANES}), mean of the last quarter of the iterations (spread: max - "
-             f"min over it). Unoptimized grids. Generated by Benchmark/fig14.py in "
-             f"{time.time() - started:.0f} s.", "",
-             "| density | cells | axial force F_z [N] | from finest | torque M_z [N m] | from finest | final p residual | solver time |",
-             "|---|---|---|---|---|---|---|---|"]
-    for r in results:
-        lines.append(
-            f"| {r['density']:g} | {r['cells']} | {r['axial']:.3f} (±{r['axial_spread'] / 2:.3f}) | "
-            f"{100 * (r['axial'] / finest['axial'] - 1):+.2f} % | {r['torque']:.3f} "
-            f"(±{r['torque_spread'] / 2:.3f}) | {100 * (r['torque'] / finest['torque'] - 1):+.2f} % | "
-            f"{r['p_residual']:.2g} | {r['seconds']:.0f} s |")
+             f"(whole row: x{VANES}), mean of the last quarter of the iterations (± half the "
+             f"spread, max - min, over it); \"from finest\": relative to the finest grid of the "
+             f"same series. Unoptimized grids: the native command line (`blockforge`, the "
+             f"template's vertices as placed); optimized: `python3 -m blockforge`, which runs "
+             f"the BlockOptimizer by default. Commit {commit}. Generated by Benchmark/fig14.py in "
+             f"{time.time() - started:.0f} s (nice'd, on a 2-core machine shared with other "
+             f"jobs: solver times are only indicative)."]
+    for name in series:
+        rows = results[name]
+        finest = rows[-1]
+        lines += ["", f"## {SERIES[name][0].upper()}{SERIES[name][1:]}", "",
+                  "| density | cells | axial force F_z [N] | from finest | torque M_z [N m] | from finest | F_z within 0.5 % from iteration | final p residual | solver time |",
+                  "|---|---|---|---|---|---|---|---|---|"]
+        for r in rows:
+            lines.append(
+                f"| {r['density']:g} | {r['cells']} | {r['axial']:.3f} (±{r['axial_spread'] / 2:.3f}) | "
+                f"{100 * (r['axial'] / finest['axial'] - 1):+.2f} % | {r['torque']:.3f} "
+                f"(±{r['torque_spread'] / 2:.3f}) | {100 * (r['torque'] / finest['torque'] - 1):+.2f} % | "
+                f"{r['settled'] if r['settled'] is not None else 'not settled'} | "
+                f"{r['p_residual']:.2g} | {r['seconds']:.0f} s |")
+    if len(series) == 2:
+        lines += ["", "## Optimized against unoptimized, density by density", "",
+                  "| density | cells | axial force: optimized - unoptimized | torque: optimized - unoptimized | final p residual (unoptimized / optimized) |",
+                  "|---|---|---|---|---|"]
+        for a, b in zip(results[series[0]], results[series[1]]):
+            lines.append(
+                f"| {a['density']:g} | {a['cells']} | {100 * (b['axial'] / a['axial'] - 1):+.2f} % | "
+                f"{100 * (b['torque'] / a['torque'] - 1):+.2f} % | "
+                f"{a['p_residual']:.2g} / {b['p_residual']:.2g} |")
     lines += ["", f"![force and torque against cells](../doc/{Path(args.png).name})", ""]
     text = "\n".join(lines)
     Path(args.table).write_text(text)

@@ -11,6 +11,13 @@
  * unwritable folder, a full disk) leaves no partial grid and keeps an older one. Write()
  * returns 0 and the error is reported through vtkErrorMacro on any failure.
  *
+ * Under MPI with GatherPieces on (ParaView's writer proxies turn it on: pvbatch, pvserver),
+ * every rank asks the pipeline for its own piece (the mesher shares the blocks out), rank
+ * 0 gathers the blocks of every rank and alone writes the files, which are the same bytes
+ * as a serial run's; Write() returns the same on every rank. With GatherPieces off (the
+ * default, plain VTK, also inside an MPI process) the whole grid is requested and written
+ * by this process, with no communication.
+ *
  * @sa vtkBlockFoamWriter vtkBlockMesher vtkGridQuality
  */
 #ifndef vtkBlockGridWriter_h
@@ -43,6 +50,19 @@ public:
   vtkGetStringMacro(FileName);
   ///@}
 
+  ///@{
+  /// Under MPI (more than one rank in the global controller): request this rank's piece and
+  /// gather every rank's blocks to rank 0, which writes. Off by default (the whole grid is
+  /// requested and written here); ParaView's writer proxies turn it on.
+  vtkSetMacro(GatherPieces, bool);
+  vtkGetMacro(GatherPieces, bool);
+  vtkBooleanMacro(GatherPieces, bool);
+  ///@}
+
+  /// Asks for this rank's piece when gathering (see GatherPieces).
+  vtkTypeBool ProcessRequest(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+
 protected:
   vtkBlockGridWriter();
   ~vtkBlockGridWriter() override;
@@ -58,6 +78,7 @@ protected:
 #endif
 
   char* FileName = nullptr;
+  bool GatherPieces = false;
 
 private:
   vtkBlockGridWriter(const vtkBlockGridWriter&) = delete;

@@ -98,6 +98,35 @@ class ClientServer(unittest.TestCase):
         for proxy in (quality, grid, optimized, model, reader):
             simple.Delete(proxy)
 
+    def test_solver_writers_on_the_server(self):
+        """SaveData of BlockForge's writers: the server's ranks mesh their shares, its rank
+        0 gathers and writes the serial run's bytes (annular sector: cyclic periodic)."""
+        import filecmp
+        import shutil
+        from blockforge import writers
+
+        template = os.path.join(bftest.SOURCE, "Templates", "annular_sector.yaml")
+        source = BlockTemplateSource(TemplateFile=template)  # noqa: F821
+        optimized = BlockOptimizer(Input=source)  # noqa: F821
+        grid = BlockMesher(Input=optimized)  # noqa: F821
+        quality = GridQuality(Input=grid)  # noqa: F821
+        root = bftest.output_path("client_server_writers")
+        shutil.rmtree(root, ignore_errors=True)
+        serial = blockforge.mesh_template(template).GetOutputDataObject(0)
+        for extension, files in (("foam", ["constant/polyMesh/" + name for name in (
+                "points", "faces", "owner", "neighbour", "boundary")]),
+                                 ("xyz", ["grid.xyz", "grid.nmf"])):
+            simple.SaveData(os.path.join(root, "server", extension, "grid." + extension),
+                            proxy=quality)
+            writers.write_solver_grid(
+                serial, os.path.join(root, "serial", extension, "grid." + extension))
+            for name in files:
+                self.assertTrue(filecmp.cmp(os.path.join(root, "server", extension, name),
+                                            os.path.join(root, "serial", extension, name),
+                                            shallow=False), name)
+        for proxy in (quality, grid, optimized, source):
+            simple.Delete(proxy)
+
     def test_error_reaches_the_client(self):
         source = BlockTemplateSource(  # noqa: F821
             TemplateFile=os.path.join(bftest.DATA, "bad_unknown_vertex.yaml"))
