@@ -296,7 +296,7 @@ private:
     Vertex vertex;
     const auto keys = entries(
       node, "vertex", { "position", "on", "at", "periodic", "pitches", "rule", "source", "origin",
-        "axis", "angle" }, vertex.name, vertex.where);
+        "axis", "angle", "fixed" }, vertex.name, vertex.where);
     const std::string entityText = entity("vertex", vertex.name);
     if (Model.findVertex(vertex.name) >= 0)
     {
@@ -323,6 +323,15 @@ private:
       vertex.constraint.periodicSource = -2; // resolved once every vertex is known
     }
     readRule(keys, node, entityText, vertex);
+    if (const MapEntry* fixed = syntax::findEntry(keys, "fixed"))
+    {
+      const std::string mark = text(fixed->value, fixed->line, entityText, "fixed");
+      if (mark != "true" && mark != "false")
+      {
+        fail(fixed->line, entityText, "fixed: expected true or false");
+      }
+      vertex.fixed = mark == "true";
+    }
     Model.vertices.push_back(vertex);
   }
 
@@ -992,6 +1001,10 @@ std::string writeModelDocument(const BlockModel& model)
         emitVector(out, vertex.rule.axis);
         out << YAML::Key << "angle" << YAML::Value << formatNumber(vertex.rule.angle);
       }
+    }
+    if (vertex.fixed)
+    {
+      out << YAML::Key << "fixed" << YAML::Value << "true";
     }
     emitWhere(out, vertex.where, model);
     out << YAML::EndMap;

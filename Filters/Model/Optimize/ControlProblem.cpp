@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -134,10 +135,16 @@ std::vector<int> redrawCurves(model::MeshPlan& plan, const std::vector<ThroughPo
   return ends;
 }
 
-/// Sets component `component` of `vertex`'s parameters (wrapped on closed carriers).
+/// Sets component `component` of `vertex`'s parameters (wrapped on closed carriers), or
+/// coordinate component - 2 of a free interior vertex's position.
 void setParameter(BlockModel& model, const CarrierGeometry& geometry, int vertex, int component,
   double value)
 {
+  if (component >= 2)
+  {
+    model.vertices[vertex].position[component - 2] = value;
+    return;
+  }
   model::VertexConstraint& constraint = model.vertices[vertex].constraint;
   const bool closed =
     component == 0 ? geometry.closedS(constraint.carrier) : geometry.closedT(constraint.carrier);
@@ -237,6 +244,13 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
   P->Objective = objective;
   const BlockModel& base = P->Base;
   std::set<int> fixedVertices;
+  for (std::size_t v = 0; v < base.vertices.size(); ++v)
+  {
+    if (base.vertices[v].fixed) // marked `fixed: true` in the template
+    {
+      fixedVertices.insert(static_cast<int>(v));
+    }
+  }
   for (const std::string& name : fixed)
   {
     const int v = base.findVertex(name);
@@ -505,6 +519,65 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
     variable.name = vertex.name + (component == 0 ? ".s" : ".t");
     if (variable.low < variable.high)
     {
+      Variables.push_back(variable);
+    }
+  }
+  // Free interior vertices: block vertices placed by position alone (no carrier, no rule
+  // that follows another vertex), on no boundary face and no end of an edge that needs
+  // them where they are (carrier edges, arcs), move in x, y and z. On a periodic face only
+  // a source moves (its image follows); bounds keep it within 45 % of the way to its
+  // nearest block-edge neighbour.
+  std::vector<char> onPeriodic(vertexCount, 0);
+  for (int f : periodicFaces)
+  {
+    for (int v : topology.faces[f].ownerIds)
+    {
+      onPeriodic[v] = 1;
+    }
+  }
+  std::vector<char> edgeEnd(vertexCount, 0);
+  for (const model::Edge& edge : base.edges)
+  {
+    if (edge.kind != model::Edge::Kind::Line && edge.kind != model::Edge::Kind::Spline &&
+      edge.kind != model::Edge::Kind::Follow)
+    {
+      edgeEnd[edge.from] = edgeEnd[edge.to] = 1;
+    }
+  }
+  for (int v = 0; v < vertexCount; ++v)
+  {
+    const model::Vertex& vertex = base.vertices[v];
+    if (!inBlock[v] || fixedVertices.count(v) || vertex.rule.kind != model::VertexRule::Kind::Fixed ||
+      vertex.constraint.carrier >= 0 || vertex.constraint.periodicSource >= 0 ||
+      !boundaryOf[v].empty() || edgeEnd[v] || neighbours[v].empty())
+    {
+      continue;
+    }
+    if (onPeriodic[v] &&
+      std::none_of(dependents[v].begin(), dependents[v].end(), [&](int w) {
+        return base.vertices[w].rule.kind == model::VertexRule::Kind::Periodic;
+      }))
+    {
+      continue; // a periodic image placed by position: moving it alone breaks periodicity
+    }
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int w : neighbours[v])
+    {
+      nearest = std::min(nearest, (base.vertices[w].position - vertex.position).norm());
+    }
+    if (!(nearest > 0.0) || !std::isfinite(nearest))
+    {
+      continue;
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      ControlVariable variable;
+      variable.vertex = v;
+      variable.component = 2 + c;
+      variable.start = vertex.position[c];
+      variable.low = variable.start - movingNeighbourShare * nearest;
+      variable.high = variable.start + movingNeighbourShare * nearest;
+      variable.name = vertex.name + "." + "xyz"[c];
       Variables.push_back(variable);
     }
   }

@@ -22,6 +22,15 @@ constexpr double MaximumMeasuredNodes = 1.0e6;
 /// factors of 0.8 until the grid has at most MaximumMeasuredNodes nodes.
 double measuredDensity(const model::BlockModel& model, double densityMultiplier);
 
+/// The density multiplier the pipelines (mesh_template, both command lines) give the
+/// optimizer for a grid meshed at `densityMultiplier`: the template's own density when the
+/// grid is finer (the template's grid ranks configurations as the finer grid does, and a
+/// huge density stays the mesher's to refuse with its memory message), else that density.
+inline double pipelineDensity(double densityMultiplier)
+{
+  return densityMultiplier < 1.0 ? densityMultiplier : 1.0;
+}
+
 struct OptimizerSettings
 {
   ObjectiveSettings objective;
