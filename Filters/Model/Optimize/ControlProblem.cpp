@@ -1,5 +1,7 @@
 #include "ControlProblem.h"
 
+#include "../../Core/InvertedCells.h"
+
 #include "Errors.h"
 #include "MeshPlan.h"
 #include "ModelSyntax.h"
@@ -202,6 +204,57 @@ struct ControlProblem::Impl
   /// The grid kept alive between evaluations, and the configuration it holds.
   std::unique_ptr<model::MeshPlan> Plan;
   std::vector<double> Current;
+  /// Angles (and neighbour size ratios) of every block of the plan as of the last feasible
+  /// evaluation; empty where a block changed since (an evaluation measures only those).
+  std::vector<std::unique_ptr<BlockAngles>> Angles;
+  std::vector<double> SizeRatios;
+
+  /// Forgets the measured angles of the blocks the last plan update recomputed.
+  void forgetUpdated()
+  {
+    if (!Plan)
+    {
+      Angles.clear();
+      return;
+    }
+    Angles.resize(Plan->blockCount());
+    SizeRatios.resize(Plan->blockCount(), 1.0);
+    for (int b : Plan->updatedBlocks())
+    {
+      Angles[b].reset();
+    }
+  }
+
+  /// The angle objectives of the plan's grid, measuring only the blocks that changed
+  /// (bit for bit what measureGrid gives for the whole grid).
+  GridMeasures measureChanged()
+  {
+    std::vector<const BlockAngles*> blocks;
+    double maxSizeRatio = 1.0;
+    for (int b = 0; b < Plan->blockCount(); ++b)
+    {
+      if (!Angles[b])
+      {
+        const std::array<int, 3> n = Plan->nodeCounts(b);
+        const BlockGrid grid{ Plan->blockNodes(b).data(), n[0], n[1], n[2] };
+        const long long inverted = findInvertedCells(grid.xyz, n[0], n[1], n[2]).count;
+        if (inverted > 0) // only the plan's first grid is not checked by its update
+        {
+          GridMeasures failed;
+          failed.invertedCells = inverted;
+          failed.objective = infeasibleObjective(inverted);
+          failed.failure = std::to_string(inverted) + " inverted cells";
+          return failed;
+        }
+        Angles[b].reset(new BlockAngles(grid));
+        SizeRatios[b] =
+          Objective.kind == ObjectiveKind::MinAngleAndSizeRatio ? maxNeighbourSizeRatio(grid) : 1.0;
+      }
+      blocks.push_back(Angles[b].get());
+      maxSizeRatio = std::max(maxSizeRatio, SizeRatios[b]);
+    }
+    return measureAngles(blocks, maxSizeRatio, Objective);
+  }
 
   /// Moves the plan to configuration x (only the parameters that changed) and updates it.
   model::Feasibility place(const std::vector<double>& x)
@@ -229,7 +282,9 @@ struct ControlProblem::Impl
     std::vector<int> applied = model::applyPlacement(work, Plan->carriers(), moved);
     const std::vector<int> ends = redrawCurves(*Plan, Through);
     applied.insert(applied.end(), ends.begin(), ends.end());
-    return Plan->update(applied);
+    const model::Feasibility feasibility = Plan->update(applied);
+    forgetUpdated();
+    return feasibility;
   }
 };
 
@@ -626,6 +681,10 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
   try
   {
     const model::Feasibility feasibility = P->place(x);
+    if (P->Objective.kind != ObjectiveKind::NonOrthogonality && feasibility.feasible())
+    {
+      return P->measureChanged();
+    }
     if (!feasibility.feasible())
     {
       GridMeasures failed;
@@ -650,6 +709,7 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
   {
     // The input model itself fails the mesher's check: nothing to evaluate.
     P->Plan.reset();
+    P->forgetUpdated();
     GridMeasures failed;
     failed.invertedCells = 1;
     failed.objective = infeasibleObjective(1);
