@@ -8,7 +8,10 @@
 //   angles, then the real grid measured.
 // Not a test (nothing asserts a time). Prints a Markdown table.
 // Usage: bench_optimizer [--repetitions N] [--evaluations N] [--sharpness K] [--step F]
-//          [--algorithm bobyqa|cobyla|subplex] [--blocks] template.yaml input.inf [...]
+//          [--algorithm bobyqa|cobyla|subplex] [--blocks] [--timing] [--csv FILE]
+//          template.yaml input.inf [...]
+// --blocks: where the smallest angles are (block, cell, grid plane) and which variables end
+// on their bounds; --csv: the table's numbers for Benchmark/optimizer_figure.py.
 #include "Optimizer.h"
 
 #include "../Testing/Cxx/TestTurboInputs.h"
@@ -237,7 +240,7 @@ void printWorstCells(const std::string& block, const std::vector<double>& xyz,
 
 struct Row
 {
-  std::string name;
+  std::string name, templateName, input;
   GridMeasures before, after, laplace, classy;
   std::size_t variables = 0;
   double seconds = 0.0, cpuSeconds = 0.0, searchSeconds = 0.0, laplaceSeconds = 0.0,
@@ -252,6 +255,7 @@ int main(int argc, char** argv)
   int repetitions = 5;
   bool blocks = false;
   bool timing = false;
+  std::string csvFile;
   OptimizerSettings settings;
   std::vector<std::pair<std::string, std::string>> cases;
   for (int a = 1; a < argc; ++a)
@@ -289,6 +293,10 @@ int main(int argc, char** argv)
     {
       timing = true;
     }
+    else if (arg == "--csv" && a + 1 < argc)
+    {
+      csvFile = argv[++a];
+    }
     else if (a + 1 < argc)
     {
       cases.emplace_back(argv[a], argv[a + 1]);
@@ -303,6 +311,8 @@ int main(int argc, char** argv)
     const model::BlockModel model = model::loadTemplate(templateFile, {}, &inputs, &geometry);
     Row row;
     row.name = baseName(templateFile) + ", " + inputFile;
+    row.templateName = baseName(templateFile);
+    row.input = inputFile;
     if (timing)
     {
       // Cost of one evaluation: one parameter moved (the plan updates its neighbourhood)
@@ -414,6 +424,39 @@ int main(int argc, char** argv)
       row.evaluations,
       row.evaluations / row.searchSeconds, angleText(row.laplace).c_str(), row.laplaceSeconds,
       angleText(row.classy).c_str(), row.classySeconds);
+  }
+  if (!csvFile.empty())
+  {
+    FILE* csv = std::fopen(csvFile.c_str(), "w");
+    if (!csv)
+    {
+      std::fprintf(stderr, "cannot write %s\n", csvFile.c_str());
+      return 1;
+    }
+    std::fprintf(csv, "template,input,variables,before_min,before_classes,after_min,"
+                      "after_classes,seconds,cpu_seconds,evaluations,evaluations_per_second,"
+                      "laplacian_min,laplacian_seconds,block_score_min,block_score_seconds\n");
+    auto minText = [](const GridMeasures& m) {
+      return m.feasible ? std::to_string(m.minAngle) : std::string("inverted");
+    };
+    auto classText = [](const GridMeasures& m) {
+      std::string text;
+      for (long long c : m.classes)
+      {
+        text += (text.empty() ? "" : " ") + std::to_string(c);
+      }
+      return text;
+    };
+    for (const Row& row : rows)
+    {
+      std::fprintf(csv, "%s,%s,%zu,%.6f,%s,%.6f,%s,%.4f,%.4f,%d,%.2f,%s,%.4f,%s,%.4f\n",
+        row.templateName.c_str(), row.input.c_str(), row.variables, row.before.minAngle,
+        classText(row.before).c_str(), row.after.minAngle, classText(row.after).c_str(),
+        row.seconds, row.cpuSeconds, row.evaluations, row.evaluations / row.searchSeconds,
+        minText(row.laplace).c_str(), row.laplaceSeconds, minText(row.classy).c_str(),
+        row.classySeconds);
+    }
+    std::fclose(csv);
   }
   return 0;
 }
