@@ -377,3 +377,27 @@ TEST(OptimizerPassage, HTemplateNeverWorse)
   EXPECT_GE(run.result.after.minAngle, run.result.before.minAngle);
   EXPECT_EQ(meshedMinAngle(run.result.model), run.result.after.minAngle);
 }
+
+TEST(OptimizerPassage, RefusesAGridTheMesherWouldRefuse)
+{
+  // The objective is measured on the final grid: one that would not fit in memory is
+  // refused before any work, with the mesher's message.
+  Loaded loaded = loadPassage("axial_passage_oh", "distributor");
+  OptimizerSettings settings;
+  settings.densityMultiplier = 1000.0;
+  try
+  {
+    optimizeModel(loaded.model, loaded.geometry, settings);
+    FAIL() << "expected a memory error";
+  }
+  catch (const std::exception& error)
+  {
+    EXPECT_NE(std::string(error.what()).find("the grid would need"), std::string::npos)
+      << error.what();
+    EXPECT_NE(std::string(error.what()).find("lower the density multiplier"), std::string::npos)
+      << error.what();
+  }
+  // A density within MaximumMeasuredNodes is measured as it is.
+  EXPECT_EQ(measuredDensity(loaded.model, 2.0), 2.0);
+  EXPECT_LT(measuredDensity(loaded.model, 3.0), 3.0);
+}
