@@ -116,12 +116,12 @@ void TemplateReader::ensureVertex(int index)
     [&](const MapEntry& entry, const std::string& entityText) {
       Vertex vertex = Model.vertices[index];
       readVertexV2(entry, entityText, vertex);
-      vertex.fixed = fixedMark(entry, entityText);
       if (!vertex.position.allFinite())
       {
         fail(entry.line, entityText, "the position is not finite");
       }
       Model.vertices[index] = vertex;
+      Model.vertices[index].fixed = fixedMark(entry, entityText);
       defineVertexQueries(vertex);
     });
 }

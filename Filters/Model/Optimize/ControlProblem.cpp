@@ -137,16 +137,10 @@ std::vector<int> redrawCurves(model::MeshPlan& plan, const std::vector<ThroughPo
   return ends;
 }
 
-/// Sets component `component` of `vertex`'s parameters (wrapped on closed carriers), or
-/// coordinate component - 2 of a free interior vertex's position.
+/// Sets component `component` of `vertex`'s parameters (wrapped on closed carriers).
 void setParameter(BlockModel& model, const CarrierGeometry& geometry, int vertex, int component,
   double value)
 {
-  if (component >= 2)
-  {
-    model.vertices[vertex].position[component - 2] = value;
-    return;
-  }
   model::VertexConstraint& constraint = model.vertices[vertex].constraint;
   const bool closed =
     component == 0 ? geometry.closedS(constraint.carrier) : geometry.closedT(constraint.carrier);
@@ -191,6 +185,19 @@ std::vector<int> followers(const std::vector<std::vector<int>>& dependents, int 
   }
   return result;
 }
+
+/// Sets variable `variable` to `value`: a control point's carrier parameter, or a
+/// coordinate of a free interior vertex's position (components 2, 3, 4: x, y, z).
+void setVariable(
+  BlockModel& model, const CarrierGeometry& geometry, const ControlVariable& variable, double value)
+{
+  if (variable.component >= 2)
+  {
+    model.vertices[variable.vertex].position[variable.component - 2] = value;
+    return;
+  }
+  setParameter(model, geometry, variable.vertex, variable.component, value);
+}
 } // namespace
 
 struct ControlProblem::Impl
@@ -199,11 +206,6 @@ struct ControlProblem::Impl
   CarrierGeometry Geometry;
   double Density = 1.0;
   ObjectiveSettings Objective;
-  std::vector<ThroughPoint> Through;
-  std::vector<ControlVariable> Variables;
-  /// The grid kept alive between evaluations, and the configuration it holds.
-  std::unique_ptr<model::MeshPlan> Plan;
-  std::vector<double> Current;
   /// Angles (and neighbour size ratios) of every block of the plan as of the last feasible
   /// evaluation; empty where a block changed since (an evaluation measures only those).
   std::vector<std::unique_ptr<BlockAngles>> Angles;
@@ -255,6 +257,11 @@ struct ControlProblem::Impl
     }
     return measureAngles(blocks, maxSizeRatio, Objective);
   }
+  std::vector<ThroughPoint> Through;
+  std::vector<ControlVariable> Variables;
+  /// The grid kept alive between evaluations, and the configuration it holds.
+  std::unique_ptr<model::MeshPlan> Plan;
+  std::vector<double> Current;
 
   /// Moves the plan to configuration x (only the parameters that changed) and updates it.
   model::Feasibility place(const std::vector<double>& x)
@@ -274,7 +281,7 @@ struct ControlProblem::Impl
     {
       if (x[i] != Current[i])
       {
-        setParameter(work, Plan->carriers(), Variables[i].vertex, Variables[i].component, x[i]);
+        setVariable(work, Plan->carriers(), Variables[i], x[i]);
         moved.push_back(Variables[i].vertex);
       }
     }
@@ -282,9 +289,7 @@ struct ControlProblem::Impl
     std::vector<int> applied = model::applyPlacement(work, Plan->carriers(), moved);
     const std::vector<int> ends = redrawCurves(*Plan, Through);
     applied.insert(applied.end(), ends.begin(), ends.end());
-    const model::Feasibility feasibility = Plan->update(applied);
-    forgetUpdated();
-    return feasibility;
+    return Plan->update(applied);
   }
 };
 
@@ -681,6 +686,7 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
   try
   {
     const model::Feasibility feasibility = P->place(x);
+    P->forgetUpdated();
     if (P->Objective.kind != ObjectiveKind::NonOrthogonality && feasibility.feasible())
     {
       return P->measureChanged();
@@ -721,6 +727,7 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
 BlockModel ControlProblem::modelAt(const std::vector<double>& x)
 {
   P->place(x);
+  P->forgetUpdated();
   return P->Plan->model();
 }
 
@@ -730,7 +737,7 @@ std::vector<Vec3> ControlProblem::verticesAt(const std::vector<double>& x) const
   std::vector<int> moved;
   for (std::size_t i = 0; i < Variables.size(); ++i)
   {
-    setParameter(work, P->Geometry, Variables[i].vertex, Variables[i].component, x[i]);
+    setVariable(work, P->Geometry, Variables[i], x[i]);
     moved.push_back(Variables[i].vertex);
   }
   model::applyPlacement(work, P->Geometry, moved);
@@ -745,6 +752,7 @@ std::vector<Vec3> ControlProblem::verticesAt(const std::vector<double>& x) const
 std::vector<std::vector<double>> ControlProblem::gridAt(const std::vector<double>& x)
 {
   const model::Feasibility feasibility = P->place(x);
+  P->forgetUpdated();
   if (!feasibility.feasible())
   {
     throw std::runtime_error(feasibility.message);
