@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace blockforge
@@ -387,6 +388,136 @@ std::vector<double> endSizes(double first, double last, int nodeCount)
   return s;
 }
 
+namespace
+{
+/// Cell i growing from the given ends by r: min(first r^i, last r^(cells-1-i)), free ends
+/// (<= 0) left out; +inf when both are free.
+double grownCell(double first, double last, double r, int i, int cells)
+{
+  double size = std::numeric_limits<double>::infinity();
+  if (first > 0.0)
+  {
+    size = std::min(size, first * std::pow(r, i));
+  }
+  if (last > 0.0)
+  {
+    size = std::min(size, last * std::pow(r, cells - 1 - i));
+  }
+  return size;
+}
+
+double grownLength(double first, double last, double r, int cells)
+{
+  CompensatedSum sum;
+  for (int i = 0; i < cells; ++i)
+  {
+    sum.add(grownCell(first, last, r, i, cells));
+  }
+  return sum.value();
+}
+} // namespace
+
+std::vector<double> matchedNodes(double first, double last, double length, int nodeCount,
+  double ratio)
+{
+  if (nodeCount < 2)
+  {
+    throw GeometryError("an edge needs at least 2 nodes (1 cell), got " +
+      std::to_string(nodeCount));
+  }
+  if (!(ratio > 1.0) || !std::isfinite(ratio))
+  {
+    throw GeometryError("match distribution: the growth ratio must be above 1, got " +
+      toString(ratio));
+  }
+  if (!(length >= 0.0) || !std::isfinite(length))
+  {
+    throw GeometryError("match distribution: the edge length must be a length, got " +
+      toString(length));
+  }
+  const int cells = nodeCount - 1;
+  first = std::isfinite(first) ? first : 0.0;
+  last = std::isfinite(last) ? last : 0.0;
+  if ((first <= 0.0 && last <= 0.0) || cells == 1 || length == 0.0)
+  {
+    return uniform(nodeCount);
+  }
+  // An end cell larger than the mean cell: cells shrink from it towards the other end or
+  // the middle, with both ends exact (log-linear sizes plus a bump, as the Ends law).
+  const double mean = length / cells;
+  if (first > mean || last > mean)
+  {
+    if (first <= 0.0 || last <= 0.0)
+    {
+      // one end given: cells shrink geometrically from it towards the free end
+      const std::vector<double> s =
+        firstCellSolvedRatio(std::max(first, last), length, nodeCount);
+      if (first > 0.0)
+      {
+        return s;
+      }
+      std::vector<double> reversed(s.size());
+      for (std::size_t i = 0; i < s.size(); ++i)
+      {
+        reversed[i] = 1.0 - s[s.size() - 1 - i];
+      }
+      reversed.front() = 0.0;
+      reversed.back() = 1.0;
+      return reversed;
+    }
+    return endSizes(first / mean, last / mean, nodeCount);
+  }
+  // Cells grown by the ratio must reach the length, else the ratio is raised (bisection
+  // on the growing total, deterministic).
+  double r = ratio;
+  if (grownLength(first, last, r, cells) < length)
+  {
+    double low = r, high = 2.0 * r;
+    for (int iteration = 0; iteration < 200 && grownLength(first, last, high, cells) < length;
+         ++iteration)
+    {
+      low = high;
+      high *= 2.0;
+    }
+    for (int iteration = 0; iteration < 200; ++iteration)
+    {
+      const double middle = 0.5 * (low + high);
+      if (!(middle > low && middle < high))
+      {
+        break;
+      }
+      (grownLength(first, last, middle, cells) < length ? low : high) = middle;
+    }
+    r = high;
+  }
+  std::vector<double> grown(cells);
+  for (int i = 0; i < cells; ++i)
+  {
+    grown[i] = grownCell(first, last, r, i, cells);
+  }
+  // The uniform cap c with sum(min(grown_i, c)) = length: the total is piecewise linear
+  // and increasing in c, found exactly from the sorted cells.
+  std::vector<double> sorted = grown;
+  std::sort(sorted.begin(), sorted.end());
+  double below = 0.0, cap = sorted.back();
+  for (int k = 0; k < cells; ++k)
+  {
+    const double candidate = (length - below) / (cells - k);
+    if (candidate <= sorted[k])
+    {
+      cap = candidate;
+      break;
+    }
+    below += sorted[k];
+  }
+  std::vector<double> sizes(cells);
+  for (int i = 0; i < cells; ++i)
+  {
+    sizes[i] = std::min(grown[i], cap);
+  }
+  return fromCellSizes(sizes, "match");
+}
+
 std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
   double edgeLength)
 {
@@ -407,6 +538,9 @@ std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
       return firstCell(law, nodeCount, edgeLength);
     case DistributionLaw::Kind::Ends:
       return endSizes(law.firstCellSize, law.lastCellSize, nodeCount);
+    case DistributionLaw::Kind::Match:
+      return matchedNodes(law.firstCellSize, law.lastCellSize, edgeLength, nodeCount,
+        law.expansionRatio);
   }
   throw GeometryError("unknown distribution law");
 }
@@ -424,6 +558,7 @@ DistributionLaw reversedLaw(const DistributionLaw& law)
       throw GeometryError("a first-cell distribution cannot be reversed into another "
         "first-cell law; reverse its node parameters instead");
     case DistributionLaw::Kind::Ends:
+    case DistributionLaw::Kind::Match:
       std::swap(reversed.firstCellSize, reversed.lastCellSize);
       return reversed;
     default:

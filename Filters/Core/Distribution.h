@@ -21,20 +21,28 @@ struct DistributionLaw
     Geometric, ///< paper eq. 7: each cell is ExpansionRatio times the previous one
     TwoSided,  ///< cells grow by ExpansionRatio from both ends towards the middle
     FirstCell, ///< first cell of FirstCellSize, growing by at most ExpansionRatio
-    Ends       ///< first and last cells FirstCellSize and LastCellSize times the mean cell
+    Ends,      ///< first and last cells FirstCellSize and LastCellSize times the mean cell
+    Match      ///< first and last cells of given lengths (FirstCellSize, LastCellSize; 0:
+               ///< free), cells growing from both ends by ExpansionRatio up to a uniform
+               ///< middle; the mesher sets the end lengths to those of the cells continuing
+               ///< the edge across block interfaces
   };
   Kind kind = Kind::Uniform;
   /// Geometric/TwoSided: ratio of successive cell sizes (k in eq. 7, > 0).
+  /// Match: the ratio the cells grow by from each end (> 1); larger only when the edge
+  /// has too few cells to reach its length that way.
   /// FirstCell: the largest allowed ratio (> 1); cells grow geometrically from
   /// FirstCellSize and stay constant once large enough to fill the edge. 0 for
   /// FirstCell means "solve the ratio so that all cells grow geometrically".
   double expansionRatio = 1.0;
   /// FirstCell: size of the first cell in length units of the edge (> 0).
   /// Ends: size of the first cell over the mean cell (edge length / cells, > 0).
+  /// Match: length of the first cell (0: free).
   double firstCellSize = 0.0;
   /// Ends: size of the last cell over the mean cell (> 0). Relative sizes do not change
   /// with the cell count, so a refined grid keeps the shape: neighbour blocks whose end
   /// cells match at one density match at all.
+  /// Match: length of the last cell (0: free).
   double lastCellSize = 0.0;
 
   bool operator==(const DistributionLaw& o) const
@@ -55,7 +63,21 @@ struct DistributionLaw
 std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
   double edgeLength = 1.0);
 
-/// The law seen from the other end of the edge (Geometric k -> 1/k, Ends swapped). FirstCell cannot be
+/// Default growth ratio of the Match law.
+constexpr double DefaultMatchRatio = 1.2;
+
+/**
+ * Relative node positions for `nodeCount` nodes on an edge of `length` whose first and
+ * last cells have the lengths `first` and `last` (0 or less: free): cells grow from each
+ * given end by `ratio` (> 1) and are uniform where that would make them larger than the
+ * edge needs. When the cells growing by `ratio` cannot fill the edge, the ratio is raised
+ * until they do; when the given end cells are too large for the edge, the cells are as
+ * near them as filling the edge allows (uniform in the limit).
+ */
+std::vector<double> matchedNodes(double first, double last, double length, int nodeCount,
+  double ratio);
+
+/// The law seen from the other end of the edge (Geometric k -> 1/k, Ends and Match swapped). FirstCell cannot be
 /// reversed into a law of the same kind; callers reverse its node parameters instead.
 DistributionLaw reversedLaw(const DistributionLaw& law);
 } // namespace blockforge

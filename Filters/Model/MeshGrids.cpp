@@ -69,9 +69,25 @@ MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedC
     static_cast<BlockLinks&>(mesh) = links;
     topology.blocks.push_back(std::move(mesh));
   }
+  // graded edges first: matched edges take their end cells from them
+  buildMatchGroups(model, topology);
   for (std::size_t e = 0; e < topology.edges.size(); ++e)
   {
-    computeEdgeParameters(model, topology, static_cast<int>(e), allowFallback);
+    if (!topology.edges[e].matched)
+    {
+      computeEdgeParameters(model, topology, static_cast<int>(e), allowFallback);
+    }
+  }
+  if (!topology.matchGroups.empty())
+  {
+    matchEdgeEnds(model, topology);
+  }
+  for (std::size_t e = 0; e < topology.edges.size(); ++e)
+  {
+    if (topology.edges[e].matched)
+    {
+      computeEdgeParameters(model, topology, static_cast<int>(e), allowFallback);
+    }
   }
   for (int b = 0; b < static_cast<int>(model.blocks.size()); ++b)
   {
@@ -86,6 +102,37 @@ void computeEdgeParameters(const BlockModel& model, MeshTopology& topology, int 
 {
   UniqueEdge& edge = topology.edges[e];
   edge.params.clear();
+  if (edge.matched)
+  {
+    for (const EdgeUse& use : edge.uses)
+    {
+      const Block& block = model.blocks[use.block];
+      const DistributionLaw& law = block.laws[use.localEdge];
+      if (law.kind != DistributionLaw::Kind::Match || law.expansionRatio != edge.matchRatio)
+      {
+        const std::array<int, 2> ends = edgeVertices(use.localEdge);
+        fail(block.where, blockEntity(model, use.block),
+          "edge " + edgeText(model, block.vertices[ends[0]], block.vertices[ends[1]]) + " (" +
+            syntax::edgeLabel(use.localEdge) + ") is matched to its neighbours in another "
+            "block that uses it: give it the same law 'match' (with the same ratio) here");
+      }
+    }
+    try
+    {
+      edge.params = matchedNodes(
+        edge.matchFirst, edge.matchLast, edge.length, edge.nodeCount, edge.matchRatio);
+    }
+    catch (const GeometryError& error)
+    {
+      const EdgeUse& use = edge.uses.front();
+      const Block& block = model.blocks[use.block];
+      const std::array<int, 2> ends = edgeVertices(use.localEdge);
+      fail(block.where, blockEntity(model, use.block),
+        "grading of edge " + edgeText(model, block.vertices[ends[0]], block.vertices[ends[1]]) +
+          " (" + syntax::edgeLabel(use.localEdge) + "): " + error.what());
+    }
+    return;
+  }
   for (const EdgeUse& use : edge.uses)
   {
     const Block& block = model.blocks[use.block];
@@ -349,6 +396,9 @@ void rotateEdgeNodes(const BlockModel& model, MeshTopology& topology, int source
   }
   const bool sourceForward = sourceFrom == from.a;
   const bool imageForward = imageFrom == to.a;
+  // A matched edge's nodes follow its length and neighbours: its image, whose length may
+  // differ (a straight chord of a source on a surface), takes the source's.
+  const bool copyParams = to.matched && from.matched;
   double difference = 0.0;
   for (int i = 0; i < n; ++i)
   {
@@ -356,6 +406,10 @@ void rotateEdgeNodes(const BlockModel& model, MeshTopology& topology, int source
     const int sourceIndex = sourceForward ? along : n - 1 - along;
     const double sourceParam =
       sourceForward ? from.params[sourceIndex] : 1.0 - from.params[sourceIndex];
+    if (copyParams)
+    {
+      to.params[i] = imageForward ? sourceParam : 1.0 - sourceParam;
+    }
     const double imageParam = imageForward ? to.params[i] : 1.0 - to.params[i];
     difference = std::max(difference, std::abs(sourceParam - imageParam));
     if (i == 0 || i == n - 1)

@@ -92,6 +92,11 @@ DistributionLaw refinedLaw(const DistributionLaw& law, int templateCells, int ce
 struct UniqueEdge : TopologyEdge
 {
   double length = 0.0;
+  /// Law `match` in its blocks: the end cells come from the edges continuing it across
+  /// block interfaces (matchEdgeEnds), lengths in the canonical direction (0: free).
+  bool matched = false;
+  double matchRatio = DefaultMatchRatio;
+  double matchFirst = 0.0, matchLast = 0.0;
   std::vector<double> params;
   std::vector<double> xyz;
 };
@@ -114,6 +119,11 @@ struct MeshTopology
   std::vector<UniqueEdge> edges;
   std::vector<UniqueFace> faces;
   std::vector<MeshLinks> blocks;
+  /// Edge ends (2 edge + 0 at vertex a, + 1 at b) that continue one another across a
+  /// block interface or a periodic pair, grouped; only when the model has matched edges.
+  std::vector<std::vector<int>> matchGroups;
+  /// (image, source) edge ends of periodic faces: the image end takes the source's cell.
+  std::vector<std::pair<int, int>> matchCopies;
 };
 
 /// Node counts of a block at a density multiplier (max(1, round(cells * m)) cells per
@@ -125,6 +135,23 @@ MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedC
 /// Node parameters of unique edge `e` from the laws of the blocks that use it (checked to
 /// agree), with its current length.
 void computeEdgeParameters(const BlockModel& model, MeshTopology& topology, int e, bool allowFallback);
+/**
+ * Groups the ends of edges that continue one another through a vertex across a block
+ * interface (the edges normal to the shared face at its corners, in the two blocks) or a
+ * periodic pair (the same at corresponding corners of the two faces), and marks the
+ * edges whose law is `match` (all their blocks must say so). Needs the periodic pairs of
+ * topology.connectivity (found here when the model has matched edges; a model whose
+ * periodic patches do not pair is left to the patch check).
+ */
+void buildMatchGroups(const BlockModel& model, MeshTopology& topology);
+/**
+ * The end cell lengths of every matched edge from its group at that end: the geometric
+ * mean of the end cells of the graded (not matched) edges there, else the smallest mean
+ * cell (length / cells) of the matched edges there; free (0) when the end continues into
+ * no other edge. The parameters of the graded edges must be current. Returns the matched
+ * edges whose end lengths changed.
+ */
+std::vector<int> matchEdgeEnds(const BlockModel& model, MeshTopology& topology);
 /// Parameters of the collapsed edges of block `b`.
 void computeCollapsedParameters(const BlockModel& model, MeshTopology& topology, int b);
 

@@ -275,7 +275,30 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
     edge.length = edge.named >= 0
       ? Curves[edge.named].length
       : (model.vertices[edge.b].position - model.vertices[edge.a].position).norm();
-    computeEdgeParameters(model, Topo, static_cast<int>(u), AllowFallback);
+    if (!edge.matched)
+    {
+      computeEdgeParameters(model, Topo, static_cast<int>(u), AllowFallback);
+    }
+  }
+  // matched edges follow the graded edges and the lengths at their ends
+  if (!Topo.matchGroups.empty())
+  {
+    for (const int u : matchEdgeEnds(model, Topo))
+    {
+      changedEdge[u] = 1;
+    }
+  }
+  for (std::size_t u = 0; u < Topo.edges.size(); ++u)
+  {
+    if (!changedEdge[u])
+    {
+      continue;
+    }
+    UniqueEdge& edge = Topo.edges[u];
+    if (edge.matched)
+    {
+      computeEdgeParameters(model, Topo, static_cast<int>(u), AllowFallback);
+    }
     computeEdgeNodes(model, Curves, Geometry, edge);
     for (const int b : EdgeBlocks[u])
     {

@@ -264,8 +264,8 @@ std::string shortNumber(double value)
 namespace
 {
 const char* const LawSyntax =
-  "uniform, {geometric: k}, {two_sided: k}, {first_cell: h, ratio: r} or "
-  "{ends: [a, b]}";
+  "uniform, {geometric: k}, {two_sided: k}, {first_cell: h, ratio: r}, "
+  "{ends: [a, b]}, match or {match: r}";
 }
 
 DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entityText,
@@ -279,6 +279,12 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
     {
       return law;
     }
+    if (node.Scalar() == "match")
+    {
+      law.kind = DistributionLaw::Kind::Match;
+      law.expansionRatio = DefaultMatchRatio;
+      return law;
+    }
     reporter.fail(here, entityText,
       what + ": unknown law '" + node.Scalar() + "'; expected " + LawSyntax);
   }
@@ -288,7 +294,24 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
   }
   const std::vector<MapEntry> entries = mapEntries(node, here, entityText, what, reporter);
   checkKeys(
-    entries, { "geometric", "two_sided", "first_cell", "ratio", "ends" }, entityText, reporter);
+    entries, { "geometric", "two_sided", "first_cell", "ratio", "ends", "match" }, entityText,
+    reporter);
+  if (const MapEntry* match = findEntry(entries, "match"))
+  {
+    if (entries.size() != 1)
+    {
+      reporter.fail(match->line, entityText, what + ": expected {match: r} alone");
+    }
+    law.kind = DistributionLaw::Kind::Match;
+    law.expansionRatio = number(match->value, match->line, what + " match");
+    if (!(law.expansionRatio > 1.0) || !std::isfinite(law.expansionRatio))
+    {
+      reporter.fail(match->line, entityText,
+        what + ": the growth ratio of a matched edge must be above 1, got " +
+          formatNumber(law.expansionRatio));
+    }
+    return law;
+  }
   if (const MapEntry* ends = findEntry(entries, "ends"))
   {
     if (entries.size() != 1 || !ends->value.IsSequence() || ends->value.size() != 2)
@@ -378,6 +401,11 @@ void emitLaw(YAML::Emitter& out, const DistributionLaw& law)
       out << YAML::Flow << YAML::BeginMap << YAML::Key << "ends" << YAML::Value
           << YAML::Flow << YAML::BeginSeq << formatNumber(law.firstCellSize)
           << formatNumber(law.lastCellSize) << YAML::EndSeq << YAML::EndMap;
+      return;
+    case DistributionLaw::Kind::Match:
+      // the end cells are the mesher's, from the neighbour edges: only the ratio is the law's
+      out << YAML::Flow << YAML::BeginMap << YAML::Key << "match" << YAML::Value
+          << formatNumber(law.expansionRatio) << YAML::EndMap;
       return;
   }
 }

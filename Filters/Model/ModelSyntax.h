@@ -80,8 +80,9 @@ std::string shortNumber(double value);
 using NumberReader = std::function<double(const YAML::Node& node, int line, const std::string& what)>;
 
 /**
- * A grading law: `uniform`, `{geometric: k}`, `{two_sided: k}` or
- * `{first_cell: h, ratio: r}` (ratio optional). `what` names the law in messages
+ * A grading law: `uniform`, `{geometric: k}`, `{two_sided: k}`,
+ * `{first_cell: h, ratio: r}` (ratio optional), `{ends: [a, b]}`, `match` or `{match: r}`
+ * (end cells from the neighbour edges, growing by r, default DefaultMatchRatio). `what` names the law in messages
  * ("grading j", "grading E9").
  */
 DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entity,

@@ -346,3 +346,77 @@ TEST(Distribution, EndsGiveTheEndCellsRelativeToTheMeanAtEveryCount)
   ends.firstCellSize = 0.0;
   EXPECT_THROW(distributeNodes(ends, 5), GeometryError);
 }
+
+TEST(Distribution, MatchGivesTheEndCellsAndGrowsByTheRatio)
+{
+  // An edge of length 2 with first cell 0.01 and last cell 0.02, 40 cells, ratio 1.2: the
+  // cells grow by exactly 1.2 from both ends up to a uniform middle that fills the edge.
+  const std::vector<double> s = matchedNodes(0.01, 0.02, 2.0, 41, 1.2);
+  expectValidNodes(s, 41);
+  EXPECT_NEAR(cell(s, 0) * 2.0, 0.01, 1e-14);
+  EXPECT_NEAR(cell(s, 39) * 2.0, 0.02, 1e-14);
+  EXPECT_NEAR(cell(s, 1) / cell(s, 0), 1.2, 1e-12);
+  EXPECT_NEAR(cell(s, 38) / cell(s, 39), 1.2, 1e-12);
+  double largest = 0.0, worst = 1.0;
+  for (int i = 0; i < 40; ++i)
+  {
+    largest = std::max(largest, cell(s, i));
+    if (i > 0)
+    {
+      worst = std::max({ worst, cell(s, i) / cell(s, i - 1), cell(s, i - 1) / cell(s, i) });
+    }
+  }
+  EXPECT_LE(worst, 1.2 + 1e-12);
+  // the middle is uniform: the largest cell is reached by more than one cell
+  int atLargest = 0;
+  for (int i = 0; i < 40; ++i)
+  {
+    atLargest += std::abs(cell(s, i) - largest) < 1e-14 ? 1 : 0;
+  }
+  EXPECT_GT(atLargest, 1);
+
+  // Too few cells to reach the length by 1.2: the ratio rises, the ends stay.
+  const std::vector<double> few = matchedNodes(0.01, 0.01, 2.0, 9, 1.2);
+  expectValidNodes(few, 9);
+  EXPECT_NEAR(cell(few, 0) * 2.0, 0.01, 1e-12);
+  EXPECT_NEAR(cell(few, 7) * 2.0, 0.01, 1e-12);
+  const double r = cell(few, 1) / cell(few, 0);
+  EXPECT_GT(r, 1.2);
+  EXPECT_NEAR(cell(few, 2) / cell(few, 1), r, 1e-9);
+  // (1 + r + r^2 + r^3) * 2 * 0.01 = 2 for the 8 symmetric cells
+  EXPECT_NEAR((1 + r + r * r + r * r * r) * 0.02, 2.0, 1e-9);
+
+  // An end cell larger than the mean cell: exact ends, cells shrinking towards the middle.
+  const std::vector<double> big = matchedNodes(0.3, 0.2, 2.0, 11, 1.2);
+  expectValidNodes(big, 11);
+  EXPECT_NEAR(cell(big, 0) * 2.0, 0.3, 1e-9);
+  EXPECT_NEAR(cell(big, 9) * 2.0, 0.2, 1e-9);
+  EXPECT_LT(cell(big, 5), cell(big, 0));
+  // One free end: cells grow from the given one and stay uniform after.
+  const std::vector<double> one = matchedNodes(0.0, 0.02, 1.0, 21, 1.3);
+  EXPECT_NEAR(cell(one, 19), 0.02, 1e-14);
+  EXPECT_NEAR(cell(one, 0), cell(one, 1), 1e-14);
+  // Both free: uniform; the law reversed swaps the ends; bad ratios throw.
+  const std::vector<double> free = matchedNodes(0.0, 0.0, 3.0, 7, 1.2);
+  for (int i = 0; i <= 6; ++i)
+  {
+    EXPECT_NEAR(free[i], i / 6.0, 1e-15);
+  }
+  DistributionLaw match;
+  match.kind = DistributionLaw::Kind::Match;
+  match.expansionRatio = 1.2;
+  match.firstCellSize = 0.01;
+  match.lastCellSize = 0.02;
+  const DistributionLaw back = reversedLaw(match);
+  EXPECT_EQ(back.firstCellSize, 0.02);
+  EXPECT_EQ(back.lastCellSize, 0.01);
+  const std::vector<double> viaLaw = distributeNodes(match, 41, 2.0);
+  const std::vector<double> mirrored = distributeNodes(back, 41, 2.0);
+  for (int i = 0; i <= 40; ++i)
+  {
+    EXPECT_EQ(viaLaw[i], s[i]);
+    EXPECT_NEAR(mirrored[i], 1.0 - s[40 - i], 1e-14);
+  }
+  EXPECT_THROW(matchedNodes(0.01, 0.01, 1.0, 5, 1.0), GeometryError);
+  EXPECT_THROW(matchedNodes(0.01, 0.01, 1.0, 5, std::nan("")), GeometryError);
+}

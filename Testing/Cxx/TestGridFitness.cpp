@@ -30,15 +30,18 @@ using test::Pi;
 
 /**
  * Largest neighbour cell size ratio across block interfaces accepted, per template (see
- * checkFitness). Issue 8 asks for 1.5; measured on the four machines at densities 0.5-4:
- * axial_passage_h 1.6-7.1 (its blade blocks against the downstream ones), axial_passage_oh
- * 30-570 (its leading- and trailing-edge O blocks against the blade sides; worst on the
- * compressor's sharp trailing edge, growing with the density). These bounds only keep
- * them from getting worse.
+ * checkFitness). Issue 8 asks for about 1.5. axial_passage_h grades every edge with the
+ * `match` law (end cells from the edges continuing it across interfaces); measured on the
+ * four machines at densities 0.5-4: 1.11-1.48, but 1.76 on the distributor at density 4,
+ * across the leading-edge plane between the upstream and blade blocks away from the
+ * vertices (the interior of a face blends its edges' distributions, which match at the
+ * vertices only). axial_passage_oh is not graded (30-570: its leading- and trailing-edge
+ * O blocks against the blade sides, see README); these bounds keep both from getting
+ * worse.
  */
 double maxNeighbourRatio(const std::string& templateName)
 {
-  return templateName == "axial_passage_h" ? 8.0 : 600.0;
+  return templateName == "axial_passage_h" ? 1.8 : 600.0;
 }
 
 struct Machine
@@ -325,9 +328,7 @@ void checkFitness(const std::string& templateName, const Machine& machine)
       a1 += cyl.axial(p) / outlet.size();
     const double volumeError =
       test::gridVolume(grid) / passageVolume(inputs, cyl, pitch, a0, a1) - 1.0;
-    // 0.5 %; at density 0.5 the turbine's thick round leading edge has 4 cells per half
-    // chord, and the polygon misses 0.84 % (H) of the passage: 1 % there.
-    EXPECT_LT(std::abs(volumeError), density < 1.0 ? 0.01 : 0.005);
+    EXPECT_LT(std::abs(volumeError), 0.005);
 
     // neighbour cells across block interfaces
     const test::NeighbourRatio jump =
@@ -335,12 +336,13 @@ void checkFitness(const std::string& templateName, const Machine& machine)
     EXPECT_GT(jump.pairs, 0u);
     EXPECT_LE(jump.ratio, maxNeighbourRatio(templateName)) << jump.where;
 
+    const double expansion = test::maxExpansionInBlocks(grid);
     std::printf("FITNESS %s %s density %.1f cells %lld MinAngle %lld %lld %lld %lld %lld "
-                "minScaledJacobian %.4f maxNeighbourRatio %.3f (%s) volumeError %.2e "
-                "offSurface %.1e periodic %.1e templateSeconds %.3f\n",
+                "minScaledJacobian %.4f maxNeighbourRatio %.3f (%s) maxExpansion %.3f "
+                "volumeError %.2e offSurface %.1e periodic %.1e templateSeconds %.3f\n",
       templateName.c_str(), machine.name.c_str(), density, cells, classes[0], classes[1],
       classes[2], classes[3], classes[4], minJacobian, jump.ratio, jump.where.c_str(),
-      volumeError, offSurface, periodic, templateSeconds);
+      expansion, volumeError, offSurface, periodic, templateSeconds);
   }
 }
 

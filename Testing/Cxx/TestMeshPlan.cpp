@@ -244,3 +244,39 @@ TEST(MeshPlan, InfeasibleMovesAreValuesNamingTheBlock)
   EXPECT_EQ(inverted.block, 0);
   EXPECT_TRUE(checkCells(plan.blockNodes(0).data(), n, 0).feasible());
 }
+
+TEST(MeshPlan, MatchedEdgesFollowMovesAsAFreshMesherDoes)
+{
+  // axial_passage_h grades its edges with `match`: a move changes the lengths at the
+  // moved vertex, so the end cells of the edges continuing them change too.
+  const TemplateInputs inputs =
+    test::readTemplateInputs(test::sourcePath("Data/rotor37/turbogrid/BladeGen.inf"));
+  CarrierGeometry carriers;
+  const BlockModel model =
+    loadTemplate(test::templatePath("axial_passage_h.yaml"), {}, &inputs, &carriers);
+  MeshPlan plan(model, carriers);
+  expectSameAsFreshMesher(plan);
+  const int mid = vertexIndex(plan.model(), "lo_mid_h");
+  const std::vector<FreeParameter> parameters = freeParameters(plan.model(), plan.carriers());
+  const FreeParameter* s = nullptr;
+  for (const FreeParameter& parameter : parameters)
+  {
+    if (parameter.vertex == mid)
+    {
+      s = &parameter;
+      break;
+    }
+  }
+  ASSERT_NE(s, nullptr);
+  const double original = plan.model().vertices[mid].constraint.s;
+  const double originalT = plan.model().vertices[mid].constraint.t;
+  const double start = s->component == 0 ? original : originalT;
+  for (const double delta : { 0.01, -0.01 })
+  {
+    SCOPED_TRACE(delta);
+    const Feasibility feasibility =
+      plan.update(moveParameter(plan.model(), plan.carriers(), *s, start + delta));
+    EXPECT_TRUE(feasibility.feasible()) << feasibility.message;
+    expectSameAsFreshMesher(plan);
+  }
+}

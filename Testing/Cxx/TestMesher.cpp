@@ -2,6 +2,7 @@
 // boundary nodes, bit-identical shared faces, density multiplier and preview cap,
 // determinism, periodicity, degenerate wedges and total volume.
 #include "Mesher.h"
+#include "ModelDocument.h"
 #include "Quality.h"
 #include "Template.h"
 
@@ -523,5 +524,64 @@ blocks:
   for (double v : g.xyz)
   {
     ASSERT_TRUE(std::isfinite(v));
+  }
+}
+
+TEST(Mesher, MatchedEdgesTakeTheirEndCellsFromTheirNeighbours)
+{
+  // Two unit cubes along x, 4 cells across the left one and 16 across the right one, law
+  // `match` along x in both: at the shared face both cells are the geometric mean of the
+  // two blocks' mean cells (0.25 and 0.0625), 0.125, at every density.
+  BlockModel model = loadTemplate(test::sourcePath("Testing/Data/two_blocks.yaml"));
+  model.blocks[1].cells[0] = 16;
+  DistributionLaw match;
+  match.kind = DistributionLaw::Kind::Match;
+  match.expansionRatio = 1.2;
+  for (Block& block : model.blocks)
+  {
+    for (int e = 0; e < 12; ++e)
+    {
+      if (edgeDirection(e) == 0)
+      {
+        block.laws[e] = match;
+      }
+    }
+  }
+  for (const double density : { 1.0, 2.0 })
+  {
+    SCOPED_TRACE(density);
+    const auto grids = meshBlocks(model, density);
+    const BlockGrid& left = grids[0];
+    const BlockGrid& right = grids[1];
+    const double expected = std::sqrt(0.25 * 0.0625) / density;
+    for (int k = 0; k < left.nk; ++k)
+    {
+      for (int j = 0; j < left.nj; ++j)
+      {
+        const double last = (left.node(left.ni - 1, j, k) - left.node(left.ni - 2, j, k)).norm();
+        const double first = (right.node(1, j, k) - right.node(0, j, k)).norm();
+        EXPECT_NEAR(last, expected, 1e-12);
+        EXPECT_NEAR(first, expected, 1e-12);
+      }
+    }
+  }
+  // The law travels in the model document (the pipeline's stages pass the model so).
+  const BlockModel reread = readModelDocument(writeModelDocument(model));
+  for (std::size_t b = 0; b < model.blocks.size(); ++b)
+  {
+    EXPECT_EQ(reread.blocks[b].laws, model.blocks[b].laws) << b;
+  }
+  // A block that shares a matched edge must match it too.
+  BlockModel mixed = loadTemplate(test::sourcePath("Testing/Data/two_blocks.yaml"));
+  mixed.blocks[0].laws[1] = match; // left E2 (a1-a2, along j) is on the shared face
+  try
+  {
+    meshBlocks(mixed);
+    ADD_FAILURE() << "no error for an edge matched in one block only";
+  }
+  catch (const TemplateError& error)
+  {
+    EXPECT_NE(std::string(error.what()).find("give it the same law 'match'"), std::string::npos)
+      << error.what();
   }
 }

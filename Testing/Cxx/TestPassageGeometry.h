@@ -206,5 +206,39 @@ inline NeighbourRatio neighbourSizeRatio(const Grid& grid, const model::BlockMod
   }
   return result;
 }
+/**
+ * The largest ratio of neighbour cell lengths along a grid line inside any block (the
+ * expansion ratio of the distributions as meshed): for every pair of consecutive cell
+ * edges along i, j or k, the longer over the shorter.
+ */
+inline double maxExpansionInBlocks(const Grid& grid)
+{
+  double worst = 1.0;
+  for (int b = 0; b < static_cast<int>(grid.nodes.size()); ++b)
+  {
+    const auto& n = grid.nodes[b];
+    for (int d = 0; d < 3; ++d)
+    {
+      std::array<int, 3> ijk{};
+      for (ijk[2] = 0; ijk[2] < n[2]; ++ijk[2])
+        for (ijk[1] = 0; ijk[1] < n[1]; ++ijk[1])
+          for (ijk[0] = 0; ijk[0] < n[0]; ++ijk[0])
+          {
+            if (ijk[d] + 2 >= n[d])
+              continue;
+            std::array<int, 3> q1 = ijk, q2 = ijk;
+            q1[d] += 1;
+            q2[d] += 2;
+            const Vec3 p0 = grid.at(b, ijk[0], ijk[1], ijk[2]);
+            const Vec3 p1 = grid.at(b, q1[0], q1[1], q1[2]);
+            const Vec3 p2 = grid.at(b, q2[0], q2[1], q2[2]);
+            const double a = (p1 - p0).norm(), c = (p2 - p1).norm();
+            const double r = std::max(a, c) / std::max(std::min(a, c), 1e-300);
+            worst = std::max(worst, r);
+          }
+    }
+  }
+  return worst;
+}
 } // namespace test
 } // namespace blockforge

@@ -41,6 +41,10 @@ CASES = [("cylinder_in_box", "cylinder_in_box", None),
 ALLOWED_FAILURES = {
     # 20 of the 60 prisms on the axis are slivers (aspect ratio 32).
     "wedge_sector": {"determinant"},
+    # The turbine's inlet is 10 % of a chord from its thick round leading edge: graded to
+    # match the short upstream blocks (law match), the blade-side cells at the leading and
+    # trailing edges are thin across the blade (62 cells below 0.001).
+    "axial_passage_h_turbine": {"determinant"},
     # Thin cells on the blade (O-grid expansion k_o towards the wall, aspect ratio up to
     # 37); and where the O-grid's leading/trailing-edge blocks meet its side blocks the cell
     # length along the blade jumps (uniform spacing in each block): low interpolation weights.
