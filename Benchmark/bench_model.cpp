@@ -12,8 +12,13 @@
  *                       what an evaluation cost before the mesh plan;
  * - MoveOneControlPoint: one evaluation with a MeshPlan built once: the O-grid corner
  *                       oa_f_h moved along its carrier (moveParameter: placement of it and
- *                       of what follows it), update() (dependent edges, faces, checks, TFI
- *                       of the affected blocks) and MinAngle of the affected cells.
+ *                       of what follows it: a_f_h projected from it, the mid-passage and
+ *                       inlet vertices placed by expressions of it, the periodic line
+ *                       drawn through them), update() (dependent edges, faces, checks, TFI
+ *                       of the affected blocks) and MinAngle of the affected cells;
+ * - MoveOneControlPointWithoutChains: the same on the model without expression and curve
+ *                       chains (only a_f_h follows, as before they were kept): the same
+ *                       work as before, for comparison with older builds.
  * Run with repetitions and read the medians:
  *   bench_model --benchmark_repetitions=7 --benchmark_report_aggregates_only=true
  */
@@ -136,9 +141,32 @@ double smallestMinAngle(const std::vector<double>& xyz, const std::array<int, 3>
   return smallest;
 }
 
-void BM_MoveOneControlPoint(benchmark::State& state)
+/// The model without what follows through expressions and curves (as before issue 7's
+/// chains): the same move then updates what it updated before, for comparison.
+const Applied& appliedWithoutChains()
 {
-  const Applied& a = applied();
+  static const Applied result = [] {
+    Applied a = applied();
+    for (model::Vertex& vertex : a.model.vertices)
+    {
+      vertex.rule.expressions = model::PlacementExpressions();
+    }
+    for (model::Carrier& carrier : a.model.carriers)
+    {
+      carrier.throughVertices.clear();
+    }
+    for (model::Edge& edge : a.model.edges)
+    {
+      edge.atExpressions.clear();
+      edge.atFollows.clear();
+    }
+    return a;
+  }();
+  return result;
+}
+
+void moveOneControlPoint(benchmark::State& state, const Applied& a)
+{
   model::MeshPlan plan(a.model, a.carriers);
   const int vertex = plan.model().findVertex("oa_f_h");
   model::FreeParameter parameter;
@@ -173,6 +201,16 @@ void BM_MoveOneControlPoint(benchmark::State& state)
   state.counters["cells"] = static_cast<double>(cells);
   state.counters["infeasible"] = static_cast<double>(infeasible);
 }
+
+void BM_MoveOneControlPoint(benchmark::State& state)
+{
+  moveOneControlPoint(state, applied());
+}
+
+void BM_MoveOneControlPointWithoutChains(benchmark::State& state)
+{
+  moveOneControlPoint(state, appliedWithoutChains());
+}
 #endif
 } // namespace
 
@@ -201,6 +239,9 @@ int main(int argc, char** argv)
     ->Unit(benchmark::kMillisecond);
 #ifdef BLOCKFORGE_HAS_MESH_PLAN
   benchmark::RegisterBenchmark("MoveOneControlPoint", BM_MoveOneControlPoint)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("MoveOneControlPointWithoutChains", BM_MoveOneControlPointWithoutChains)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 #endif

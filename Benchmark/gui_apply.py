@@ -29,24 +29,38 @@ view = GetActiveViewOrCreate("RenderView")
 # "" keeps the plugin's default first look; e.g. "Surface With Edges" forces one.
 representation = os.environ.get("BLOCKFORGE_REPRESENTATION", "")
 apply_times, mesh_times = [], []
+parts = {"mesh": [], "data_information": [], "show": [], "first_render": [], "render_again": []}
 cells = 0
+shown_as = ""
 for run in range(5):
     mesher = BlockMesher(Input=model, DensityMultiplier=4.70 + 0.01 * (run % 2))  # noqa: F821
     start = time.perf_counter()
     mesher.UpdatePipeline()
     meshed = time.perf_counter()
     cells = mesher.GetDataInformation().GetNumberOfCells()
+    informed = time.perf_counter()
     display = Show(mesher, view)
     if representation:
         display.SetRepresentationType(representation)
+    shown = time.perf_counter()
     Render(view)
-    apply_times.append(time.perf_counter() - start)
+    rendered = time.perf_counter()
+    apply_times.append(rendered - start)
     mesh_times.append(meshed - start)
+    Render(view)  # what every later interaction costs (a camera move renders again)
+    parts["mesh"].append(meshed - start)
+    parts["data_information"].append(informed - meshed)
+    parts["show"].append(shown - informed)
+    parts["first_render"].append(rendered - shown)
+    parts["render_again"].append(time.perf_counter() - rendered)
+    shown_as = str(display.GetPropertyValue("Representation"))
     Hide(mesher, view)
     Delete(mesher)
 result = {"plugin": os.environ.get("PV_PLUGIN_PATH", ""), "cells": cells,
-          "representation": representation or "default",
+          "representation": representation or "default", "shown_as": shown_as,
           "apply_to_render_s": statistics.median(apply_times),
-          "mesh_s": statistics.median(mesh_times)}
+          "mesh_s": statistics.median(mesh_times),
+          "parts_s": {key: statistics.median(values) for key, values in parts.items()},
+          "load": os.getloadavg()[0]}
 with open(os.path.join(os.environ["BLOCKFORGE_GUI_OUTPUT"], "gui_apply.jsonl"), "a") as stream:
     stream.write(json.dumps(result) + "\n")

@@ -229,6 +229,29 @@ namespace blockforge
 {
 namespace vtkglue
 {
+namespace
+{
+/// The blocks of `piece` (model::balancedPieces: shared out by cells), all for one piece.
+std::vector<int> pieceBlocks(const model::MultiBlockMesher& mesher, int piece, int pieceCount)
+{
+  std::vector<std::array<int, 3>> nodeCounts;
+  for (int b = 0; b < mesher.blockCount(); ++b)
+  {
+    nodeCounts.push_back(mesher.nodeCounts(b));
+  }
+  const std::vector<int> pieceOf = model::balancedPieces(nodeCounts, pieceCount);
+  std::vector<int> blocks;
+  for (int b = 0; b < mesher.blockCount(); ++b)
+  {
+    if (pieceCount <= 1 || pieceOf[b] == piece)
+    {
+      blocks.push_back(b);
+    }
+  }
+  return blocks;
+}
+} // namespace
+
 void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlockMesher& mesher,
   vtkMultiBlockDataSet* output, int piece, int pieceCount,
   const std::function<void(double)>& progress, InvertedCellPolicy policy,
@@ -236,17 +259,16 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
 {
   const int blockCount = mesher.blockCount();
   output->SetNumberOfBlocks(static_cast<unsigned int>(blockCount));
-  std::vector<std::array<int, 3>> nodeCounts;
-  for (int b = 0; b < blockCount; ++b)
+  std::vector<char> mine(static_cast<std::size_t>(blockCount), 0);
+  for (const int b : pieceBlocks(mesher, piece, pieceCount))
   {
-    nodeCounts.push_back(mesher.nodeCounts(b));
+    mine[b] = 1;
   }
-  const std::vector<int> pieceOf = model::balancedPieces(nodeCounts, pieceCount);
   for (int b = 0; b < blockCount; ++b)
   {
     output->GetMetaData(static_cast<unsigned int>(b))
       ->Set(vtkCompositeDataSet::NAME(), blockModel.blocks[b].name.c_str());
-    if (pieceCount > 1 && pieceOf[b] != piece)
+    if (!mine[b])
     {
       continue;
     }
@@ -278,8 +300,9 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
       }
     }
 
-    vtkNew<vtkPoints> points;
-    points->SetData(coordinates);
+    // With its bounds (and the coordinates' ranges) computed now, on threads: ParaView
+    // asks for them after every update.
+    vtkSmartPointer<vtkPoints> points = pointsWithKnownBounds(coordinates);
     vtkNew<vtkStructuredGrid> grid;
     grid->SetDimensions(nodes[0], nodes[1], nodes[2]);
     grid->SetPoints(points);
@@ -289,8 +312,6 @@ void fillMultiBlock(const model::BlockModel& blockModel, const model::MultiBlock
     blockId->SetNumberOfTuples(grid->GetNumberOfCells());
     blockId->FillValue(b);
     grid->GetCellData()->AddArray(blockId);
-    // Ranges ParaView asks for after every update, computed now while cheap.
-    cacheRanges(coordinates);
     cacheConstantRange(blockId, b);
     // The active scalars are what ParaView colours by at first: the decomposition.
     grid->GetCellData()->SetActiveScalars("BlockId");
@@ -381,19 +402,19 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
     CarrierCache::instance().store(document, mesher.carriers());
   }
   mesher.setCellCap(cellCap);
+  // This piece's blocks (an MPI rank's share): their memory is checked and only the
+  // boundary grids they need are computed.
+  const std::vector<int> share = pieceBlocks(mesher, piece, pieceCount);
   model::BlockNodeCounts nodes;
-  for (int b = 0; b < mesher.blockCount(); ++b)
+  for (const int b : share)
   {
-    if (pieceCount <= 1 || b % pieceCount == piece)
-    {
-      nodes.push_back(mesher.nodeCounts(b));
-    }
+    nodes.push_back(mesher.nodeCounts(b));
   }
   model::checkGridMemory(nodes, maximumMemoryGigabytes,
     cellCap > 0 || policy == InvertedCellPolicy::Skip // the template's preview
       ? "lower PreviewCells or the cell counts"
                 : "lower the density multiplier or the cell counts");
-  mesher.computeBoundaries();
+  mesher.computeBoundaries(share);
   if (progress)
   {
     progress(0.05);

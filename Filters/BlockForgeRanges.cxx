@@ -8,6 +8,8 @@
 #include <vtkInformationInformationVectorKey.h>
 #include <vtkInformationVector.h>
 #include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkPoints.h>
 
 #include <algorithm>
 #include <cmath>
@@ -85,12 +87,15 @@ void store(vtkDataArray* array, const Ranges& ranges)
 }
 } // namespace
 
-void cacheRanges(vtkDoubleArray* array)
+namespace
+{
+/// Computes (on threads) and caches every range of `array`; returns them.
+Ranges computeAndCache(vtkDoubleArray* array)
 {
   const vtkIdType tuples = array ? array->GetNumberOfTuples() : 0;
   if (tuples == 0)
   {
-    return;
+    return Ranges(array ? array->GetNumberOfComponents() : 0);
   }
   const int components = array->GetNumberOfComponents();
   const double* values = array->GetPointer(0);
@@ -139,7 +144,45 @@ void cacheRanges(vtkDoubleArray* array)
     total.merge(ranges);
   }
   store(array, total);
+  return total;
 }
+
+/// vtkPoints with bounds set from outside, kept until the points are modified.
+class vtkPointsWithKnownBounds : public vtkPoints
+{
+public:
+  static vtkPointsWithKnownBounds* New();
+  vtkTypeMacro(vtkPointsWithKnownBounds, vtkPoints);
+  void SetKnownBounds(const double bounds[6])
+  {
+    std::copy(bounds, bounds + 6, this->Bounds);
+    this->ComputeTime.Modified(); // newer than the data: ComputeBounds keeps them
+  }
+
+protected:
+  vtkPointsWithKnownBounds() = default;
+  ~vtkPointsWithKnownBounds() override = default;
+};
+vtkStandardNewMacro(vtkPointsWithKnownBounds);
+} // namespace
+
+void cacheRanges(vtkDoubleArray* array)
+{
+  computeAndCache(array);
+}
+
+vtkSmartPointer<vtkPoints> pointsWithKnownBounds(vtkDoubleArray* coordinates)
+{
+  vtkNew<vtkPointsWithKnownBounds> points;
+  points->SetData(coordinates);
+  if (coordinates->GetNumberOfComponents() == 3 && coordinates->GetNumberOfTuples() > 0)
+  {
+    const Ranges ranges = computeAndCache(coordinates);
+    points->SetKnownBounds(ranges.all.data());
+  }
+  return points.GetPointer();
+}
+
 
 void cacheConstantRange(vtkDataArray* array, double value)
 {

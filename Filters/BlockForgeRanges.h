@@ -11,8 +11,11 @@
  */
 #pragma once
 
+#include <vtkSmartPointer.h>
+
 class vtkDataArray;
 class vtkDoubleArray;
+class vtkPoints;
 
 namespace blockforge
 {
@@ -21,6 +24,16 @@ namespace vtkglue
 /// Computes every range in one pass over the values (on threads, see Core/Parallel.h)
 /// and caches them. Call after the last change to the values.
 void cacheRanges(vtkDoubleArray* array);
+
+/**
+ * Points on `coordinates` (3 components) whose bounds are already known: the ranges are
+ * computed and cached as by cacheRanges(), in the same pass, and the bounds (the
+ * per-component ranges, NaN skipped, as vtkPoints::ComputeBounds gives them) are set on
+ * the points. ParaView's data information asks every grid for its bounds after an update;
+ * vtkPoints would scan all coordinates again for them, on one core (about 0.7 s for 1e7
+ * nodes). A later change of the coordinates drops the known bounds (they are recomputed).
+ */
+vtkSmartPointer<vtkPoints> pointsWithKnownBounds(vtkDoubleArray* coordinates);
 
 /// Caches the ranges of an array whose values are all `value` (e.g. BlockId).
 void cacheConstantRange(vtkDataArray* array, double value);

@@ -1,5 +1,6 @@
 #include "vtkGridQuality.h"
 
+#include "../Core/Parallel.h"
 #include "../Core/Quality.h"
 #include "../Model/MemoryBudget.h"
 #include "../Model/ModelDocument.h"
@@ -173,6 +174,7 @@ int vtkGridQuality::RequestData(
   std::vector<vtkSmartPointer<vtkStructuredGrid>> measuredGrids;
   std::vector<std::array<vtkSmartPointer<vtkDoubleArray>, 6>> measureArrays(grids.size());
   std::vector<blockforge::CellQualityPointers> outputs(grids.size());
+  std::vector<std::pair<void*, std::size_t>> freshMemory;
   for (size_t b = 0; b < grids.size(); ++b)
   {
     auto measured = vtkSmartPointer<vtkStructuredGrid>::New();
@@ -183,7 +185,7 @@ int vtkGridQuality::RequestData(
       auto array = vtkSmartPointer<vtkDoubleArray>::New();
       array->SetName(MeasureNames[m]);
       array->SetNumberOfTuples(cells);
-      blockforge::prepareOutputMemory(array->GetPointer(0), sizeof(double) * cells);
+      freshMemory.emplace_back(array->GetPointer(0), sizeof(double) * cells);
       measured->GetCellData()->AddArray(array);
       measureArrays[b][m] = array;
     }
@@ -204,6 +206,7 @@ int vtkGridQuality::RequestData(
     measured->GetCellData()->SetActiveScalars("MinAngle");
     measuredGrids.push_back(measured);
   }
+  blockforge::prepareOutputMemory(freshMemory);
   try
   {
     const blockforge::vtkglue::QualityNeighbourhood neighbours =
@@ -239,21 +242,35 @@ int vtkGridQuality::RequestData(
   minimum.fill(std::numeric_limits<double>::max());
   maximum.fill(std::numeric_limits<double>::lowest());
   double cellCount = 0.0;
+  // Minimum, maximum and sum of every array of every block, arrays on threads; the sums
+  // are then added in block order (the same bits on any number of threads).
+  struct ArraySummary
+  {
+    double minimum = std::numeric_limits<double>::max();
+    double maximum = std::numeric_limits<double>::lowest();
+    double sum = 0.0;
+  };
+  std::vector<ArraySummary> summaries(6 * grids.size());
+  blockforge::forEachChunk(static_cast<long>(summaries.size()), [&](long n) {
+    const double* values = measureArrays[n / 6][n % 6]->GetPointer(0);
+    const vtkIdType cells = measureArrays[n / 6][n % 6]->GetNumberOfTuples();
+    ArraySummary& summary = summaries[n];
+    for (vtkIdType c = 0; c < cells; ++c)
+    {
+      summary.minimum = std::min(summary.minimum, values[c]);
+      summary.maximum = std::max(summary.maximum, values[c]);
+      summary.sum += values[c];
+    }
+  });
   for (size_t b = 0; b < grids.size(); ++b)
   {
     const vtkIdType cells = measureArrays[b][0]->GetNumberOfTuples();
     for (int m = 0; m < 6; ++m)
     {
-      const double* values = measureArrays[b][m]->GetPointer(0);
-      for (vtkIdType c = 0; c < cells; ++c)
-      {
-        minimum[m] = std::min(minimum[m], values[c]);
-        maximum[m] = std::max(maximum[m], values[c]);
-        sum[m] += values[c];
-      }
-    }
-    for (int m = 0; m < 6; ++m)
-    {
+      const ArraySummary& summary = summaries[6 * b + m];
+      minimum[m] = std::min(minimum[m], summary.minimum);
+      maximum[m] = std::max(maximum[m], summary.maximum);
+      sum[m] += summary.sum;
       blockforge::vtkglue::cacheRanges(measureArrays[b][m]);
     }
     const auto blockClasses = blockforge::minAngleClasses(

@@ -5,7 +5,7 @@
 find_package(Python3 REQUIRED COMPONENTS Interpreter Development.Module)
 find_package(MPI REQUIRED COMPONENTS C)
 find_package(ParaView 5.10 REQUIRED COMPONENTS RemotingClientServerStream
-  OPTIONAL_COMPONENTS pqComponents)
+  OPTIONAL_COMPONENTS pqComponents pqApplicationComponents)
 # Debian's paraview-dev exports link interfaces that name targets of packages it does not
 # install (Boost, HDF5, NetCDF, GLEW, libxml2, X11, Qt5 OpenGL); only linking against
 # ParaView's Qt libraries (the panel widget, Plugin/) meets them. Those are shared

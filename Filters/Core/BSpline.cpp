@@ -227,6 +227,31 @@ int findSpan(int degree, const std::vector<double>& knots, int controlPointCount
   {
     return degree;
   }
+  // knots[degree] < t < knots[n + 1]: exactly one span k has knots[k] <= t < knots[k + 1],
+  // so any search finds the same one. Interpolated curves have nearly even knots: a guess
+  // from t's place between the end knots is mostly right or one off (a binary search
+  // costs a mispredicted branch per halving, a tenth of the evaluation of a cubic).
+  const double first = knots[degree], range = knots[n + 1] - first;
+  const double place = (t - first) / range * (n + 1 - degree);
+  if (place >= 0.0 && place < n + 1 - degree)
+  {
+    int guess = degree + static_cast<int>(place);
+    for (int step = 0; step < 3; ++step)
+    {
+      if (t < knots[guess])
+      {
+        --guess; // t > knots[degree]: stays >= degree
+      }
+      else if (t >= knots[guess + 1])
+      {
+        ++guess; // t < knots[n + 1]: stays <= n
+      }
+      else
+      {
+        return guess;
+      }
+    }
+  }
   int low = degree, high = n + 1;
   int mid = (low + high) / 2;
   while (t < knots[mid] || t >= knots[mid + 1])
@@ -293,16 +318,20 @@ void basisFunctions(int span, double t, int degree, const std::vector<double>& k
 namespace
 {
 /**
- * Piegl & Tiller's algorithm A2.3. With FixedDegree > 0 the degree is a compile-time
- * constant, so the compiler unrolls the loops (cubic carriers are most of the evaluations
- * of a template); the operations and their order are the same, so are the results, bit
- * for bit.
+ * Piegl & Tiller's algorithm A2.3. With FixedDegree > 0 the degree (FixedOrder > 0: the
+ * order too) is a compile-time constant, so the compiler unrolls the loops (cubic
+ * carriers are most of the evaluations of a template); the operations and their order
+ * are the same, so are the results, bit for bit.
  */
-template <int FixedDegree>
+template <int FixedDegree, int FixedOrder = 0>
 void basisDerivativesOf(int span, double t, int degree, int order,
   const std::vector<double>& knots, double* ders)
 {
   const int p = FixedDegree > 0 ? FixedDegree : degree;
+  if (FixedOrder > 0)
+  {
+    order = FixedOrder;
+  }
   const int width = p + 1;
   // ndu holds the basis functions (upper triangle) and knot differences (lower triangle).
   double ndu[MaxBasis][MaxBasis];
@@ -380,7 +409,11 @@ void basisDerivativesOf(int span, double t, int degree, int order,
 void basisDerivatives(int span, double t, int degree, int order,
   const std::vector<double>& knots, double* ders)
 {
-  if (degree == 3)
+  if (degree == 3 && order == 1)
+  {
+    basisDerivativesOf<3, 1>(span, t, degree, order, knots, ders); // arc lengths, tangents
+  }
+  else if (degree == 3)
   {
     basisDerivativesOf<3>(span, t, degree, order, knots, ders);
   }
@@ -447,6 +480,38 @@ BSplineCurve::BSplineCurve(int degree, std::vector<double> knots,
   requireDegree(degree, "B-spline curve");
   validateKnots(degree, Knots, static_cast<int>(ControlPoints.size()), "B-spline curve");
   requireFinitePoints(ControlPoints, "B-spline curve control points");
+  const int count = static_cast<int>(ControlPoints.size());
+  const int bins = 4 * count;
+  const double first = Knots[Degree], range = Knots[count] - first;
+  SpanTable.resize(bins + 1);
+  for (int bin = 0; bin <= bins; ++bin)
+  {
+    SpanTable[bin] = bspline::findSpan(Degree, Knots, count, first + range * bin / bins);
+  }
+}
+
+int BSplineCurve::span(double t) const
+{
+  const int count = static_cast<int>(ControlPoints.size());
+  const int n = count - 1;
+  if (!(t > Knots[Degree] && t < Knots[n + 1]))
+  {
+    return bspline::findSpan(Degree, Knots, count, t); // ends, NaN
+  }
+  // Inside, exactly one span k has Knots[k] <= t < Knots[k + 1]: walk to it from the
+  // table (a step or two), the same span the bisection finds.
+  const int bins = static_cast<int>(SpanTable.size()) - 1;
+  const double place = (t - Knots[Degree]) / (Knots[n + 1] - Knots[Degree]) * bins;
+  int k = SpanTable[std::max(0, std::min(bins - 1, static_cast<int>(place)))];
+  while (t < Knots[k])
+  {
+    --k;
+  }
+  while (t >= Knots[k + 1])
+  {
+    ++k;
+  }
+  return k;
 }
 
 namespace
@@ -541,8 +606,7 @@ BSplineCurve BSplineCurve::interpolateAt(const std::vector<Vec3>& points,
 Vec3 BSplineCurve::point(double t) const
 {
   t = clampUnit(t);
-  const int count = static_cast<int>(ControlPoints.size());
-  const int span = bspline::findSpan(Degree, Knots, count, t);
+  const int span = this->span(t);
   double basis[MaxBasis];
   bspline::basisFunctions(span, t, Degree, Knots, basis);
   Vec3 result = Vec3::Zero();
@@ -571,8 +635,7 @@ Vec3 BSplineCurve::derivative(double t, int order) const
 void BSplineCurve::derivatives(double t, int order, Vec3* out) const
 {
   t = clampUnit(t);
-  const int count = static_cast<int>(ControlPoints.size());
-  const int span = bspline::findSpan(Degree, Knots, count, t);
+  const int span = this->span(t);
   const int computed = std::min(order, Degree);
   double ders[MaxBasis * MaxBasis];
   bspline::basisDerivatives(span, t, Degree, computed, Knots, ders);

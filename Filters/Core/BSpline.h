@@ -82,8 +82,13 @@ public:
   const std::vector<double>& dataParameters() const { return DataParameters; }
 
 private:
+  /// findSpan(Degree, Knots, count, t), from SpanTable: same result, no bisection.
+  int span(double t) const;
   int Degree;
   std::vector<double> Knots;
+  /// The span at the start of each of SpanTable.size() - 1 equal bins of
+  /// [Knots[Degree], Knots[count]] (spans of curves on blades are uneven: crowded at the edges).
+  std::vector<int> SpanTable;
   std::vector<Vec3> ControlPoints;
   std::vector<double> DataParameters;
 };

@@ -2,6 +2,7 @@
 // revolution and offsets within a surface. Split from Carriers.cpp, which builds the
 // surfaces themselves.
 #include "Carriers.h"
+#include "RootFinding.h"
 
 #include <Eigen/Geometry>
 
@@ -27,81 +28,6 @@ std::string format(double value)
 // =======================================================================================
 namespace
 {
-/// Brent's method (Brent 1973; zbrent in Numerical Recipes) on a sign-changing bracket:
-/// inverse quadratic / secant steps with bisection fallback, always converges. Stops when
-/// the bracket is narrower than `tolerance` (absolute in t) or f hits 0.
-template <typename F>
-double brentRoot(const F& f, double a, double b, double fa, double fb, double tolerance)
-{
-  constexpr double Eps = std::numeric_limits<double>::epsilon();
-  double c = b, fc = fb, d = b - a, e = d;
-  for (int iteration = 0; iteration < 200; ++iteration)
-  {
-    if ((fb > 0.0 && fc > 0.0) || (fb < 0.0 && fc < 0.0))
-    {
-      c = a;
-      fc = fa;
-      e = d = b - a;
-    }
-    if (std::abs(fc) < std::abs(fb))
-    {
-      a = b;
-      b = c;
-      c = a;
-      fa = fb;
-      fb = fc;
-      fc = fa;
-    }
-    const double tol1 = 2.0 * Eps * std::abs(b) + 0.5 * tolerance;
-    const double xm = 0.5 * (c - b);
-    if (std::abs(xm) <= tol1 || fb == 0.0)
-    {
-      return b;
-    }
-    if (std::abs(e) >= tol1 && std::abs(fa) > std::abs(fb))
-    {
-      const double s = fb / fa;
-      double p, q;
-      if (a == c)
-      {
-        p = 2.0 * xm * s;
-        q = 1.0 - s;
-      }
-      else
-      {
-        const double qq = fa / fc, r = fb / fc;
-        p = s * (2.0 * xm * qq * (qq - r) - (b - a) * (r - 1.0));
-        q = (qq - 1.0) * (r - 1.0) * (s - 1.0);
-      }
-      if (p > 0.0)
-      {
-        q = -q;
-      }
-      p = std::abs(p);
-      const double min1 = 3.0 * xm * q - std::abs(tol1 * q), min2 = std::abs(e * q);
-      if (2.0 * p < std::min(min1, min2))
-      {
-        e = d;
-        d = p / q;
-      }
-      else
-      {
-        d = xm;
-        e = d;
-      }
-    }
-    else
-    {
-      d = xm;
-      e = d;
-    }
-    a = b;
-    fa = fb;
-    b += std::abs(d) > tol1 ? d : std::copysign(tol1, xm);
-    fb = f(b);
-  }
-  return b;
-}
 
 /// Finds t with f(s, t) = 0 on [tMin, tMax] for one s of the intersection.
 class RootFinder

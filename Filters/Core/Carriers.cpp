@@ -374,6 +374,7 @@ SurfaceOfRevolution::SurfaceOfRevolution(CurvePtr contour, const Vec3& axisPoint
       " to " + format(angleEnd) + " rad is empty or not finite");
   }
   AxisDirection = axisDirection / norm;
+  ContourSpline = dynamic_cast<const BSplineCurve*>(Contour.get());
   Meridional = std::make_shared<MeridionalCurve>(Contour, AxisPoint, AxisDirection);
   // 256 samples: hub/shroud contours are smooth; candidates are refined by Newton anyway.
   MeridionalProjector = std::make_shared<CurveProjector>(Meridional, 256);
@@ -390,11 +391,36 @@ Vec3 SurfaceOfRevolution::point(double s, double t) const
     rotateVector(Contour->point(s) - AxisPoint, AxisDirection, std::cos(angle), std::sin(angle));
 }
 
+// point() at the five parameters: three contour points and three angles, each once.
+void SurfaceOfRevolution::crossPoints(double s, double sPlus, double sMinus, double t,
+  double tPlus, double tMinus, Vec3 out[5]) const
+{
+  const Vec3 contour[3] = { Contour->point(s), Contour->point(sPlus), Contour->point(sMinus) };
+  double angle[3], cs[3], sn[3];
+  const double at[3] = { t, tPlus, tMinus };
+  for (int k = 0; k < 3; ++k)
+  {
+    angle[k] = AngleStart + at[k] * (AngleEnd - AngleStart);
+    cs[k] = std::cos(angle[k]);
+    sn[k] = std::sin(angle[k]);
+  }
+  auto rotated = [&](int c, int a) {
+    return angle[a] == 0.0
+      ? contour[c]
+      : Vec3(AxisPoint + rotateVector(contour[c] - AxisPoint, AxisDirection, cs[a], sn[a]));
+  };
+  out[0] = rotated(0, 0);
+  out[1] = rotated(1, 0);
+  out[2] = rotated(2, 0);
+  out[3] = rotated(0, 1);
+  out[4] = rotated(0, 2);
+}
+
 void SurfaceOfRevolution::contourJet(double s, int order, Vec3 (&c)[3]) const
 {
-  if (const auto* spline = dynamic_cast<const BSplineCurve*>(Contour.get()))
+  if (ContourSpline)
   {
-    spline->derivatives(s, order, c);
+    ContourSpline->derivatives(s, order, c);
     return;
   }
   c[0] = Contour->point(s);
@@ -705,6 +731,72 @@ Vec3 GordonSurface::point(double s, double t) const
     }
   }
   return result;
+}
+
+// point() at the five parameters, each section and t-curve evaluated once per parameter
+// it is needed at; every sum runs in point()'s order, so the bits are point()'s.
+void GordonSurface::crossPoints(double s, double sPlus, double sMinus, double t, double tPlus,
+  double tMinus, Vec3 out[5]) const
+{
+  const int n = static_cast<int>(TNodes.size());
+  const int m = static_cast<int>(SNodes.size());
+  const double sAt[3] = { s, sPlus, sMinus };
+  const double tAt[3] = { t, tPlus, tMinus };
+  const BlendAt b[3] = { { TheBlending, TNodes, TBlendCoefficients, t },
+    { TheBlending, TNodes, TBlendCoefficients, tPlus },
+    { TheBlending, TNodes, TBlendCoefficients, tMinus } };
+  const BlendAt a[3] = { { TheBlending, SNodes, SBlendCoefficients, s },
+    { TheBlending, SNodes, SBlendCoefficients, sPlus },
+    { TheBlending, SNodes, SBlendCoefficients, sMinus } };
+  static const int at[5][2] = { { 0, 0 }, { 1, 0 }, { 2, 0 }, { 0, 1 }, { 0, 2 } }; // (s, t)
+  for (int k = 0; k < 5; ++k)
+  {
+    out[k].setZero();
+  }
+  for (int j = 0; j < n; ++j)
+  {
+    Vec3 bracket[3];
+    bool have[3] = { false, false, false };
+    for (int k = 0; k < 5; ++k)
+    {
+      const int si = at[k][0];
+      const double bj = b[at[k][1]].value(j);
+      if (bj == 0.0)
+      {
+        continue;
+      }
+      if (!have[si])
+      {
+        bracket[si] = extendedCurvePoint(*SCurves[j], sAt[si]);
+        for (int i = 0; i < m; ++i)
+        {
+          bracket[si] -= a[si].value(i) * NodePoints[i + j * m];
+        }
+        have[si] = true;
+      }
+      out[k] += bj * bracket[si];
+    }
+  }
+  for (int i = 0; i < m; ++i)
+  {
+    Vec3 curve[3];
+    bool have[3] = { false, false, false };
+    for (int k = 0; k < 5; ++k)
+    {
+      const int ti = at[k][1];
+      const double ai = a[at[k][0]].value(i);
+      if (ai == 0.0)
+      {
+        continue;
+      }
+      if (!have[ti])
+      {
+        curve[ti] = extendedCurvePoint(*TCurves[i], tAt[ti]);
+        have[ti] = true;
+      }
+      out[k] += ai * curve[ti];
+    }
+  }
 }
 
 void GordonSurface::derivatives(double s, double t, SurfaceDerivatives& out) const

@@ -43,6 +43,8 @@ public:
   Vec3 point(double s, double t) const override;
   void derivatives(double s, double t, SurfaceDerivatives& out) const override;
   void firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const override;
+  void crossPoints(double s, double sPlus, double sMinus, double t, double tPlus, double tMinus,
+    Vec3 out[5]) const override;
 
   const Vec3& axisPoint() const { return AxisPoint; }
   const Vec3& axisDirection() const { return AxisDirection; } ///< unit vector
@@ -72,6 +74,7 @@ private:
   void firstOrder(const Vec3 (&c)[3], double t, Vec3& P, Vec3& Ps, Vec3& Pt, double& cs,
     double& sn, Vec3& arm) const;
   CurvePtr Contour;
+  const BSplineCurve* ContourSpline = nullptr; ///< Contour when it is a B-spline (one basis evaluation per jet)
   Vec3 AxisPoint, AxisDirection;
   double AngleStart, AngleEnd;
   // The contour mapped to (axial, radius, 0) and its projector: the closest meridional
@@ -142,6 +145,8 @@ public:
   Vec3 point(double s, double t) const override;
   void derivatives(double s, double t, SurfaceDerivatives& out) const override;
   void firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const override;
+  void crossPoints(double s, double sPlus, double sMinus, double t, double tPlus, double tMinus,
+    Vec3 out[5]) const override;
   /// Same as point() (which extrapolates too); kept as the explicit name for callers.
   Vec3 extendedPoint(double s, double t) const { return point(s, t); }
 

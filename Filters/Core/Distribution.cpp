@@ -1,4 +1,5 @@
 #include "Distribution.h"
+#include "RootFinding.h"
 
 #include <algorithm>
 #include <cmath>
@@ -205,15 +206,7 @@ std::vector<double> firstCellSolvedRatio(double h, double length, int nodeCount)
     lo = 1.0;
     hi = std::max(1.0, std::pow(q, 1.0 / (cells - 1))) * (1.0 + 1e-12);
   }
-  for (int iteration = 0; iteration < 2000; ++iteration)
-  {
-    const double mid = 0.5 * (lo + hi);
-    if (!(mid > lo && mid < hi))
-    {
-      break;
-    }
-    (sumOfPowers(mid) < q ? lo : hi) = mid;
-  }
+  bisect([&](double k) { return sumOfPowers(k) < q; }, lo, hi, 0.0, 2000);
   const double k = std::abs(sumOfPowers(lo) - q) <= std::abs(sumOfPowers(hi) - q) ? lo : hi;
   if (!(k > 0.0))
   {
@@ -363,11 +356,7 @@ std::vector<double> endSizes(double first, double last, int nodeCount)
     double low = -60.0, high = 60.0;
     if (mean(sizes(low)) <= 1.0 && mean(sizes(high)) >= 1.0)
     {
-      for (int iteration = 0; iteration < 200 && high - low > 1e-13; ++iteration)
-      {
-        const double middle = 0.5 * (low + high);
-        (mean(sizes(middle)) < 1.0 ? low : high) = middle;
-      }
+      bisect([&](double beta) { return mean(sizes(beta)) < 1.0; }, low, high, 1e-13, 200);
       h = sizes(0.5 * (low + high));
     }
   }
@@ -449,9 +438,13 @@ std::vector<double> matchedNodes(double first, double last, double length, int n
   {
     if (first <= 0.0 || last <= 0.0)
     {
-      // one end given: cells shrink geometrically from it towards the free end
+      // one end given: cells shrink geometrically from it towards the free end, by at
+      // most the ratio to the fourth (an end cell near the whole edge would leave the
+      // others no room)
+      const double q = std::pow(ratio, -4.0);
+      const double largest = length * (1.0 - q) / (1.0 - std::pow(q, cells));
       const std::vector<double> s =
-        firstCellSolvedRatio(std::max(first, last), length, nodeCount);
+        firstCellSolvedRatio(std::min(std::max(first, last), largest), length, nodeCount);
       if (first > 0.0)
       {
         return s;
@@ -479,15 +472,7 @@ std::vector<double> matchedNodes(double first, double last, double length, int n
       low = high;
       high *= 2.0;
     }
-    for (int iteration = 0; iteration < 200; ++iteration)
-    {
-      const double middle = 0.5 * (low + high);
-      if (!(middle > low && middle < high))
-      {
-        break;
-      }
-      (grownLength(first, last, middle, cells) < length ? low : high) = middle;
-    }
+    bisect([&](double x) { return grownLength(first, last, x, cells) < length; }, low, high, 0.0, 200);
     r = high;
   }
   std::vector<double> grown(cells);

@@ -1,5 +1,7 @@
 #include "InvertedCells.h"
 
+#include "Parallel.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -119,15 +121,12 @@ inline double smallestRawJacobian(const double* xyz, std::size_t n0, std::size_t
                                 (zeta.x + zeta.y + zeta.z));
   return std::min(m, triple(xi, eta, zeta)) + finite;
 }
-} // namespace
 
-InvertedCells findInvertedCells(const double* xyz, int ni, int nj, int nk, double tolerance)
+/// findInvertedCells over the cell layers k0 <= k < k1.
+InvertedCells findInLayers(
+  const double* xyz, int ni, int nj, int k0, int k1, double tolerance)
 {
   InvertedCells found;
-  if (ni < 2 || nj < 2 || nk < 2)
-  {
-    return found;
-  }
   const std::size_t strideJ = static_cast<std::size_t>(ni);
   const std::size_t strideK = strideJ * static_cast<std::size_t>(nj);
   auto node = [xyz](std::size_t n) {
@@ -135,7 +134,7 @@ InvertedCells findInvertedCells(const double* xyz, int ni, int nj, int nk, doubl
   };
   std::vector<double> smallest(static_cast<std::size_t>(ni - 1));
   Frames frames;
-  for (int k = 0; k + 1 < nk; ++k)
+  for (int k = k0; k < k1; ++k)
   {
     for (int j = 0; j + 1 < nj; ++j)
     {
@@ -192,6 +191,57 @@ InvertedCells findInvertedCells(const double* xyz, int ni, int nj, int nk, doubl
         ++found.count;
       }
     }
+  }
+  return found;
+}
+} // namespace
+
+InvertedCells findInvertedCells(const double* xyz, int ni, int nj, int nk, double tolerance)
+{
+  if (ni < 2 || nj < 2 || nk < 2)
+  {
+    return InvertedCells();
+  }
+  // k-layer chunks on threads (Core/Parallel.h), merged in layer order: the same result
+  // as one pass, bit for bit, whatever the threads.
+  const long layerCells = static_cast<long>(ni - 1) * (nj - 1);
+  const long chunks = chunkCount(layerCells * (nk - 1), 1L << 18, nk - 1);
+  std::vector<InvertedCells> partial(static_cast<std::size_t>(chunks));
+  forEachChunk(chunks, [&](long chunk) {
+    const int k0 = static_cast<int>((nk - 1) * chunk / chunks);
+    const int k1 = static_cast<int>((nk - 1) * (chunk + 1) / chunks);
+    partial[static_cast<std::size_t>(chunk)] = findInLayers(xyz, ni, nj, k0, k1, tolerance);
+  });
+  InvertedCells found;
+  for (const InvertedCells& part : partial)
+  {
+    if (part.count == 0)
+    {
+      continue;
+    }
+    if (found.count == 0)
+    {
+      found.lowest = part.lowest;
+      found.highest = part.highest;
+      found.worstCell = part.worstCell;
+      found.worstScaledJacobian = part.worstScaledJacobian;
+    }
+    else
+    {
+      for (int d = 0; d < 3; ++d)
+      {
+        found.lowest[d] = std::min(found.lowest[d], part.lowest[d]);
+        found.highest[d] = std::max(found.highest[d], part.highest[d]);
+      }
+      // The first cell with the most negative Jacobian, as in one pass in cell order.
+      if (part.worstScaledJacobian < found.worstScaledJacobian)
+      {
+        found.worstScaledJacobian = part.worstScaledJacobian;
+        found.worstCell = part.worstCell;
+      }
+    }
+    found.count += part.count;
+    found.nonFinite += part.nonFinite;
   }
   return found;
 }

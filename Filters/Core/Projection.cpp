@@ -541,69 +541,154 @@ SurfaceProjector::SurfaceProjector(SurfacePtr surface, int samplesS, int samples
       SamplePoints[i + static_cast<std::size_t>(j) * samplesS] = TheSurface->point(s, t);
     }
   }
+  auto at = [&](int i, int j) -> const Vec3& {
+    return SamplePoints[i + static_cast<std::size_t>(j) * samplesS];
+  };
+  Spacing.assign(SamplePoints.size(), 0.0);
+  for (int j = 0; j < samplesT; ++j)
+  {
+    for (int i = 0; i < samplesS; ++i)
+    {
+      double& spacing = Spacing[i + static_cast<std::size_t>(j) * samplesS];
+      for (int dj = -1; dj <= 1; ++dj)
+      {
+        for (int di = -1; di <= 1; ++di)
+        {
+          const int ii = i + di, jj = j + dj;
+          if (ii >= 0 && jj >= 0 && ii < samplesS && jj < samplesT)
+          {
+            spacing = std::max(spacing, (at(ii, jj) - at(i, j)).norm());
+          }
+        }
+      }
+    }
+  }
+  const int size = 8;
+  for (int j0 = 0; j0 < samplesT; j0 += size)
+  {
+    for (int i0 = 0; i0 < samplesS; i0 += size)
+    {
+      Tile tile;
+      tile.i0 = i0;
+      tile.j0 = j0;
+      tile.i1 = std::min(samplesS, i0 + size);
+      tile.j1 = std::min(samplesT, j0 + size);
+      tile.low = Vec3::Constant(std::numeric_limits<double>::infinity());
+      tile.high = -tile.low;
+      for (int j = tile.j0; j < tile.j1; ++j)
+      {
+        for (int i = tile.i0; i < tile.i1; ++i)
+        {
+          tile.low = tile.low.cwiseMin(at(i, j));
+          tile.high = tile.high.cwiseMax(at(i, j));
+          tile.spacing = std::max(tile.spacing, Spacing[i + static_cast<std::size_t>(j) * samplesS]);
+        }
+      }
+      Tiles.push_back(tile);
+    }
+  }
 }
 
 SurfaceProjection SurfaceProjector::project(const Vec3& p, double tolerance) const
 {
   requireFinite(p);
   const int ns = SamplesS, nt = SamplesT;
-  auto at = [&](int i, int j) -> const Vec3& {
-    return SamplePoints[i + static_cast<std::size_t>(j) * ns];
-  };
+  const std::size_t count = SamplePoints.size();
 
   // Per-thread scratch: projection runs in inner loops and must not allocate each call.
+  // Distances are computed when first needed, each with the same formula, so the search
+  // sees the same numbers as one computing them all.
   thread_local std::vector<double> distances;
-  distances.resize(SamplePoints.size());
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < SamplePoints.size(); ++k)
-  {
-    distances[k] = (SamplePoints[k] - p).norm();
-    best = std::min(best, distances[k]);
-  }
-  CandidateList candidates;
-  for (int j = 0; j < nt; ++j)
-  {
-    for (int i = 0; i < ns; ++i)
+  thread_local std::vector<char> known;
+  distances.resize(count);
+  known.assign(count, 0);
+  auto distance = [&](std::size_t k) {
+    if (!known[k])
     {
-      const std::size_t index = i + static_cast<std::size_t>(j) * ns;
-      const double d = distances[index];
-      bool localMinimum = true;
-      for (int dj = -1; dj <= 1 && localMinimum; ++dj)
+      distances[k] = (SamplePoints[k] - p).norm();
+      known[k] = 1;
+    }
+    return distances[k];
+  };
+  // The nearest sample: tiles nearest first, until a tile's box is farther than the best
+  // sample so far (its samples cannot be nearer). Bounds are lowered by a margin far above
+  // rounding, so no tile that might hold the nearest sample is left out.
+  const std::size_t tileCount = Tiles.size();
+  thread_local std::vector<std::pair<double, std::size_t>> byBound;
+  byBound.clear();
+  for (std::size_t k = 0; k < tileCount; ++k)
+  {
+    const Tile& tile = Tiles[k];
+    const Vec3 gap = (tile.low - p).cwiseMax(p - tile.high).cwiseMax(Vec3::Zero());
+    byBound.emplace_back(gap.norm() * (1.0 - 1e-12), k);
+  }
+  std::sort(byBound.begin(), byBound.end());
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& entry : byBound)
+  {
+    if (entry.first > best)
+    {
+      break;
+    }
+    const Tile& tile = Tiles[entry.second];
+    for (int j = tile.j0; j < tile.j1; ++j)
+    {
+      for (int i = tile.i0; i < tile.i1; ++i)
       {
-        for (int di = -1; di <= 1; ++di)
-        {
-          const int ii = i + di, jj = j + dj;
-          if (ii >= 0 && jj >= 0 && ii < ns && jj < nt &&
-            distances[ii + static_cast<std::size_t>(jj) * ns] < d)
-          {
-            localMinimum = false;
-            break;
-          }
-        }
-      }
-      if (!localMinimum)
-      {
-        continue;
-      }
-      // A local minimum farther than the best sample by more than its cell size cannot
-      // hold the closest point.
-      double spacing = 0.0;
-      for (int dj = -1; dj <= 1; ++dj)
-      {
-        for (int di = -1; di <= 1; ++di)
-        {
-          const int ii = i + di, jj = j + dj;
-          if (ii >= 0 && jj >= 0 && ii < ns && jj < nt)
-          {
-            spacing = std::max(spacing, (at(ii, jj) - at(i, j)).norm());
-          }
-        }
-      }
-      if (d - spacing <= best)
-      {
-        candidates.offer({ d, static_cast<int>(index) });
+        best = std::min(best, distance(i + static_cast<std::size_t>(j) * ns));
       }
     }
+  }
+  // Candidates: local minima no farther than the best sample by more than their cell size
+  // (Spacing); only tiles near enough to hold one are searched, and candidates are offered
+  // in sample order.
+  thread_local std::vector<std::size_t> found;
+  found.clear();
+  for (const auto& entry : byBound)
+  {
+    const Tile& tile = Tiles[entry.second];
+    if (entry.first > (best + tile.spacing) * (1.0 + 1e-12))
+    {
+      continue;
+    }
+    for (int j = tile.j0; j < tile.j1; ++j)
+    {
+      for (int i = tile.i0; i < tile.i1; ++i)
+      {
+        const std::size_t index = i + static_cast<std::size_t>(j) * ns;
+        const double d = distance(index);
+        if (!(d - Spacing[index] <= best))
+        {
+          continue;
+        }
+        // A local minimum farther than the best sample by more than its cell size cannot
+        // hold the closest point.
+        bool localMinimum = true;
+        for (int dj = -1; dj <= 1 && localMinimum; ++dj)
+        {
+          for (int di = -1; di <= 1; ++di)
+          {
+            const int ii = i + di, jj = j + dj;
+            if (ii >= 0 && jj >= 0 && ii < ns && jj < nt &&
+              distance(ii + static_cast<std::size_t>(jj) * ns) < d)
+            {
+              localMinimum = false;
+              break;
+            }
+          }
+        }
+        if (localMinimum)
+        {
+          found.push_back(index);
+        }
+      }
+    }
+  }
+  std::sort(found.begin(), found.end());
+  CandidateList candidates;
+  for (const std::size_t index : found)
+  {
+    candidates.offer({ distances[index], static_cast<int>(index) });
   }
 
   // A step may cross at most two sample cells; beyond that the sample is a better guide.
@@ -628,163 +713,4 @@ SurfaceProjection SurfaceProjector::project(const Vec3& p, double tolerance) con
   return result;
 }
 
-// =======================================================================================
-namespace
-{
-// 10-point Gauss-Legendre rule on [-1, 1] (exact for polynomials of degree 19).
-constexpr std::array<double, 5> GaussNodes = { 0.148874338981631210885, 0.433395394129247190799,
-  0.679409568299024406234, 0.865063366688984510732, 0.973906528517171720078 };
-constexpr std::array<double, 5> GaussWeights = { 0.295524224714752870174,
-  0.269266719309996355091, 0.219086362515982043996, 0.149451349150580593146,
-  0.066671344308688137594 };
-
-double gaussSpeed(const Curve& curve, double a, double b)
-{
-  const double half = 0.5 * (b - a), centre = 0.5 * (a + b);
-  double sum = 0.0;
-  for (std::size_t k = 0; k < GaussNodes.size(); ++k)
-  {
-    const double offset = half * GaussNodes[k];
-    sum += GaussWeights[k] *
-      (curve.derivative(centre - offset, 1).norm() + curve.derivative(centre + offset, 1).norm());
-  }
-  return sum * half;
-}
-
-/// Adaptive bisection until the halves agree with the whole to `tolerance`; speed
-/// discontinuities (knots of low continuity, corners) only cost local refinement.
-double adaptiveLength(const Curve& curve, double a, double b, double whole, double tolerance,
-  int depth)
-{
-  const double m = 0.5 * (a + b);
-  const double left = gaussSpeed(curve, a, m);
-  const double right = gaussSpeed(curve, m, b);
-  const double halves = left + right;
-  // The halved tolerance is floored at what rounding of the speed allows: curves whose
-  // speed is only known to rounding (curves on Gordon surfaces) would otherwise refine
-  // to the depth limit everywhere.
-  const double achievable = 1e-13 * std::abs(halves);
-  if (depth >= 24 || std::abs(halves - whole) <= std::max(tolerance, achievable) ||
-    !(m > a && m < b))
-  {
-    return halves;
-  }
-  return adaptiveLength(curve, a, m, left, 0.5 * tolerance, depth + 1) +
-    adaptiveLength(curve, m, b, right, 0.5 * tolerance, depth + 1);
-}
-} // namespace
-
-ArcLength::ArcLength(CurvePtr curve, int segments)
-  : TheCurve(std::move(curve))
-{
-  if (!TheCurve)
-  {
-    throw GeometryError("arc length: no curve given");
-  }
-  if (segments < 1)
-  {
-    throw GeometryError("arc length needs at least 1 segment, got " +
-      std::to_string(segments));
-  }
-  Breaks.resize(segments + 1);
-  for (int k = 0; k <= segments; ++k)
-  {
-    Breaks[k] = static_cast<double>(k) / segments;
-  }
-  Breaks.back() = 1.0;
-  Cumulative.assign(segments + 1, 0.0);
-  for (int k = 0; k < segments; ++k)
-  {
-    Cumulative[k + 1] = Cumulative[k] + segmentLength(Breaks[k], Breaks[k + 1]);
-  }
-  Total = Cumulative.back();
-}
-
-double ArcLength::segmentLength(double a, double b) const
-{
-  if (!(b > a))
-  {
-    return 0.0;
-  }
-  const double whole = gaussSpeed(*TheCurve, a, b);
-  // Tolerance relative to the whole curve's length scale (segments are a fraction of it),
-  // with an absolute floor so that zero-speed pieces terminate at once.
-  const double scale = std::max(std::abs(whole), Total / static_cast<double>(Breaks.size()));
-  return adaptiveLength(*TheCurve, a, b, whole, 1e-15 * scale + 1e-300, 0);
-}
-
-double ArcLength::lengthAt(double t) const
-{
-  if (!(t > 0.0))
-  {
-    return 0.0;
-  }
-  if (t >= 1.0)
-  {
-    return Total;
-  }
-  const int segments = static_cast<int>(Breaks.size()) - 1;
-  int k = std::min(static_cast<int>(t * segments), segments - 1);
-  while (k > 0 && Breaks[k] > t)
-  {
-    --k;
-  }
-  while (k + 1 < segments && Breaks[k + 1] <= t)
-  {
-    ++k;
-  }
-  return Cumulative[k] + segmentLength(Breaks[k], t);
-}
-
-double ArcLength::parameterAtFraction(double fraction) const
-{
-  if (!(Total > 0.0))
-  {
-    // A collapsed curve: every parameter is at length 0, keep the mapping monotone.
-    return clampUnit(fraction);
-  }
-  if (!(fraction > 0.0))
-  {
-    return 0.0;
-  }
-  if (fraction >= 1.0)
-  {
-    return 1.0;
-  }
-  const double target = fraction * Total;
-  const int segments = static_cast<int>(Breaks.size()) - 1;
-  int k = static_cast<int>(std::upper_bound(Cumulative.begin(), Cumulative.end(), target) -
-            Cumulative.begin()) - 1;
-  k = std::max(0, std::min(k, segments - 1));
-  double lo = Breaks[k], hi = Breaks[k + 1];
-  const double base = Cumulative[k];
-  const double segment = Cumulative[k + 1] - base;
-  double t = segment > 0.0 ? lo + (hi - lo) * std::min(1.0, (target - base) / segment)
-                           : 0.5 * (lo + hi);
-  const double accuracy = 1e-14 * Total;
-  // The length at the current iterate is updated by the integral over each Newton step;
-  // those intervals shrink quadratically, so their quadrature is cheap and exact.
-  double error = base + segmentLength(Breaks[k], t) - target;
-  for (int iteration = 0; iteration < 100; ++iteration)
-  {
-    if (std::abs(error) <= accuracy)
-    {
-      break;
-    }
-    (error < 0.0 ? lo : hi) = t;
-    const double speed = TheCurve->derivative(t, 1).norm();
-    double next = speed > 0.0 ? t - error / speed : lo - 1.0;
-    if (!(next > lo && next < hi))
-    {
-      next = 0.5 * (lo + hi);
-    }
-    if (next == t || !(hi > lo))
-    {
-      break;
-    }
-    error += next > t ? segmentLength(t, next) : -segmentLength(next, t);
-    t = next;
-  }
-  return t;
-}
 } // namespace blockforge

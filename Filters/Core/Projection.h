@@ -56,28 +56,16 @@ private:
   SurfacePtr TheSurface;
   int SamplesS, SamplesT;
   std::vector<Vec3> SamplePoints; // s fastest
+  /// Per sample, the largest distance to a neighbour (the sample cell's size).
+  std::vector<double> Spacing;
+  /// Blocks of 8 x 8 samples with their bounding boxes: the search skips the far ones.
+  struct Tile
+  {
+    int i0 = 0, i1 = 0, j0 = 0, j1 = 0;
+    Vec3 low, high;
+    double spacing = 0.0;
+  };
+  std::vector<Tile> Tiles;
 };
 
-/**
- * @class ArcLength
- * @brief Arc-length parametrisation of a curve: length(t) by adaptive Gauss-Legendre
- * quadrature, and its inverse by Newton with bisection fallback.
- */
-class ArcLength
-{
-public:
-  explicit ArcLength(CurvePtr curve, int segments = 64);
-  double totalLength() const { return Total; }
-  /// Length of the curve from 0 to t.
-  double lengthAt(double t) const;
-  /// Parameter t at which lengthAt(t) == fraction * totalLength(), |error| < 1e-12 * total.
-  double parameterAtFraction(double fraction) const;
-
-private:
-  CurvePtr TheCurve;
-  std::vector<double> Breaks;     // segment boundaries in t
-  std::vector<double> Cumulative; // length up to each break
-  double Total = 0.0;
-  double segmentLength(double a, double b) const;
-};
 } // namespace blockforge

@@ -968,6 +968,17 @@ void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
   }
 }
 
+/// body(first, count) over [0, cells) in ranges on threads (elementwise work: the same
+/// bits in any chunking).
+void forEachCellRange(long cells, const std::function<void(long, long)>& body)
+{
+  const long chunks = chunkCount(cells, 1L << 17, 64);
+  forEachChunk(chunks, [&](long chunk) {
+    const long first = cells * chunk / chunks;
+    body(first, cells * (chunk + 1) / chunks - first);
+  });
+}
+
 void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
   const InterfaceTable& interfaces, const CellQualityPointers& quality,
   std::vector<double>& scratch, ProgressReporter& progress)
@@ -978,12 +989,15 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
   {
     return;
   }
-  std::fill_n(quality.minAngle, cellCount, 0.0);
-  std::fill_n(quality.maxAngle, cellCount, 0.0);
-  std::fill_n(quality.nonOrthogonality, cellCount, 1.0); // signed squared cosine until the end
-  std::fill_n(quality.skewness, cellCount, 0.0);
-  std::fill_n(quality.aspectRatio, cellCount, 0.0);
-  std::fill_n(quality.scaledJacobian, cellCount, 0.0);
+  forEachCellRange(cellCount, [&](long first, long count) {
+    std::fill_n(quality.minAngle + first, count, 0.0);
+    std::fill_n(quality.maxAngle + first, count, 0.0);
+    // signed squared cosine until finishBlock
+    std::fill_n(quality.nonOrthogonality + first, count, 1.0);
+    std::fill_n(quality.skewness + first, count, 0.0);
+    std::fill_n(quality.aspectRatio + first, count, 0.0);
+    std::fill_n(quality.scaledJacobian + first, count, 0.0);
+  });
   // Layers in chunks of at least two, on threads when a runner is installed. A chunk
   // [k0, k1) first re-evaluates layer k0 - 1 (the same values again: idempotent writes and
   // min/max updates), whose centres its lowest faces need, and updates cells of layers
@@ -1022,8 +1036,20 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
       progress.advance(static_cast<double>(layerCells) * view.ck * 0.5);
     }
   }
+}
+
+/// After every block's interior: the faces on the block's sides (boundaryFaces), then
+/// non-orthogonality from the signed squared cosine to degrees. Writes this block's
+/// cells only.
+void finishBlock(const std::vector<BlockView>& views, int blockIndex,
+  const InterfaceTable& interfaces, const CellQualityPointers& quality)
+{
+  if (views[blockIndex].cellCount == 0)
+  {
+    return;
+  }
   boundaryFaces(views, blockIndex, interfaces, quality);
-  for (long cell = 0; cell < cellCount; ++cell)
+  for (long cell = 0; cell < views[blockIndex].cellCount; ++cell)
   {
     double& value = quality.nonOrthogonality[cell];
     value = angleFromCosine(std::copysign(std::sqrt(std::abs(value)), value));
@@ -1186,6 +1212,11 @@ void evaluateBlocks(const std::vector<BlockView>& views, std::size_t measured, d
   {
     evaluateBlock(views, static_cast<int>(n), interfaces, outputs[n], scratch, reporter);
   }
+  // The blocks' sides read other blocks' nodes only and write their own block's cells:
+  // blocks on threads (min and max updates, the same bits in any order).
+  forEachChunk(static_cast<long>(measured), [&](long n) {
+    finishBlock(views, static_cast<int>(n), interfaces, outputs[n]);
+  });
   reporter.finish();
 }
 } // namespace
@@ -1281,8 +1312,32 @@ StructuredBlock sideLayer(const StructuredBlock& block, int side, std::vector<do
 
 void prepareOutputMemory(void* begin, std::size_t bytes)
 {
-  const auto start = reinterpret_cast<std::uintptr_t>(begin);
-  prefault(start, start + bytes);
+  prepareOutputMemory({ { begin, bytes } });
+}
+
+void prepareOutputMemory(const std::vector<std::pair<void*, std::size_t>>& buffers)
+{
+  // The kernel zeroes the pages it faults in: in 2 MiB-aligned pieces of about 4 MiB on
+  // threads, so a large output is not prepared by one core alone.
+  constexpr std::uintptr_t hugePage = std::uintptr_t(1) << 21;
+  constexpr std::uintptr_t pieceSize = 2 * hugePage;
+  std::vector<std::pair<std::uintptr_t, std::uintptr_t>> pieces;
+  for (const auto& buffer : buffers)
+  {
+    const auto start = reinterpret_cast<std::uintptr_t>(buffer.first);
+    const std::uintptr_t end = start + buffer.second;
+    std::uintptr_t from = start;
+    while (from < end)
+    {
+      std::uintptr_t to = ((from + pieceSize) & ~(hugePage - 1));
+      to = to >= end || end - to < hugePage ? end : to;
+      pieces.emplace_back(from, to);
+      from = to;
+    }
+  }
+  forEachChunk(static_cast<long>(pieces.size()), [&](long piece) {
+    prefault(pieces[piece].first, pieces[piece].second);
+  });
 }
 
 std::array<long long, 5> minAngleClasses(const double* minAngles, std::size_t count)

@@ -15,6 +15,8 @@
 
 #include <array>
 #include <functional>
+#include <utility>
+#include <vector>
 
 namespace blockforge
 {
@@ -188,6 +190,9 @@ void computeGridQuality(const std::vector<StructuredBlock>& blocks,
 /// fault it in at once. On virtual machines where a first-touch page fault costs ~10 us,
 /// this makes filling a fresh array several times cheaper. Contents are unchanged.
 void prepareOutputMemory(void* begin, std::size_t bytes);
+/// The same for several buffers at once (the arrays of a multiblock output), on threads
+/// in pieces of a few MiB, whatever the sizes of the single buffers.
+void prepareOutputMemory(const std::vector<std::pair<void*, std::size_t>>& buffers);
 
 /// Counts of cells per MinAngle class: [0,20), [20,40), [40,60), [60,80), [80,90].
 std::array<long long, 5> minAngleClasses(const std::vector<CellQualityArrays>& quality);

@@ -31,6 +31,20 @@ public:
     Ps = d.Ps;
     Pt = d.Pt;
   }
+  /**
+   * The points at (s, t), (sPlus, t), (sMinus, t), (s, tPlus) and (s, tMinus), the same
+   * bits as point() at each (central differences around a point): surfaces whose points
+   * are sums over curves in s and in t (Gordon) evaluate each curve once per parameter.
+   */
+  virtual void crossPoints(double s, double sPlus, double sMinus, double t, double tPlus,
+    double tMinus, Vec3 out[5]) const
+  {
+    out[0] = point(s, t);
+    out[1] = point(sPlus, t);
+    out[2] = point(sMinus, t);
+    out[3] = point(s, tPlus);
+    out[4] = point(s, tMinus);
+  }
 };
 
 using SurfacePtr = std::shared_ptr<const Surface>;

@@ -53,6 +53,30 @@ int BlockModel::requiredFormat() const
 {
   for (const Vertex& vertex : vertices)
   {
+    if (vertex.rule.expressions.form != PlacementExpressions::Form::None)
+    {
+      return 4;
+    }
+  }
+  for (const Edge& edge : edges)
+  {
+    if (!edge.atFollows.empty())
+    {
+      return 4;
+    }
+  }
+  for (const Carrier& carrier : carriers)
+  {
+    for (const int vertex : carrier.throughVertices)
+    {
+      if (vertex >= 0)
+      {
+        return 4;
+      }
+    }
+  }
+  for (const Vertex& vertex : vertices)
+  {
     // Rules the constraint does not imply travel as such from format 3 on.
     if (vertex.rule.kind != impliedRule(vertex.constraint).kind)
     {

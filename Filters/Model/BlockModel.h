@@ -92,6 +92,9 @@ struct Carrier
   Vec3 axis = Vec3::UnitZ();
   double angleStart = 0.0, angleEnd = 0.0;
   std::vector<Eigen::Vector2d> parameterPoints;
+  /// SurfaceCurve: the vertex each parameter point is taken from (-1: a given [s, t]); the
+  /// curve is drawn again through them when they move (Placement.h).
+  std::vector<int> throughVertices;
   double rangeMin = -0.5, rangeMax = 1.5; ///< Intersect: t range searched on refs[0]
   int samples = 64;                       ///< Intersect: s samples
   /// Offset: distance within the surface, in model units (> 0: outwards for closed curves).
@@ -125,6 +128,41 @@ struct VertexConstraint
  * placement rule (Placement.h applies the rules in dependency order, for the template,
  * the optimizer and manual moves alike).
  */
+/**
+ * Template expressions that placed an OnCarrier vertex and refer to other vertices
+ * (`on_surface` with `axial`/`theta`, `on_curve` with `at` an expression), so the vertex
+ * follows them (format 4). The vertex's own parameters stay free: a move shifts them from
+ * what the expressions give, and the shift is kept when the followed vertices move.
+ */
+struct PlacementExpressions
+{
+  enum class Form
+  {
+    None,
+    AxialTheta,    ///< texts: axial, theta on the surface of revolution (machine axis)
+    CurveParameter ///< texts: the parameter u on the curve
+  };
+  Form form = Form::None;
+  std::vector<std::string> texts;
+  std::vector<int> follows; ///< vertices referred to, directly or through definitions
+  /// (s, t) the expressions gave when the template placed the vertex, and the shift of
+  /// the vertex's parameters from what they give (0 0 until the vertex itself is moved).
+  std::array<double, 2> base{ { 0.0, 0.0 } }, shift{ { 0.0, 0.0 } };
+};
+
+/**
+ * What placement expressions are evaluated in (format 4): the template's named values
+ * other than vertex queries (parameters, machine values, carrier queries such as
+ * `hub.axial_min`), its definitions (expressions, evaluated when used) and the direction
+ * of theta = 0 about the machine axis.
+ */
+struct ExpressionScope
+{
+  std::vector<std::pair<std::string, double>> values;
+  std::vector<std::pair<std::string, std::string>> definitions;
+  Vec3 thetaZero = Vec3::UnitX();
+};
+
 struct VertexRule
 {
   enum class Kind
@@ -141,6 +179,7 @@ struct VertexRule
   Vec3 origin = Vec3::Zero();
   Vec3 axis = Vec3::UnitZ(); ///< unit vector
   double angle = 0.0;        ///< radians, right-hand rule
+  PlacementExpressions expressions; ///< OnCarrier: what places it, when it follows vertices
 };
 
 /// The rule a vertex's constraint implies on its own (documents older than format 3
@@ -190,6 +229,11 @@ struct Edge
   /// the end vertices (their constraint on this carrier, else their projection). Values
   /// outside [0, 1] wrap around a closed carrier.
   std::vector<double> at;
+  /// `at` given by expressions that refer to vertices (format 4): one text per value of
+  /// `at`, and the vertices they refer to (directly or through definitions); the values
+  /// are evaluated again when those vertices move (Placement.h).
+  std::vector<std::string> atExpressions;
+  std::vector<int> atFollows;
   int source = -1; ///< Periodic: the edge this one is the image of; Follow: the one it follows
   int pitches = 0; ///< Periodic
   SourceLocation where;
@@ -250,10 +294,12 @@ struct SurfaceFaces
 
 struct BlockModel
 {
-  /// Newest model document format (3: vertices carry their placement rules); documents
-  /// of models without format-2 entities are still written as format 1, and documents of
-  /// formats 1 and 2 still read (their rules follow from the constraints).
-  static constexpr int FormatVersion = 3;
+  /// Newest model document format (3: vertices carry their placement rules; 4: and the
+  /// expressions that make them follow other vertices, with their scope, and the vertices
+  /// curves are drawn through); documents of models without format-2 entities are still
+  /// written as format 1, and documents of formats 1 to 3 still read (their rules follow
+  /// from the constraints, nothing follows through expressions).
+  static constexpr int FormatVersion = 4;
   std::string name;
   std::string sourceFile;
   /// Parameter values after overrides, in definition order.
@@ -265,6 +311,8 @@ struct BlockModel
   Machine machine;
   std::vector<Carrier> carriers;
   std::vector<SurfaceFaces> surfaceFaces;
+  /// What the placement expressions of vertices are evaluated in (empty without any).
+  ExpressionScope expressionScope;
   /// What applying the template chose for the user to know (its `notes:` whose `when`
   /// held, e.g. "the inlet is at the start of the hub contour"). Not part of the document.
   std::vector<std::string> notes;
@@ -272,7 +320,9 @@ struct BlockModel
   int findVertex(const std::string& name) const; ///< -1 if absent
   int findBlock(const std::string& name) const;  ///< -1 if absent
   int findCarrier(const std::string& name) const; ///< -1 if absent
-  /// 2 when the model uses carriers, constraints, surface faces or a machine, else 1.
+  /// 4 when vertices follow others through expressions or curves are drawn through
+  /// vertices, 3 with other rules than the constraints imply, 2 when the model uses
+  /// carriers, constraints, surface faces or a machine, else 1.
   int requiredFormat() const;
   /// Index into `edges` of the edge joining a and b in either direction, -1 if straight.
   int findEdge(int a, int b) const;

@@ -111,126 +111,6 @@ Vec3 ParameterLineCurve::derivative(double u, int order) const
     d.Ptt * delta[1] * delta[1];
 }
 
-// ----------------------------------------------------------------- ArcLengthTable
-namespace
-{
-const double GaussX[5] = { -0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
-  0.9061798459386640 };
-const double GaussW[5] = { 0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
-  0.4786286704993665, 0.2369268850561891 };
-}
-
-ArcLengthTable::ArcLengthTable(CurvePtr curve, int pieces, bool keepDerivatives)
-  : TheCurve(std::move(curve))
-{
-  Cumulative.assign(pieces + 1, 0.0);
-  if (keepDerivatives)
-  {
-    Derivatives.resize(5 * static_cast<std::size_t>(pieces));
-  }
-  for (int k = 0; k < pieces; ++k)
-  {
-    const double a = static_cast<double>(k) / pieces, b = static_cast<double>(k + 1) / pieces;
-    if (!keepDerivatives)
-    {
-      Cumulative[k + 1] = Cumulative[k] + piece(a, b);
-      continue;
-    }
-    // piece(a, b), remembering the derivatives
-    const double half = 0.5 * (b - a), centre = 0.5 * (a + b);
-    double sum = 0.0;
-    for (int g = 0; g < 5; ++g)
-    {
-      Vec3& derivative = Derivatives[5 * static_cast<std::size_t>(k) + g];
-      derivative = TheCurve->derivative(centre + half * GaussX[g], 1);
-      sum += GaussW[g] * derivative.norm();
-    }
-    Cumulative[k + 1] = Cumulative[k] + sum * half;
-  }
-}
-
-ArcLengthTable::ArcLengthTable(
-  CurvePtr curve, const ArcLengthTable& base, const Vec3& startShift, const Vec3& endShift)
-  : TheCurve(std::move(curve))
-{
-  const int pieces = static_cast<int>(base.Cumulative.size()) - 1;
-  Cumulative.assign(pieces + 1, 0.0);
-  for (int k = 0; k < pieces; ++k)
-  {
-    const double a = static_cast<double>(k) / pieces, b = static_cast<double>(k + 1) / pieces;
-    const double half = 0.5 * (b - a);
-    double sum = 0.0;
-    for (int g = 0; g < 5; ++g)
-    {
-      // As FollowCurve::derivative: (base + endShift) - startShift.
-      const Vec3& derivative = base.Derivatives[5 * static_cast<std::size_t>(k) + g];
-      sum += GaussW[g] * Vec3(derivative + endShift - startShift).norm();
-    }
-    Cumulative[k + 1] = Cumulative[k] + sum * half;
-  }
-}
-
-double ArcLengthTable::piece(double a, double b) const
-{
-  const double half = 0.5 * (b - a), centre = 0.5 * (a + b);
-  double sum = 0.0;
-  for (int k = 0; k < 5; ++k)
-  {
-    sum += GaussW[k] * TheCurve->derivative(centre + half * GaussX[k], 1).norm();
-  }
-  return sum * half;
-}
-
-double ArcLengthTable::parameterAtFraction(double fraction) const
-{
-  const double total = totalLength();
-  if (!(fraction > 0.0) || !(total > 0.0))
-  {
-    return fraction >= 1.0 ? 1.0 : 0.0;
-  }
-  if (fraction >= 1.0)
-  {
-    return 1.0;
-  }
-  const int pieces = static_cast<int>(Cumulative.size()) - 1;
-  const double target = fraction * total;
-  int k = static_cast<int>(
-    std::upper_bound(Cumulative.begin(), Cumulative.end(), target) - Cumulative.begin()) - 1;
-  k = std::max(0, std::min(k, pieces - 1));
-  const double a = static_cast<double>(k) / pieces, b = static_cast<double>(k + 1) / pieces;
-  const double span = Cumulative[k + 1] - Cumulative[k];
-  double low = a, high = b;
-  double t = span > 0.0 ? a + (target - Cumulative[k]) / span * (b - a) : a;
-  for (int iteration = 0; iteration < 60; ++iteration)
-  {
-    const double error = Cumulative[k] + piece(a, t) - target;
-    if (error > 0.0)
-    {
-      high = t;
-    }
-    else
-    {
-      low = t;
-    }
-    if (std::abs(error) <= 1e-15 * total)
-    {
-      break;
-    }
-    const double speed = TheCurve->derivative(t, 1).norm();
-    double next = speed > 0.0 ? t - error / speed : 0.5 * (low + high);
-    if (!(next > low && next < high))
-    {
-      next = 0.5 * (low + high);
-    }
-    if (next == t)
-    {
-      break;
-    }
-    t = next;
-  }
-  return t;
-}
-
 // ---------------------------------------------------------------- CarrierGeometry
 CarrierGeometry::CarrierGeometry(const BlockModel& model)
 {
@@ -549,6 +429,28 @@ Vec3 CarrierGeometry::point(int index, double s, double t) const
     return entry.surface->point(ws, wt);
   }
   return entry.curve->point(ws);
+}
+
+void CarrierGeometry::crossPoints(int index, double s, double t, double h, Vec3 out[5]) const
+{
+  const Entry& entry = Entries.at(index);
+  if (!entry.surface)
+  {
+    out[0] = point(index, s, t);
+    out[1] = point(index, s + h, t);
+    out[2] = point(index, s - h, t);
+    out[3] = point(index, s, t + h);
+    out[4] = point(index, s, t - h);
+    return;
+  }
+  // as point() wraps or limits each parameter
+  auto inS = [&](double u) { return entry.closedS ? wrapUnit(u) : clampUnit(u); };
+  auto inT = [&](double u) {
+    return entry.closedT ? wrapUnit(u)
+      : entry.extendT    ? std::max(-1.0, std::min(2.0, u))
+                         : clampUnit(u);
+  };
+  entry.surface->crossPoints(inS(s), inS(s + h), inS(s - h), inT(t), inT(t + h), inT(t - h), out);
 }
 
 void CarrierGeometry::project(

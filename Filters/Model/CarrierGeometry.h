@@ -11,6 +11,7 @@
  */
 #pragma once
 
+#include "../Core/ArcLength.h"
 #include "BlockModel.h"
 
 #include "../Core/Carriers.h"
@@ -63,38 +64,6 @@ private:
 };
 
 /**
- * @class ArcLengthTable
- * @brief Arc length of a carrier curve by a fixed composite 5-point Gauss-Legendre rule
- * (512 pieces) and its inverse by Newton inside the piece: bounded cost whatever the
- * curve's smoothness (curves on blade surfaces are only C1 at the section knots), accurate
- * to about 1e-12 of the length for placing nodes, deterministic.
- */
-class ArcLengthTable
-{
-public:
-  /// `keepDerivatives`: remember the sampled derivatives, for tables that follow this one.
-  explicit ArcLengthTable(CurvePtr curve, int pieces = 512, bool keepDerivatives = false);
-  /**
-   * The table of `curve`, whose derivative is base's plus endShift minus startShift at
-   * every parameter (a follow edge running the same way as its source): from base's kept
-   * derivatives, the same bits as sampling `curve` itself, at no cost.
-   */
-  ArcLengthTable(CurvePtr curve, const ArcLengthTable& base, const Vec3& startShift,
-    const Vec3& endShift);
-  bool keepsDerivatives() const { return !Derivatives.empty(); }
-  double totalLength() const { return Cumulative.back(); }
-  /// Parameter t at which the length from 0 is `fraction` of the total; 0 and 1 exactly
-  /// at the ends.
-  double parameterAtFraction(double fraction) const;
-
-private:
-  double piece(double a, double b) const;
-  CurvePtr TheCurve;
-  std::vector<double> Cumulative;
-  std::vector<Vec3> Derivatives; ///< 5 per piece when kept
-};
-
-/**
  * @class CarrierGeometry
  * @brief Built carriers of one model, by carrier index.
  */
@@ -130,6 +99,9 @@ public:
 
   /// Curve point at u or surface point at (s, t); wraps on closed carriers.
   Vec3 point(int index, double s, double t = 0.0) const;
+  /// point() at (s, t), (s + h, t), (s - h, t), (s, t + h) and (s, t - h), the same bits,
+  /// with the curves of Gordon surfaces evaluated once per parameter (central differences).
+  void crossPoints(int index, double s, double t, double h, Vec3 out[5]) const;
   /// Parameters of the closest point of carrier `index` to p (t = 0 for curves).
   void project(int index, const Vec3& p, double& s, double& t, double& distance) const;
   /**

@@ -142,7 +142,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       }
       named.curve = std::make_shared<SubCurve>(
         geometry.curve(edge.carrier), u0, u1, geometry.closedS(edge.carrier));
-      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve, 512, isFollowed(model, edge));
+      named.lengthTable = std::make_shared<ArcLength>(named.curve, 512, isFollowed(model, edge));
       named.length = named.lengthTable->totalLength();
       break;
     }
@@ -169,7 +169,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       named.curve = std::make_shared<ParameterLineCurve>(geometry.surface(edge.carrier), a, b,
         geometry.closedS(edge.carrier), geometry.closedT(edge.carrier),
         geometry.extendsT(edge.carrier));
-      named.lengthTable = std::make_shared<ArcLengthTable>(named.curve, 512, isFollowed(model, edge));
+      named.lengthTable = std::make_shared<ArcLength>(named.curve, 512, isFollowed(model, edge));
       named.length = named.lengthTable->totalLength();
       break;
     }
@@ -242,9 +242,9 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
         : std::make_shared<FollowCurve>(base.curve, start - sourceStart, end - sourceEnd, false);
       const bool shared = !reversed && base.lengthTable && base.lengthTable->keepsDerivatives();
       named.lengthTable = shared
-        ? std::make_shared<ArcLengthTable>(
+        ? std::make_shared<ArcLength>(
             named.curve, *base.lengthTable, Vec3(start - sourceStart), Vec3(end - sourceEnd))
-        : std::make_shared<ArcLengthTable>(named.curve);
+        : std::make_shared<ArcLength>(named.curve);
       named.length = named.lengthTable->totalLength();
       break;
     }
@@ -274,8 +274,8 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       points.push_back(end);
       named.curve = std::make_shared<BSplineCurve>(
         BSplineCurve::interpolate(points, 3, ParameterMethod::ChordLength));
-      named.arcLength = std::make_shared<ArcLength>(named.curve);
-      named.length = named.arcLength->totalLength();
+      named.lengthTable = std::make_shared<ArcLength>(named.curve, 512, isFollowed(model, edge));
+      named.length = named.lengthTable->totalLength();
       break;
     }
     default:
@@ -292,9 +292,10 @@ void followEdgeEnds(
   BlockModel& model, const CarrierGeometry& geometry, int index, const std::vector<char>& movedVertex)
 {
   Edge& edge = model.edges[index];
-  if (edge.at.empty() || (edge.kind != Edge::Kind::OnCurve && edge.kind != Edge::Kind::OnSurface))
+  if (edge.at.empty() || !edge.atExpressions.empty() ||
+    (edge.kind != Edge::Kind::OnCurve && edge.kind != Edge::Kind::OnSurface))
   {
-    return;
+    return; // ends given by expressions: the placement evaluates them again
   }
   const bool surface = edge.kind == Edge::Kind::OnSurface;
   const std::size_t per = surface ? 2 : 1;

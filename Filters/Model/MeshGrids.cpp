@@ -347,9 +347,8 @@ void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& cu
     else
     {
       const double fraction = curveReversed ? 1.0 - edge.params[i] : edge.params[i];
-      const double t = named->lengthTable ? named->lengthTable->parameterAtFraction(fraction)
-        : named->arcLength                ? named->arcLength->parameterAtFraction(fraction)
-                                          : fraction;
+      const double t =
+        named->lengthTable ? named->lengthTable->parameterAtFraction(fraction) : fraction;
       point = named->curve->point(t);
     }
     for (int c = 0; c < 3; ++c)
@@ -531,16 +530,23 @@ std::size_t ProjectionCache::KeyHash::operator()(const Key& key) const
  * surface's own parameters (derivatives by central differences through geometry.point,
  * which wraps closed and extends Gordon carriers), steps limited so the node stays on
  * the part of the surface it started on (a thin trailing edge has another side close by).
+ * `start` gets the surface point at the (s, t) it starts from.
  */
 void closestNear(const CarrierGeometry& geometry, int carrier, const Vec3& target, double& s,
-  double& t)
+  double& t, Vec3& start)
 {
   const double h = 1e-6, largest = 0.02;
   for (int iteration = 0; iteration < 8; ++iteration)
   {
-    const Vec3 p = geometry.point(carrier, s, t);
-    const Vec3 ps = (geometry.point(carrier, s + h, t) - geometry.point(carrier, s - h, t)) / (2 * h);
-    const Vec3 pt = (geometry.point(carrier, s, t + h) - geometry.point(carrier, s, t - h)) / (2 * h);
+    Vec3 around[5];
+    geometry.crossPoints(carrier, s, t, h, around);
+    const Vec3& p = around[0];
+    if (iteration == 0)
+    {
+      start = p;
+    }
+    const Vec3 ps = (around[1] - around[2]) / (2 * h);
+    const Vec3 pt = (around[3] - around[4]) / (2 * h);
     const Vec3 r = target - p;
     const double a = ps.dot(ps), b = ps.dot(pt), c = pt.dot(pt);
     const double det = a * c - b * b;
@@ -657,9 +663,9 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
       const double s0 = parameters[3 * i], t0 = parameters[3 * i + 1];
       const Vec3 target(targets[3 * i], targets[3 * i + 1], targets[3 * i + 2]);
       double s = s0, t = t0;
-      closestNear(geometry, carrier, target, s, t);
+      Vec3 p0;
+      closestNear(geometry, carrier, target, s, t, p0); // p0: the point at (s0, t0)
       Vec3 p = geometry.point(carrier, s, t);
-      const Vec3 p0 = geometry.point(carrier, s0, t0);
       if (!((p - target).norm() <= (p0 - target).norm()))
       {
         p = p0; // no better than the (s, t) node: keep that
@@ -755,22 +761,122 @@ void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
   }
 }
 
-void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geometry,
-  const std::vector<NamedCurve>& curves, MeshTopology& topology)
+BoundaryNeeds boundaryNeeds(const MeshTopology& topology, const std::vector<EdgeCopy>& copies,
+  const std::vector<char>& meshed)
 {
-  for (UniqueEdge& edge : topology.edges)
+  BoundaryNeeds needs;
+  needs.edges.assign(topology.edges.size(), 0);
+  needs.faces.assign(topology.faces.size(), 0);
+  for (std::size_t b = 0; b < topology.blocks.size() && b < meshed.size(); ++b)
   {
-    computeEdgeNodes(model, curves, geometry, edge);
+    if (!meshed[b])
+    {
+      continue;
+    }
+    const MeshLinks& links = topology.blocks[b];
+    for (const int face : links.face)
+    {
+      if (face >= 0)
+      {
+        needs.faces[face] = 1;
+      }
+    }
+    for (const int edge : links.edge)
+    {
+      if (edge >= 0)
+      {
+        needs.edges[edge] = 1;
+      }
+    }
   }
+  // A periodic image face is its source face rotated: the source is needed too (chains
+  // of images, if a template makes one, are followed to their end).
+  for (bool grown = true; grown;)
+  {
+    grown = false;
+    for (const PeriodicPair& entry : topology.connectivity.periodic)
+    {
+      if (needs.faces[entry.image] && !needs.faces[entry.source])
+      {
+        needs.faces[entry.source] = 1;
+        grown = true;
+      }
+    }
+  }
+  // A face grid is made from its owner's four edges.
+  for (std::size_t f = 0; f < topology.faces.size(); ++f)
+  {
+    if (!needs.faces[f])
+    {
+      continue;
+    }
+    const FaceUse& owner = topology.faces[f].uses.front();
+    for (const int local : faceEdges(owner.face))
+    {
+      const int edge = topology.blocks[owner.block].edge[local];
+      if (edge >= 0)
+      {
+        needs.edges[edge] = 1;
+      }
+    }
+  }
+  // A periodic copy needs its source edge, which may itself be a copy made before it.
+  for (bool grown = true; grown;)
+  {
+    grown = false;
+    for (const EdgeCopy& copy : copies)
+    {
+      if (needs.edges[copy.image] && !needs.edges[copy.source])
+      {
+        needs.edges[copy.source] = 1;
+        grown = true;
+      }
+    }
+  }
+  return needs;
+}
+
+void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::vector<NamedCurve>& curves, MeshTopology& topology, const std::vector<char>* meshed)
+{
   // Periodic copies: named periodic edges, then the edges and faces of every periodic
   // patch's partner, rotated node for node from the first patch of the pair.
   findPeriodicPairs(model, topology.connectivity);
   const std::vector<PeriodicPair>& images = topology.connectivity.periodic;
-  for (const EdgeCopy& copy : periodicEdgeCopies(model, topology))
+  const std::vector<EdgeCopy> copies = periodicEdgeCopies(model, topology);
+  // Only what the meshed blocks need, when not all are (an MPI rank's share): every
+  // edge and face grid depends on its own edges, sources and carriers alone, so the
+  // grids computed are the same bits as in a run that computes all of them.
+  BoundaryNeeds needs;
+  if (meshed)
   {
-    copyPeriodicEdge(model, topology, copy);
+    needs = boundaryNeeds(topology, copies, *meshed);
   }
-  checkCornerCells(model, topology, modelSize(model));
+  const auto edgeNeeded = [&](std::size_t e) { return !meshed || needs.edges[e]; };
+  const auto faceNeeded = [&](std::size_t f) { return !meshed || needs.faces[f]; };
+  // Edges are independent of each other (periodic ones are copied below): on threads
+  // when a runner is installed (Core/Parallel.h), the first failing edge's error first.
+  forEachChunk(static_cast<long>(topology.edges.size()), [&](long e) {
+    if (edgeNeeded(static_cast<std::size_t>(e)))
+    {
+      computeEdgeNodes(model, curves, geometry, topology.edges[e]);
+    }
+  });
+  for (const EdgeCopy& copy : copies)
+  {
+    if (edgeNeeded(static_cast<std::size_t>(copy.image)))
+    {
+      copyPeriodicEdge(model, topology, copy);
+    }
+  }
+  const double size = modelSize(model);
+  for (int b = 0; b < static_cast<int>(model.blocks.size()); ++b)
+  {
+    if (!meshed || (*meshed)[b])
+    {
+      checkCornerCells(model, topology, b, size);
+    }
+  }
   std::vector<bool> isImage(topology.faces.size(), false);
   for (const PeriodicPair& entry : images)
   {
@@ -778,17 +884,20 @@ void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geomet
   }
   const std::map<int, int> onSurface = surfaceFaceCarriers(model, topology);
   // Faces are computed from their edges alone, each into its own grid: on threads when a
-  // runner is installed (Core/Parallel.h), with the same bits, and the error of the first
-  // failing face in face order.
+  // runner is installed, with the same bits, and the error of the first failing face in
+  // face order.
   forEachChunk(static_cast<long>(topology.faces.size()), [&](long f) {
-    if (!isImage[f])
+    if (!isImage[f] && faceNeeded(static_cast<std::size_t>(f)))
     {
       computeFaceGrid(model, geometry, onSurface, topology, static_cast<int>(f));
     }
   });
   for (const PeriodicPair& entry : images)
   {
-    periodicFace(model, topology, entry, topology.faces[entry.image].xyz);
+    if (faceNeeded(static_cast<std::size_t>(entry.image)))
+    {
+      periodicFace(model, topology, entry, topology.faces[entry.image].xyz);
+    }
   }
 }
 

@@ -46,8 +46,8 @@ inline std::string blockEntity(const BlockModel& model, int block)
 struct NamedCurve
 {
   CurvePtr curve;
-  std::shared_ptr<const ArcLength> arcLength; ///< splines only: arcs are arc-length already
-  std::shared_ptr<const ArcLengthTable> lengthTable; ///< curves on carriers
+  /// Curves on carriers, splines and follow edges (arcs and lines are arc-length already).
+  std::shared_ptr<const ArcLength> lengthTable;
   double length = 0.0;
   int projectOnto = -1; ///< Project: the nodes of the straight line are projected onto it
 };
@@ -66,7 +66,8 @@ std::vector<NamedCurve> buildNamedCurves(const BlockModel& model, const CarrierG
  * Keeps the explicit end parameters (`at`) of an on_curve or on_surface edge on its end
  * vertices after they moved: each moved end takes its vertex's parameters on the edge's
  * carrier; on closed carriers the change is taken the short way round, so an edge that
- * ran across the seam (ends outside [0, 1]) still does.
+ * ran across the seam (ends outside [0, 1]) still does. Ends given by expressions of
+ * vertices are left to the placement (applyPlacement evaluates them again).
  */
 void followEdgeEnds(
   BlockModel& model, const CarrierGeometry& geometry, int edge, const std::vector<char>& movedVertex);
@@ -231,9 +232,21 @@ std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopolo
 void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
   const std::map<int, int>& onSurface, MeshTopology& topology, int f,
   ProjectionCache* cache = nullptr);
-/// Every edge and face grid of the model (computeBoundaries), after buildMeshTopology.
+/// The unique edges and faces whose grids the blocks marked in `meshed` need: their own
+/// edges and faces, the edges the faces are made from, and the sources of periodic
+/// images among them (faces and edges), followed to their end.
+struct BoundaryNeeds
+{
+  std::vector<char> edges, faces;
+};
+BoundaryNeeds boundaryNeeds(const MeshTopology& topology, const std::vector<EdgeCopy>& copies,
+  const std::vector<char>& meshed);
+/// Every edge and face grid of the model (computeBoundaries), after buildMeshTopology;
+/// with `meshed`, only those the marked blocks need (BoundaryNeeds), the corner cells of
+/// those blocks checked. Grids computed either way are the same bits.
 void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geometry,
-  const std::vector<NamedCurve>& curves, MeshTopology& topology);
+  const std::vector<NamedCurve>& curves, MeshTopology& topology,
+  const std::vector<char>* meshed = nullptr);
 /// The nodes of block b by transfinite interpolation from its face and edge grids.
 void meshBlockNodes(const BlockModel& model, const MeshTopology& topology, int block, double* out);
 

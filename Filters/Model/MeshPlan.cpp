@@ -30,6 +30,16 @@ struct MeshPlan::Impl
   std::vector<int> Updated;
   std::vector<int> Pending; ///< vertices of failed updates, recomputed with the next one
   ProjectionCache Projections;
+  /// The curve and surface of every carrier as last meshed: a carrier whose shape is no
+  /// longer these was drawn again by the placement (a curve through moved vertices).
+  std::vector<std::pair<const void*, const void*>> CarrierShapes;
+  /// The `at` of every edge as last meshed: the placement evaluates `at` expressions again.
+  std::vector<std::vector<double>> EdgeEnds;
+
+  std::pair<const void*, const void*> shape(int c) const
+  {
+    return { Geometry.curve(c).get(), Geometry.surface(c).get() };
+  }
 
   // What depends on what, built once.
   std::vector<std::vector<int>> VertexNamedEdges;  ///< vertex -> named edges ending at it
@@ -153,6 +163,14 @@ MeshPlan::MeshPlan(const BlockModel& model, const CarrierGeometry& carriers, dou
     P->IsImage[pair.image] = true;
   }
   P->buildDependencies();
+  for (int c = 0; c < static_cast<int>(P->Model.carriers.size()); ++c)
+  {
+    P->CarrierShapes.push_back(P->shape(c));
+  }
+  for (const Edge& edge : P->Model.edges)
+  {
+    P->EdgeEnds.push_back(edge.at);
+  }
   P->Nodes.resize(P->Model.blocks.size());
   for (int b = 0; b < blockCount(); ++b)
   {
@@ -176,6 +194,11 @@ const BlockModel& MeshPlan::model() const
 }
 
 const CarrierGeometry& MeshPlan::carriers() const
+{
+  return P->Geometry;
+}
+
+CarrierGeometry& MeshPlan::carriers()
 {
   return P->Geometry;
 }
@@ -216,10 +239,26 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
     movedVertex.at(v) = 1;
   }
   checkCarriers(model, Geometry, size, &moved);
+  std::vector<char> changedCarrier(model.carriers.size(), 0);
+  for (std::size_t c = 0; c < model.carriers.size(); ++c)
+  {
+    changedCarrier[c] = shape(static_cast<int>(c)) != CarrierShapes[c] ? 1 : 0;
+  }
+  if (std::find(changedCarrier.begin(), changedCarrier.end(), 1) != changedCarrier.end())
+  {
+    Projections = ProjectionCache(); // it remembers projections onto the old shapes
+  }
 
-  // Named edge curves: those ending at a moved vertex, and those following a rebuilt one
-  // (a follow or periodic edge always comes after its source).
+  // Named edge curves: those ending at a moved vertex, those on a carrier drawn again,
+  // and those following a rebuilt one (a follow or periodic edge comes after its source).
   std::vector<char> rebuilt(model.edges.size(), 0);
+  for (std::size_t e = 0; e < model.edges.size(); ++e)
+  {
+    const int carrier = model.edges[e].carrier;
+    const bool onChanged = carrier >= 0 && carrier < static_cast<int>(changedCarrier.size()) &&
+      changedCarrier[carrier];
+    rebuilt[e] = onChanged || model.edges[e].at != EdgeEnds[e] ? 1 : 0;
+  }
   for (const int v : moved)
   {
     for (const int e : VertexNamedEdges[v])
@@ -337,6 +376,13 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
       }
     }
   }
+  for (const auto& onSurface : OnSurface)
+  {
+    if (changedCarrier[onSurface.second])
+    {
+      changedFace[onSurface.first] = 1;
+    }
+  }
   for (std::size_t f = 0; f < Topo.faces.size(); ++f)
   {
     if (changedFace[f] && !IsImage[f])
@@ -371,6 +417,14 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
   }
   std::sort(blocks.begin(), blocks.end());
   Updated = blocks;
+  for (std::size_t c = 0; c < model.carriers.size(); ++c)
+  {
+    CarrierShapes[c] = shape(static_cast<int>(c));
+  }
+  for (std::size_t e = 0; e < model.edges.size(); ++e)
+  {
+    EdgeEnds[e] = model.edges[e].at;
+  }
 }
 
 Feasibility MeshPlan::update(const std::vector<int>& moved)

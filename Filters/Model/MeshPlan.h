@@ -59,6 +59,9 @@ public:
   BlockModel& model();
   const BlockModel& model() const;
   const CarrierGeometry& carriers() const;
+  /// The carriers to place vertices with (applyPlacement draws curves through moved
+  /// vertices again here; update() rebuilds what lies on carriers that changed).
+  CarrierGeometry& carriers();
   const Topology& topology() const;
 
   /**

@@ -22,6 +22,7 @@ struct MultiBlockMesher::Impl
   CarrierGeometry Geometry;
   std::vector<NamedCurve> Curves;
   MeshTopology Topo;
+  std::vector<char> Meshable; ///< blocks whose boundary grids were computed
   bool Ready = false;
 
   std::array<int, 3> nodeCounts(int block) const
@@ -69,15 +70,36 @@ void MultiBlockMesher::setCellCap(int cap)
 
 void MultiBlockMesher::computeBoundaries()
 {
+  std::vector<int> all(static_cast<std::size_t>(blockCount()));
+  for (int b = 0; b < blockCount(); ++b)
+  {
+    all[b] = b;
+  }
+  computeBoundaries(all);
+}
+
+void MultiBlockMesher::computeBoundaries(const std::vector<int>& blocks)
+{
   const BlockModel& model = P->Model;
   std::vector<std::array<int, 3>> nodes;
   for (int b = 0; b < blockCount(); ++b)
   {
     nodes.push_back(P->nodeCounts(b));
   }
+  P->Meshable.assign(static_cast<std::size_t>(blockCount()), 0);
+  for (const int b : blocks)
+  {
+    if (b < 0 || b >= blockCount())
+    {
+      throw std::out_of_range("MultiBlockMesher::computeBoundaries: no block " + std::to_string(b));
+    }
+    P->Meshable[b] = 1;
+  }
+  const bool everyBlock =
+    std::find(P->Meshable.begin(), P->Meshable.end(), 0) == P->Meshable.end();
   const bool countsChanged = nodes != baseNodeCounts(model);
   P->Topo = buildMeshTopology(model, P->Curves, nodes, countsChanged);
-  computeAllBoundaries(model, P->Geometry, P->Curves, P->Topo);
+  computeAllBoundaries(model, P->Geometry, P->Curves, P->Topo, everyBlock ? nullptr : &P->Meshable);
   P->Ready = true;
 }
 
@@ -109,6 +131,11 @@ void MultiBlockMesher::meshBlock(int block, double* out) const
   if (block < 0 || block >= blockCount())
   {
     throw std::out_of_range("MultiBlockMesher::meshBlock: no block " + std::to_string(block));
+  }
+  if (!P->Meshable[block])
+  {
+    throw std::logic_error("MultiBlockMesher::meshBlock: block " + std::to_string(block) +
+      " is not in the share passed to computeBoundaries()");
   }
   meshBlockNodes(P->Model, P->Topo, block, out);
 }

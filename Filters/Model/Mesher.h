@@ -69,6 +69,11 @@ public:
   /// naming the block and corner when the first nodes of the edges leaving a corner form
   /// a left-handed frame (inverted corner cells).
   void computeBoundaries();
+  /// The same for a share of the blocks (an MPI rank's): only the edge and face grids
+  /// `blocks` need are computed and only their corner cells checked, so a rank does its
+  /// own part of the boundary work. The grids of these blocks are the same bits as after
+  /// computeBoundaries(); meshBlock() then takes these blocks only.
+  void computeBoundaries(const std::vector<int>& blocks);
 
   int blockCount() const;
   /// The model's carriers as built for meshing.
@@ -79,7 +84,8 @@ public:
   /// periodic pairs, patches). computeBoundaries() must have been called.
   const Topology& topology() const;
   /// Writes the nodes of block b (ni*nj*nk*3 doubles, i fastest) into `out`.
-  /// computeBoundaries() must have been called. Thread-safe for different blocks.
+  /// computeBoundaries() must have been called (for this block). Thread-safe for
+  /// different blocks.
   void meshBlock(int block, double* out) const;
 
 private:

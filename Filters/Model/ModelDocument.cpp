@@ -97,7 +97,7 @@ public:
     // Checked after the version: a newer document may well have keys this build lacks.
     syntax::checkKeys(sections,
       { "blockforge_model", "name", "source", "parameters", "machine", "carriers", "vertices",
-        "edges", "blocks", "faces", "patches" },
+        "edges", "blocks", "faces", "patches", "expression_scope" },
       "", Report);
     if (const MapEntry* name = syntax::findEntry(sections, "name"))
     {
@@ -144,6 +144,11 @@ public:
     {
       resolvePeriodicSource(vertex);
       resolveRuleSource(vertex);
+    }
+    resolveFollowedVertices();
+    if (const MapEntry* scope = syntax::findEntry(sections, "expression_scope"))
+    {
+      readExpressionScope(*scope);
     }
     for (const YAML::Node& node : list(sections, "edges"))
     {
@@ -296,7 +301,7 @@ private:
     Vertex vertex;
     const auto keys = entries(
       node, "vertex", { "position", "on", "at", "periodic", "pitches", "rule", "source", "origin",
-        "axis", "angle", "fixed" }, vertex.name, vertex.where);
+        "axis", "angle", "expressions", "fixed" }, vertex.name, vertex.where);
     const std::string entityText = entity("vertex", vertex.name);
     if (Model.findVertex(vertex.name) >= 0)
     {
@@ -332,7 +337,118 @@ private:
       }
       vertex.fixed = mark == "true";
     }
+    if (const MapEntry* expressions = syntax::findEntry(keys, "expressions"))
+    {
+      readPlacementExpressions(*expressions, entityText, vertex);
+    }
     Model.vertices.push_back(vertex);
+  }
+
+  /// Format 4: `expressions: {form: axial_theta | curve_parameter, texts: [...],
+  /// follows: [vertex, ...], base: [s, t], shift: [s, t]}`.
+  void readPlacementExpressions(const MapEntry& entry, const std::string& entityText, Vertex& vertex)
+  {
+    const auto keys = syntax::mapEntries(entry.value, entry.line, entityText, "expressions", Report);
+    syntax::checkKeys(keys, { "form", "texts", "follows", "base", "shift" }, entityText, Report);
+    PlacementExpressions& expressions = vertex.rule.expressions;
+    const MapEntry& form = required(keys, "form", entry.value, entityText);
+    const std::string formName = text(form.value, form.line, entityText, "form");
+    if (formName != "axial_theta" && formName != "curve_parameter")
+    {
+      fail(form.line, entityText, "unknown expression form '" + formName + "' (axial_theta, curve_parameter)");
+    }
+    expressions.form = formName == "axial_theta" ? PlacementExpressions::Form::AxialTheta
+                                                 : PlacementExpressions::Form::CurveParameter;
+    const MapEntry& texts = required(keys, "texts", entry.value, entityText);
+    const std::size_t count = expressions.form == PlacementExpressions::Form::AxialTheta ? 2 : 1;
+    if (!texts.value.IsSequence() || texts.value.size() != count)
+    {
+      fail(texts.line, entityText, "'texts' expects " + std::to_string(count) + " expressions");
+    }
+    for (const YAML::Node& item : texts.value)
+    {
+      expressions.texts.push_back(text(item, texts.line, entityText, "texts"));
+    }
+    const MapEntry& follows = required(keys, "follows", entry.value, entityText);
+    if (!follows.value.IsSequence())
+    {
+      fail(follows.line, entityText, "'follows' expects a list of vertices");
+    }
+    std::vector<std::string> names;
+    for (const YAML::Node& item : follows.value)
+    {
+      names.push_back(text(item, follows.line, entityText, "follows"));
+    }
+    FollowedNames.push_back({ Model.vertices.size(), names, follows.line, entityText });
+    for (const char* key : { "base", "shift" })
+    {
+      const MapEntry& pair = required(keys, key, entry.value, entityText);
+      if (!pair.value.IsSequence() || pair.value.size() != 2)
+      {
+        fail(pair.line, entityText, std::string("'") + key + "' expects [s, t]");
+      }
+      std::array<double, 2>& values = std::string(key) == "base" ? expressions.base : expressions.shift;
+      values = { { number(pair.value[0], pair.line, entityText, key),
+        number(pair.value[1], pair.line, entityText, key) } };
+    }
+  }
+
+  /// Vertices named in `follows` and carriers' `through`, once every vertex is known.
+  void resolveFollowedVertices()
+  {
+    auto resolve = [&](const FollowedName& item, std::vector<int>& out) {
+      out.clear();
+      for (const std::string& name : item.names)
+      {
+        const int vertex = name == "-" ? -1 : Model.findVertex(name);
+        if (name != "-" && vertex < 0)
+        {
+          fail(item.line, item.entity, "unknown vertex '" + name + "'");
+        }
+        out.push_back(vertex);
+      }
+    };
+    for (const FollowedName& item : FollowedNames)
+    {
+      resolve(item, Model.vertices[item.index].rule.expressions.follows);
+    }
+    for (const FollowedName& item : ThroughNames)
+    {
+      std::vector<int>& through = Model.carriers[item.index].throughVertices;
+      resolve(item, through);
+      if (through.size() != Model.carriers[item.index].parameterPoints.size())
+      {
+        fail(item.line, item.entity, "'through' names one vertex (or -) per point");
+      }
+    }
+  }
+
+  /// Format 4: `expression_scope: {theta_zero: [x, y, z], values: {name: v},
+  /// definitions: {name: expression}}`.
+  void readExpressionScope(const MapEntry& entry)
+  {
+    const std::string entityText = "expression_scope";
+    const auto keys = syntax::mapEntries(entry.value, entry.line, entityText, entityText, Report);
+    syntax::checkKeys(keys, { "theta_zero", "values", "definitions" }, entityText, Report);
+    ExpressionScope& scope = Model.expressionScope;
+    const MapEntry& zero = required(keys, "theta_zero", entry.value, entityText);
+    scope.thetaZero = vector3(zero.value, zero.line, entityText, "theta_zero");
+    if (const MapEntry* values = syntax::findEntry(keys, "values"))
+    {
+      for (const MapEntry& value : syntax::mapEntries(values->value, values->line, entityText, "values", Report))
+      {
+        scope.values.emplace_back(value.key, number(value.value, value.line, entityText, value.key));
+      }
+    }
+    if (const MapEntry* definitions = syntax::findEntry(keys, "definitions"))
+    {
+      for (const MapEntry& definition :
+        syntax::mapEntries(definitions->value, definitions->line, entityText, "definitions", Report))
+      {
+        scope.definitions.emplace_back(
+          definition.key, text(definition.value, definition.line, entityText, definition.key));
+      }
+    }
   }
 
   /// Format 3: the placement rule when the constraint does not imply it (older documents
@@ -408,7 +524,8 @@ private:
   {
     Edge edge;
     const auto keys = entries(node, "edge",
-      { "kind", "from", "to", "centre", "through", "points", "carrier", "at", "source", "pitches" },
+      { "kind", "from", "to", "centre", "through", "points", "carrier", "at", "at_expressions",
+        "at_follows", "source", "pitches" },
       edge.name, edge.where);
     const std::string entityText = entity("edge", edge.name);
     const MapEntry& kind = required(keys, "kind", node, entityText);
@@ -417,13 +534,12 @@ private:
     const MapEntry& to = required(keys, "to", node, entityText);
     edge.from = vertexRef(from.value, from.line, entityText);
     edge.to = vertexRef(to.value, to.line, entityText);
-    if (kindName == "line")
+    const bool known = edgeKindFromName(kindName, edge.kind); // the one table of edge kinds
+    if (known && edge.kind == Edge::Kind::Line)
     {
-      edge.kind = Edge::Kind::Line;
     }
-    else if (kindName == "arc")
+    else if (known && edge.kind == Edge::Kind::Arc)
     {
-      edge.kind = Edge::Kind::Arc;
       const MapEntry* centre = syntax::findEntry(keys, "centre");
       const MapEntry* through = syntax::findEntry(keys, "through");
       if ((centre != nullptr) == (through != nullptr))
@@ -440,9 +556,8 @@ private:
         edge.arcThrough = vector3(through->value, through->line, entityText, "through");
       }
     }
-    else if (kindName == "spline")
+    else if (known && edge.kind == Edge::Kind::Spline)
     {
-      edge.kind = Edge::Kind::Spline;
       const MapEntry& points = required(keys, "points", node, entityText);
       if (!points.value.IsSequence())
       {
@@ -453,9 +568,10 @@ private:
         edge.splinePoints.push_back(vector3(point, points.line, entityText, "point"));
       }
     }
-    else if (kindName == "on_curve" || kindName == "on_surface" || kindName == "project")
+    else if (known &&
+      (edge.kind == Edge::Kind::OnCurve || edge.kind == Edge::Kind::OnSurface ||
+        edge.kind == Edge::Kind::Project))
     {
-      edgeKindFromName(kindName, edge.kind);
       const MapEntry& carrier = required(keys, "carrier", node, entityText);
       edge.carrier = carrierRef(carrier.value, carrier.line, entityText);
       if (const MapEntry* at = syntax::findEntry(keys, "at"))
@@ -469,10 +585,32 @@ private:
           edge.at.push_back(number(value, at->line, entityText, "at"));
         }
       }
+      const MapEntry* texts = syntax::findEntry(keys, "at_expressions");
+      const MapEntry* follows = syntax::findEntry(keys, "at_follows");
+      if ((texts != nullptr) != (follows != nullptr))
+      {
+        fail((texts ? texts : follows)->line, entityText,
+          "'at_expressions' and 'at_follows' come together");
+      }
+      if (texts)
+      {
+        if (!texts->value.IsSequence() || texts->value.size() != edge.at.size() ||
+          !follows->value.IsSequence())
+        {
+          fail(texts->line, entityText, "'at_expressions' gives one expression per value of 'at'");
+        }
+        for (const YAML::Node& text : texts->value)
+        {
+          edge.atExpressions.push_back(this->text(text, texts->line, entityText, "at_expressions"));
+        }
+        for (const YAML::Node& vertex : follows->value)
+        {
+          edge.atFollows.push_back(vertexRef(vertex, follows->line, entityText));
+        }
+      }
     }
-    else if (kindName == "periodic" || kindName == "follow")
+    else if (known && (edge.kind == Edge::Kind::Periodic || edge.kind == Edge::Kind::Follow))
     {
-      edgeKindFromName(kindName, edge.kind);
       const MapEntry& source = required(keys, "source", node, entityText);
       const std::string sourceName = text(source.value, source.line, entityText, "source");
       for (std::size_t e = 0; e < Model.edges.size(); ++e)
@@ -740,6 +878,20 @@ private:
         }
       }
     }
+    if (const MapEntry* through = syntax::findEntry(keys, "through"))
+    {
+      if (!through->value.IsSequence())
+      {
+        fail(through->line, entityText, "'through' expects a list of vertices (- for none)");
+      }
+      std::vector<std::string> names;
+      for (const YAML::Node& item : through->value)
+      {
+        names.push_back(text(item, through->line, entityText, "through"));
+      }
+      ThroughNames.push_back({ static_cast<std::size_t>(&carrier - Model.carriers.data()), names,
+        through->line, entityText });
+    }
     if (const MapEntry* degree = syntax::findEntry(keys, "degree"))
     {
       carrier.degree = integer(degree->value, degree->line, entityText, "degree");
@@ -818,7 +970,17 @@ private:
 
   const std::vector<std::string> CarrierKeys = { "kind", "points", "degree", "parameters",
     "refs", "cross_refs", "at", "cross_at", "blending", "closed", "axis", "origin", "angle",
-    "range", "samples", "distance" };
+    "range", "samples", "distance", "through" };
+  /// Vertex names read before every vertex is known: whose (vertex or carrier index),
+  /// the names, and where.
+  struct FollowedName
+  {
+    std::size_t index;
+    std::vector<std::string> names;
+    int line;
+    std::string entity;
+  };
+  std::vector<FollowedName> FollowedNames, ThroughNames;
   std::vector<std::string> PeriodicSources;
   std::size_t NextPeriodic = 0;
   std::vector<std::string> RuleSources;
@@ -946,6 +1108,16 @@ std::string writeModelDocument(const BlockModel& model)
                 << YAML::EndSeq;
           }
           out << YAML::EndSeq;
+          if (std::any_of(carrier.throughVertices.begin(), carrier.throughVertices.end(),
+                [](int v) { return v >= 0; }))
+          {
+            out << YAML::Key << "through" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+            for (const int v : carrier.throughVertices)
+            {
+              out << (v >= 0 ? vertexName(model, v, user) : std::string("-"));
+            }
+            out << YAML::EndSeq;
+          }
           break;
         case Carrier::Kind::Intersect:
           refList("refs", carrier.refs);
@@ -1006,6 +1178,32 @@ std::string writeModelDocument(const BlockModel& model)
     {
       out << YAML::Key << "fixed" << YAML::Value << "true";
     }
+    const PlacementExpressions& expressions = vertex.rule.expressions;
+    if (expressions.form != PlacementExpressions::Form::None)
+    {
+      out << YAML::Key << "expressions" << YAML::Value << YAML::Flow << YAML::BeginMap;
+      out << YAML::Key << "form" << YAML::Value
+          << (expressions.form == PlacementExpressions::Form::AxialTheta ? "axial_theta"
+                                                                        : "curve_parameter");
+      out << YAML::Key << "texts" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      for (const std::string& text : expressions.texts)
+      {
+        out << YAML::DoubleQuoted << text;
+      }
+      out << YAML::EndSeq;
+      out << YAML::Key << "follows" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      for (const int followed : expressions.follows)
+      {
+        out << vertexName(model, followed, user);
+      }
+      out << YAML::EndSeq;
+      out << YAML::Key << "base" << YAML::Value << YAML::Flow << YAML::BeginSeq
+          << formatNumber(expressions.base[0]) << formatNumber(expressions.base[1]) << YAML::EndSeq;
+      out << YAML::Key << "shift" << YAML::Value << YAML::Flow << YAML::BeginSeq
+          << formatNumber(expressions.shift[0]) << formatNumber(expressions.shift[1])
+          << YAML::EndSeq;
+      out << YAML::EndMap;
+    }
     emitWhere(out, vertex.where, model);
     out << YAML::EndMap;
   }
@@ -1044,6 +1242,21 @@ std::string writeModelDocument(const BlockModel& model)
         for (double value : edge.at)
         {
           out << formatNumber(value);
+        }
+        out << YAML::EndSeq;
+      }
+      if (!edge.atFollows.empty())
+      {
+        out << YAML::Key << "at_expressions" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+        for (const std::string& text : edge.atExpressions)
+        {
+          out << YAML::DoubleQuoted << text;
+        }
+        out << YAML::EndSeq;
+        out << YAML::Key << "at_follows" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+        for (const int vertex : edge.atFollows)
+        {
+          out << vertexName(model, vertex, user);
         }
         out << YAML::EndSeq;
       }
@@ -1154,6 +1367,26 @@ std::string writeModelDocument(const BlockModel& model)
     out << YAML::EndMap;
   }
   out << YAML::EndSeq;
+  const ExpressionScope& scope = model.expressionScope;
+  if (!scope.values.empty() || !scope.definitions.empty())
+  {
+    out << YAML::Key << "expression_scope" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "theta_zero" << YAML::Value;
+    emitVector(out, scope.thetaZero);
+    out << YAML::Key << "values" << YAML::Value << YAML::BeginMap;
+    for (const auto& value : scope.values)
+    {
+      out << YAML::Key << value.first << YAML::Value << formatNumber(value.second);
+    }
+    out << YAML::EndMap;
+    out << YAML::Key << "definitions" << YAML::Value << YAML::BeginMap;
+    for (const auto& definition : scope.definitions)
+    {
+      out << YAML::Key << definition.first << YAML::Value << YAML::DoubleQuoted << definition.second;
+    }
+    out << YAML::EndMap;
+    out << YAML::EndMap;
+  }
   out << YAML::EndMap;
   if (!out.good())
   {

@@ -61,6 +61,11 @@ void TemplateReader::readCarriersAndVertices()
       if (definition != DefinitionIndex.end())
       {
         ensureDefinition(definition->second);
+        if (!Referenced.empty())
+        {
+          const std::set<int>& vertices = DefinitionVertices[definition->second];
+          Referenced.back().insert(vertices.begin(), vertices.end());
+        }
       }
       return;
     }
@@ -68,6 +73,10 @@ void TemplateReader::readCarriersAndVertices()
     if (index >= 0)
     {
       ensureVertex(index);
+      if (!Referenced.empty())
+      {
+        Referenced.back().insert(index);
+      }
     }
     else if (Model.findCarrier(referenced) >= 0)
     {
@@ -141,7 +150,9 @@ void TemplateReader::ensureCarrier(int index)
   resolveOnce(CarrierState, CarrierEntries, index, "carrier",
     [&](const MapEntry& entry, const std::string& entityText) {
       Carrier carrier = Model.carriers[index];
+      Referenced.emplace_back(); // what the carrier's expressions refer to is its own
       readCarrier(entry, entityText, index, carrier);
+      Referenced.pop_back();
       Model.carriers[index] = carrier;
       Geometry.build(Model, index);
     });
@@ -727,6 +738,8 @@ void TemplateReader::readCarrier(const MapEntry& entry, const std::string& entit
         Geometry.vertexParameters(Model, vertex, surface, s, t, distance);
         checkOnCarrier(vertex, surface, distance, lineOrFallback(item, through->line), entityText);
         carrier.parameterPoints.emplace_back(s, t);
+        carrier.throughVertices.resize(carrier.parameterPoints.size(), -1);
+        carrier.throughVertices.back() = vertex; // drawn again when it moves
       }
     }
     return;

@@ -60,6 +60,23 @@ public:
   }
   bool hasQuery(const std::string& name) const { return Queries.count(name) != 0; }
 
+  /// The queries of vertex `name`: .x .y .z of `xyz`, .axial .radius .theta of
+  /// `cylindrical` and, for a vertex on a carrier (`st` not null), .s and .t.
+  void defineVertexQueries(
+    const std::string& name, const double xyz[3], const double cylindrical[3], const double* st)
+  {
+    static const char* const attributes[6] = { ".x", ".y", ".z", ".axial", ".radius", ".theta" };
+    for (int k = 0; k < 6; ++k)
+    {
+      defineQuery(name + attributes[k], k < 3 ? xyz[k] : cylindrical[k - 3]);
+    }
+    if (st)
+    {
+      defineQuery(name + ".s", st[0]);
+      defineQuery(name + ".t", st[1]);
+    }
+  }
+
   /// Names that parameters must not take: the constants and muParser's functions.
   static bool isReserved(const std::string& name)
   {
@@ -77,6 +94,17 @@ public:
   }
 
   const std::vector<std::string>& names() const { return Names; }
+
+  /// Every named constant: parameters, definitions, machine values, queries, pi, deg.
+  std::map<std::string, double> constants() const
+  {
+    std::map<std::string, double> values;
+    for (const auto& constant : Parser.GetConst())
+    {
+      values[constant.first] = constant.second;
+    }
+    return values;
+  }
 
   double evaluate(const std::string& expression)
   {

@@ -287,23 +287,46 @@ Vec3 TemplateReader::referenceDirection() const
 
 void TemplateReader::cylindrical(const Vec3& p, double& axial, double& radius, double& theta) const
 {
-  const Vec3& axis = Model.machine.axis;
-  const Vec3 q = p - Model.machine.axisPoint;
-  axial = q.dot(axis);
-  const Vec3 radial = q - axial * axis;
-  radius = radial.norm();
-  const Vec3 e1 = referenceDirection();
-  const Vec3 e2 = axis.cross(e1);
-  theta = std::atan2(radial.dot(e2), radial.dot(e1));
+  cylindricalAbout(Model.machine, referenceDirection(), p, axial, radius, theta);
 }
 
 Vec3 TemplateReader::fromCylindrical(double axial, double radius, double theta) const
 {
-  const Vec3& axis = Model.machine.axis;
-  const Vec3 e1 = referenceDirection();
-  const Vec3 e2 = axis.cross(e1);
-  return Model.machine.axisPoint + axial * axis +
-    radius * (std::cos(theta) * e1 + std::sin(theta) * e2);
+  return fromCylindricalAbout(Model.machine, referenceDirection(), axial, radius, theta);
+}
+
+void TemplateReader::recordExpressionScope()
+{
+  const bool follows =
+    std::any_of(Model.vertices.begin(), Model.vertices.end(),
+      [](const Vertex& v) { return v.rule.expressions.form != PlacementExpressions::Form::None; }) ||
+    std::any_of(Model.edges.begin(), Model.edges.end(),
+      [](const Edge& e) { return !e.atFollows.empty(); });
+  if (!follows)
+  {
+    return;
+  }
+  ExpressionScope& scope = Model.expressionScope;
+  scope.thetaZero = referenceDirection();
+  std::set<std::string> skipped;
+  for (const auto& definition : DefinitionIndex)
+  {
+    skipped.insert(definition.first);
+  }
+  for (const auto& value : Evaluator.constants())
+  {
+    const std::size_t dot = value.first.find('.');
+    if (skipped.count(value.first) ||
+      (dot != std::string::npos && Model.findVertex(value.first.substr(0, dot)) >= 0))
+    {
+      continue; // definitions are evaluated again, vertex queries come from the positions
+    }
+    scope.values.emplace_back(value.first, value.second);
+  }
+  for (const MapEntry& entry : DefinitionEntries)
+  {
+    scope.definitions.emplace_back(entry.key, entry.value.Scalar());
+  }
 }
 
 void TemplateReader::readMachineAndInputs()
@@ -558,13 +581,18 @@ void TemplateReader::readDefinitionNames()
     DefinitionEntries.push_back(entry);
   }
   DefinitionState.assign(DefinitionEntries.size(), 0);
+  DefinitionVertices.assign(DefinitionEntries.size(), {});
 }
 
 void TemplateReader::ensureDefinition(int index)
 {
   resolveOnce(DefinitionState, DefinitionEntries, index, "definition",
     [&](const MapEntry& entry, const std::string& entityText) {
-      Evaluator.define(entry.key, number(entry.value, entry.line, entityText, ""));
+      Referenced.emplace_back();
+      const double value = number(entry.value, entry.line, entityText, "");
+      DefinitionVertices[index] = std::move(Referenced.back());
+      Referenced.pop_back();
+      Evaluator.define(entry.key, value);
     });
 }
 } // namespace detail

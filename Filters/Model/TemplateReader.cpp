@@ -40,6 +40,7 @@ BlockModel TemplateReader::readModel()
   readFaces();
   readPatches();
   readNotes();
+  recordExpressionScope();
   return std::move(Model);
 }
 
@@ -697,18 +698,20 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
   }
   const MapEntry* at = syntax::findEntry(keys, "at");
   const MapEntry* pitches = syntax::findEntry(keys, "pitches");
-  if (pitches && kind->key != "periodic")
+  Edge::Kind edgeKind = Edge::Kind::Line;
+  edgeKindFromName(kind->key, edgeKind); // one of carrierEdgeKindNames(), found above
+  if (pitches && edgeKind != Edge::Kind::Periodic)
   {
     fail(pitches->line, entityText, "'pitches' belongs to periodic edges");
   }
-  if (kind->key == "periodic" || kind->key == "follow")
+  if (edgeKind == Edge::Kind::Periodic || edgeKind == Edge::Kind::Follow)
   {
     if (at)
     {
       fail(at->line, entityText,
         "a " + kind->key + " edge takes its shape from its source edge, not from 'at'");
     }
-    edge.kind = kind->key == "periodic" ? Edge::Kind::Periodic : Edge::Kind::Follow;
+    edge.kind = edgeKind;
     const std::string sourceName = name(kind->value, kind->line, entityText, kind->key);
     for (std::size_t e = 0; e < Model.edges.size(); ++e)
     {
@@ -731,7 +734,7 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
           "; the source edge must be defined above this one");
     }
   }
-  if (kind->key == "periodic")
+  if (edgeKind == Edge::Kind::Periodic)
   {
     edge.pitches = 1;
     if (pitches)
@@ -749,11 +752,11 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
         "a periodic edge needs the blade count: " + Evaluator.Unavailable["pitch"]);
     }
   }
-  else if (kind->key != "follow") // a follow edge is its source's shape at its own ends
+  else if (edgeKind != Edge::Kind::Follow) // a follow edge is its source's shape at its own ends
   {
-    const Want want = kind->key == "on_curve" ? Want::Curve : Want::Surface;
+    const Want want = edgeKind == Edge::Kind::OnCurve ? Want::Curve : Want::Surface;
     edge.carrier = carrierRef(kind->value, kind->line, entityText, kind->key, want);
-    edgeKindFromName(kind->key, edge.kind);
+    edge.kind = edgeKind;
     if (at)
     {
       if (edge.kind == Edge::Kind::Project)
@@ -766,12 +769,15 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
           edge.kind == Edge::Kind::OnCurve ? "'at' expects [u_a, u_b]"
                                            : "'at' expects [[s_a, t_a], [s_b, t_b]]");
       }
+      Referenced.emplace_back(); // the vertices the ends follow
+      std::vector<std::string> texts;
       for (int end = 0; end < 2; ++end)
       {
         const YAML::Node item = at->value[end];
         if (edge.kind == Edge::Kind::OnCurve)
         {
           edge.at.push_back(number(item, at->line, entityText, "at"));
+          texts.push_back(item.Scalar());
         }
         else
         {
@@ -781,8 +787,16 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
           }
           edge.at.push_back(number(item[0], at->line, entityText, "at s"));
           edge.at.push_back(number(item[1], at->line, entityText, "at t"));
+          texts.push_back(item[0].Scalar());
+          texts.push_back(item[1].Scalar());
         }
       }
+      if (!Referenced.back().empty())
+      {
+        edge.atExpressions = texts;
+        edge.atFollows.assign(Referenced.back().begin(), Referenced.back().end());
+      }
+      Referenced.pop_back();
     }
   }
   addEdge(edge, entry.line, entityText);

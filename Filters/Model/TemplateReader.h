@@ -358,6 +358,14 @@ private:
   double curveParameterQuery(const MapEntry& at, int curve, const std::string& entityText);
 
   void readVertexV2(const MapEntry& entry, const std::string& entityText, Vertex& vertex);
+
+  /// Records the expressions `texts` that gave `vertex`'s parameters as its placement
+  /// expressions when they referred to vertices (Referenced.back()).
+  void recordPlacementExpressions(
+    Vertex& vertex, PlacementExpressions::Form form, const std::vector<std::string>& texts);
+
+  /// The template's expression scope, when some vertex follows others (after reading).
+  void recordExpressionScope();
   // --- edges and faces (format 2) --------------------------------------------------
   bool isEdgeV2(const MapEntry& entry) const;
 
@@ -382,6 +390,11 @@ private:
   std::map<std::string, int> DefinitionIndex;
   std::vector<int> CarrierState, VertexState, DefinitionState; // 0 pending, 1 in progress, 2 done
   std::vector<std::string> Resolving;         // entities being resolved, for cycles
+  /// Vertices the expressions being evaluated refer to, directly or through definitions
+  /// (one set per entity being resolved, innermost last), and those of each definition:
+  /// what a vertex placed by expressions follows (PlacementExpressions).
+  std::vector<std::set<int>> Referenced;
+  std::vector<std::set<int>> DefinitionVertices;
   syntax::Reporter Report;
   ExpressionEvaluator Evaluator;
   std::vector<MapEntry> Sections;

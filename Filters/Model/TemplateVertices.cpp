@@ -1,6 +1,8 @@
 // The template reader: vertices, their placement rules and the queries on points and carriers (extrema, intersections, axial/theta on surfaces).
 #include "TemplateReader.h"
 
+#include "../Core/RootFinding.h"
+
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -115,7 +117,9 @@ void TemplateReader::ensureVertex(int index)
   resolveOnce(VertexState, VertexEntries, index, "vertex",
     [&](const MapEntry& entry, const std::string& entityText) {
       Vertex vertex = Model.vertices[index];
+      Referenced.emplace_back(); // what its expressions refer to (not its referrer's)
       readVertexV2(entry, entityText, vertex);
+      Referenced.pop_back();
       if (!vertex.position.allFinite())
       {
         fail(entry.line, entityText, "the position is not finite");
@@ -132,21 +136,13 @@ void TemplateReader::defineVertexQueries(const Vertex& vertex)
   {
     return; // names with '-' cannot appear in expressions
   }
-  double axial = 0.0, radius = 0.0, theta = 0.0;
-  cylindrical(vertex.position, axial, radius, theta);
+  double cylindricalValues[3] = { 0.0, 0.0, 0.0 };
+  cylindrical(vertex.position, cylindricalValues[0], cylindricalValues[1], cylindricalValues[2]);
   const std::string& n = vertex.name;
-  Evaluator.defineQuery(n + ".x", vertex.position.x());
-  Evaluator.defineQuery(n + ".y", vertex.position.y());
-  Evaluator.defineQuery(n + ".z", vertex.position.z());
-  Evaluator.defineQuery(n + ".axial", axial);
-  Evaluator.defineQuery(n + ".radius", radius);
-  Evaluator.defineQuery(n + ".theta", theta);
-  if (vertex.constraint.carrier >= 0)
-  {
-    Evaluator.defineQuery(n + ".s", vertex.constraint.s);
-    Evaluator.defineQuery(n + ".t", vertex.constraint.t);
-  }
-  else
+  const double st[2] = { vertex.constraint.s, vertex.constraint.t };
+  Evaluator.defineVertexQueries(
+    n, vertex.position.data(), cylindricalValues, vertex.constraint.carrier >= 0 ? st : nullptr);
+  if (vertex.constraint.carrier < 0)
   {
     const std::string why = "vertex '" + n + "' is not attached to a carrier, so it has no "
                                              "parameters s, t";
@@ -260,30 +256,7 @@ double TemplateReader::extremum(const std::function<Vec3(double)>& point, bool c
     a = std::max(a, from);
     b = std::min(b, to);
   }
-  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-  double c = b - ratio * (b - a), d = a + ratio * (b - a);
-  double fc = f(c), fd = f(d);
-  // bounded: far from 0 the bracket stops shrinking at the spacing of doubles
-  for (int iteration = 0; b - a > 1e-14 && iteration < 200; ++iteration)
-  {
-    if (fc < fd)
-    {
-      b = d;
-      d = c;
-      fd = fc;
-      c = b - ratio * (b - a);
-      fc = f(c);
-    }
-    else
-    {
-      a = c;
-      c = d;
-      fc = fd;
-      d = a + ratio * (b - a);
-      fd = f(d);
-    }
-  }
-  double u = 0.5 * (a + b);
+  double u = goldenSectionMinimum(f, a, b, 1e-14);
   if (!whole && f(from) <= f(u))
   {
     u = from;
@@ -302,34 +275,6 @@ double TemplateReader::curveSurfaceIntersection(int curve, int surface, const Ma
   const int samples = 512;
   const SurfaceOfRevolution* revolution = Geometry.revolution(surface);
   std::vector<double> roots;
-  auto refine = [&](auto&& f, double a, double b) {
-    double fa = f(a), fb = f(b);
-    for (int iteration = 0; iteration < 200 && b - a > 1e-15; ++iteration)
-    {
-      // Illinois-style regula falsi with bisection safeguard.
-      double m = fb != fa ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
-      if (!(m > a && m < b) || iteration % 3 == 2)
-      {
-        m = 0.5 * (a + b);
-      }
-      const double fm = f(m);
-      if (fm == 0.0)
-      {
-        return m;
-      }
-      if ((fm < 0.0) == (fa < 0.0))
-      {
-        a = m;
-        fa = fm;
-      }
-      else
-      {
-        b = m;
-        fb = fm;
-      }
-    }
-    return std::abs(fa) < std::abs(fb) ? a : b;
-  };
   if (revolution)
   {
     auto f = [&](double u) { return revolution->signedMeridionalDistance(Geometry.point(curve, u)); };
@@ -348,7 +293,7 @@ double TemplateReader::curveSurfaceIntersection(int curve, int surface, const Ma
       }
       else if (previous != 0.0 && (value < 0.0) != (previous < 0.0))
       {
-        roots.push_back(refine(f, static_cast<double>(k - 1) / samples, u));
+        roots.push_back(brentRoot(f, static_cast<double>(k - 1) / samples, u, previous, value, 1e-15));
       }
       previous = value;
     }
@@ -371,21 +316,8 @@ double TemplateReader::curveSurfaceIntersection(int curve, int surface, const Ma
         best = k;
       }
     }
-    double a = std::max(0.0, (best - 1.0) / samples), b = std::min(1.0, (best + 1.0) / samples);
-    const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-    for (int iteration = 0; b - a > 1e-15 && iteration < 200; ++iteration)
-    {
-      const double c = b - ratio * (b - a), d = a + ratio * (b - a);
-      if (f(c) < f(d))
-      {
-        b = d;
-      }
-      else
-      {
-        a = c;
-      }
-    }
-    const double u = 0.5 * (a + b);
+    const double u = goldenSectionMinimum(
+      f, std::max(0.0, (best - 1.0) / samples), std::min(1.0, (best + 1.0) / samples), 1e-15);
     const double distance = f(u);
     if (distance > onTolerance(surface))
     {
@@ -430,75 +362,13 @@ double TemplateReader::curveSurfaceIntersection(int curve, int surface, const Ma
 void TemplateReader::onRevolutionAt(int surface, double axial, double theta, const std::string& entityText,
   int line, double& s, double& t)
 {
-  const SurfaceOfRevolution* revolution = Geometry.revolution(surface);
-  const Machine& machine = Model.machine;
-  const double size = std::max(Geometry.size(surface), 1e-300);
-  if (!revolution || revolution->axisDirection().cross(machine.axis).norm() > 1e-12 ||
-    (revolution->axisPoint() - machine.axisPoint).cross(machine.axis).norm() > 1e-12 * size)
+  try
   {
-    fail(line, entityText,
-      "'axial' and 'theta' place a vertex on a surface of revolution about the machine "
-      "axis; '" + Model.carriers[surface].name + "' is not one");
+    revolutionParametersAt(Model, Geometry, referenceDirection(), surface, axial, theta, s, t);
   }
-  auto f = [&](double u) {
-    double a = 0.0, r = 0.0, th = 0.0;
-    cylindrical(Geometry.point(surface, u, 0.5), a, r, th);
-    return a - axial;
-  };
-  const int samples = 256;
-  double a = 0.0, fa = f(0.0);
-  bool found = fa == 0.0;
-  double root = 0.0;
-  for (int k = 1; k <= samples && !found; ++k)
+  catch (const GeometryError& error)
   {
-    const double b = static_cast<double>(k) / samples, fb = f(b);
-    if (fb == 0.0)
-    {
-      root = b;
-      found = true;
-    }
-    else if ((fa < 0.0) != (fb < 0.0))
-    {
-      double low = a, high = b, flow = fa;
-      for (int iteration = 0; iteration < 200 && high - low > 1e-16; ++iteration)
-      {
-        const double middle = 0.5 * (low + high), fm = f(middle);
-        if ((fm < 0.0) == (flow < 0.0))
-        {
-          low = middle;
-          flow = fm;
-        }
-        else
-        {
-          high = middle;
-        }
-      }
-      root = 0.5 * (low + high);
-      found = true;
-    }
-    a = b;
-    fa = fb;
-  }
-  if (!found)
-  {
-    double a0 = 0.0, a1 = 0.0, r = 0.0, th = 0.0;
-    cylindrical(Geometry.point(surface, 0.0, 0.5), a0, r, th);
-    cylindrical(Geometry.point(surface, 1.0, 0.5), a1, r, th);
-    fail(line, entityText,
-      "surface '" + Model.carriers[surface].name + "' does not reach axial = " +
-        shortNumber(axial) + " (its contour spans axial " + shortNumber(std::min(a0, a1)) +
-        " to " + shortNumber(std::max(a0, a1)) + ")");
-  }
-  double ignored = 0.0, radius = 0.0;
-  cylindrical(Geometry.point(surface, root, 0.5), ignored, radius, ignored);
-  double distance = 0.0;
-  const Vec3 target = fromCylindrical(axial, radius, theta);
-  Geometry.project(surface, target, s, t, distance);
-  if ((Geometry.point(surface, s, t) - target).norm() > 1e-9 * size)
-  {
-    fail(line, entityText,
-      "theta = " + shortNumber(theta) + " is outside the angle range of surface '" +
-        Model.carriers[surface].name + "'");
+    fail(line, entityText, error.what());
   }
 }
 
@@ -524,7 +394,7 @@ double TemplateReader::curveParameterQuery(const MapEntry& at, int curve, const 
     {
       fail(length->line, entityText, "the length fraction must be in [0, 1]");
     }
-    return ArcLengthTable(Geometry.curve(curve)).parameterAtFraction(fraction);
+    return ArcLength(Geometry.curve(curve)).parameterAtFraction(fraction);
   }
   const MapEntry& extreme = minimum ? *minimum : *maximum;
   const bool closed = Geometry.closedS(curve);
@@ -589,6 +459,20 @@ double TemplateReader::curveParameterQuery(const MapEntry& at, int curve, const 
   return extremum(curve, value, extreme.key == "min" ? 1.0 : -1.0, from, to);
 }
 
+void TemplateReader::recordPlacementExpressions(
+  Vertex& vertex, PlacementExpressions::Form form, const std::vector<std::string>& texts)
+{
+  const std::set<int>& followed = Referenced.back();
+  if (followed.empty())
+  {
+    return; // numbers and parameters only: nothing to follow
+  }
+  PlacementExpressions& expressions = vertex.rule.expressions;
+  expressions.form = form;
+  expressions.texts = texts;
+  expressions.follows.assign(followed.begin(), followed.end());
+}
+
 void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& entityText, Vertex& vertex)
 {
   if (entry.value.IsSequence())
@@ -641,7 +525,10 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
     }
     else
     {
+      Referenced.back().clear();
       u = number(at->value, at->line, entityText, "at");
+      recordPlacementExpressions(
+        vertex, PlacementExpressions::Form::CurveParameter, { at->value.Scalar() });
       if (Geometry.closedS(curve))
       {
         u = wrapUnit(u);
@@ -655,6 +542,7 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
     constraint.carrier = curve;
     constraint.s = u;
     vertex.rule.kind = VertexRule::Kind::OnCarrier;
+    vertex.rule.expressions.base = { { u, 0.0 } };
     placeVertex(Model, Geometry, vertex);
     return;
   }
@@ -669,13 +557,17 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
     {
       fail(entry.line, entityText, "on_surface with 'axial' needs 'theta' too");
     }
+    Referenced.back().clear();
     const double axial = number(axialEntry->value, axialEntry->line, entityText, "axial");
     const double theta = number(thetaEntry->value, thetaEntry->line, entityText, "theta");
+    recordPlacementExpressions(vertex, PlacementExpressions::Form::AxialTheta,
+      { axialEntry->value.Scalar(), thetaEntry->value.Scalar() });
     double s = 0.0, t = 0.0;
     onRevolutionAt(surface, axial, theta, entityText, axialEntry->line, s, t);
     constraint.carrier = surface;
     constraint.s = s;
     constraint.t = t;
+    vertex.rule.expressions.base = { { s, t } };
     vertex.rule.kind = VertexRule::Kind::OnCarrier;
     placeVertex(Model, Geometry, vertex);
     return;

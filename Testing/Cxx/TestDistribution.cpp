@@ -420,3 +420,17 @@ TEST(Distribution, MatchGivesTheEndCellsAndGrowsByTheRatio)
   EXPECT_THROW(matchedNodes(0.01, 0.01, 1.0, 5, 1.0), GeometryError);
   EXPECT_THROW(matchedNodes(0.01, 0.01, 1.0, 5, std::nan("")), GeometryError);
 }
+
+TEST(Distribution, MatchWithAnEndCellNearTheWholeEdgeDoesNotFail)
+{
+  // A neighbour's cell as long as the edge itself: the end cell is capped so the other
+  // cells shrink by at most ratio^4 each, and the nodes stay valid.
+  const std::vector<double> s = matchedNodes(0.0, 0.99, 1.0, 33, 1.2);
+  expectValidNodes(s, 33);
+  for (int i = 1; i < 32; ++i)
+  {
+    EXPECT_LE(cell(s, i) / cell(s, i - 1), std::pow(1.2, 4.0) * (1.0 + 1e-4)); // tiny cells: differences of nodes near 1
+  }
+  const std::vector<double> both = matchedNodes(2.0, 0.99, 1.0, 9, 1.2);
+  expectValidNodes(both, 9);
+}

@@ -33,9 +33,9 @@ using test::Pi;
  * checkFitness). Issue 8 asks for about 1.5. axial_passage_h grades every edge with the
  * `match` law (end cells from the edges continuing it across interfaces); measured on the
  * four machines at densities 0.5-4: 1.11-1.48, but 1.76 on the distributor at density 4,
- * across the leading-edge plane between the upstream and blade blocks away from the
- * vertices (the interior of a face blends its edges' distributions, which match at the
- * vertices only). axial_passage_oh is not graded (30-570: its leading- and trailing-edge
+ * across the leading-edge plane between the upstream and blade blocks (the blade side
+ * leaves the round leading edge across the pitch: the blade block's first cells there
+ * are short along the axis once they are smaller than the edge's radius). axial_passage_oh is not graded (30-570: its leading- and trailing-edge
  * O blocks against the blade sides, see README); these bounds keep both from getting
  * worse.
  */

@@ -2,6 +2,9 @@
 // plan recomputes only the blocks that depend on it, the result is the grid a fresh mesher
 // makes of the moved model bit for bit, and infeasible moves come back as values.
 #include "MeshPlan.h"
+#include "ControlProblem.h"
+
+#include <cstdio>
 #include "ModelDocument.h"
 #include "Placement.h"
 #include "TestHelpers.h"
@@ -101,7 +104,8 @@ TEST(Placement, PassageRulesAndOrder)
   {
     all[v] = static_cast<int>(v);
   }
-  applyPlacement(again, rotor37Passage().carriers, all);
+  CarrierGeometry carriers = rotor37Passage().carriers;
+  applyPlacement(again, carriers, all);
   for (std::size_t v = 0; v < model.vertices.size(); ++v)
   {
     EXPECT_TRUE(test::sameBits(again.vertices[v].position, model.vertices[v].position))
@@ -122,7 +126,7 @@ TEST(Placement, PassageRulesAndOrder)
 TEST(Placement, ProjectedVertexFollowsItsSource)
 {
   BlockModel model = rotor37Passage().model;
-  const CarrierGeometry& carriers = rotor37Passage().carriers;
+  CarrierGeometry carriers = rotor37Passage().carriers;
   const int oa = vertexIndex(model, "oa_f_h"), a = vertexIndex(model, "a_f_h");
   const Vec3 before = model.vertices[a].position;
   const FreeParameter s = sParameter(freeParameters(model, carriers), oa);
@@ -141,19 +145,63 @@ TEST(Placement, RulesTravelInTheModelDocument)
 {
   const BlockModel& model = rotor37Passage().model;
   const std::string document = writeModelDocument(model);
-  EXPECT_NE(document.find("blockforge_model: 3"), std::string::npos);
+  EXPECT_NE(document.find("blockforge_model: 4"), std::string::npos);
   EXPECT_NE(document.find("rule: projected, source: oa_f_h"), std::string::npos);
+  EXPECT_NE(document.find("through: [lo_f_h, lo_m_h, lo_r_h]"), std::string::npos);
+  EXPECT_NE(document.find("expression_scope:"), std::string::npos);
   const BlockModel reread = readModelDocument(document);
   for (std::size_t v = 0; v < model.vertices.size(); ++v)
   {
-    EXPECT_EQ(reread.vertices[v].rule.kind, model.vertices[v].rule.kind) << model.vertices[v].name;
-    EXPECT_EQ(reread.vertices[v].rule.source, model.vertices[v].rule.source);
+    const VertexRule& rule = model.vertices[v].rule;
+    EXPECT_EQ(reread.vertices[v].rule.kind, rule.kind) << model.vertices[v].name;
+    EXPECT_EQ(reread.vertices[v].rule.source, rule.source);
+    EXPECT_EQ(reread.vertices[v].rule.expressions.texts, rule.expressions.texts);
+    EXPECT_EQ(reread.vertices[v].rule.expressions.follows, rule.expressions.follows);
   }
+  const int arc = reread.findEdge(vertexIndex(model, "oa_f_h"), vertexIndex(model, "oa_r_h"));
+  ASSERT_GE(arc, 0);
+  EXPECT_EQ(reread.edges[arc].atExpressions, model.edges[arc].atExpressions);
+  EXPECT_EQ(reread.edges[arc].atFollows, model.edges[arc].atFollows);
+  EXPECT_FALSE(reread.edges[arc].atFollows.empty()); // ol_a_h: at: [oa_f_h.s, ...]
   EXPECT_EQ(writeModelDocument(reread), document);
+  // The reread model places its vertices as the template did, bit for bit.
+  BlockModel replaced = reread;
+  CarrierGeometry rereadCarriers(reread);
+  std::vector<int> all(model.vertices.size());
+  for (std::size_t v = 0; v < all.size(); ++v)
+  {
+    all[v] = static_cast<int>(v);
+  }
+  applyPlacement(replaced, rereadCarriers, all);
+  for (std::size_t v = 0; v < model.vertices.size(); ++v)
+  {
+    EXPECT_TRUE(test::sameBits(replaced.vertices[v].position, model.vertices[v].position))
+      << model.vertices[v].name;
+  }
+
+  // A document of format 3 (rules, no expressions) still reads.
+  BlockModel withoutExpressions = model;
+  for (Vertex& vertex : withoutExpressions.vertices)
+  {
+    vertex.rule.expressions = PlacementExpressions();
+  }
+  for (Carrier& carrier : withoutExpressions.carriers)
+  {
+    carrier.throughVertices.clear();
+  }
+  for (Edge& edge : withoutExpressions.edges)
+  {
+    edge.atExpressions.clear();
+    edge.atFollows.clear();
+  }
+  withoutExpressions.expressionScope = ExpressionScope();
+  const std::string format3 = writeModelDocument(withoutExpressions);
+  EXPECT_NE(format3.find("blockforge_model: 3"), std::string::npos);
+  EXPECT_EQ(readModelDocument(format3).vertices.size(), model.vertices.size());
 
   // A document of format 2 (before rules) still reads: the rules are those its
   // constraints imply, and it meshes the same grid.
-  std::string older = test::replaced(document, "blockforge_model: 3", "blockforge_model: 2");
+  std::string older = test::replaced(format3, "blockforge_model: 3", "blockforge_model: 2");
   for (std::size_t at; (at = older.find(", rule: ")) != std::string::npos;)
   {
     older.erase(at, older.find(", line:", at) - at);
@@ -172,6 +220,153 @@ TEST(Placement, RulesTravelInTheModelDocument)
   // Bad rules are named.
   test::expectError([&] { readModelDocument(test::replaced(document, "rule: projected, source: oa_f_h", "rule: glued, source: oa_f_h")); },
     { "vertex 'a_f_h'", "unknown placement rule 'glued'" });
+}
+
+/// The OH template on Rotor 37 with `text` in place of `from`.
+BlockModel rotor37With(const std::string& from, const std::string& text, CarrierGeometry& carriers)
+{
+  const TemplateInputs inputs =
+    test::readTemplateInputs(test::sourcePath("Data/rotor37/turbogrid/BladeGen.inf"));
+  const std::string path = test::templatePath("axial_passage_oh.yaml");
+  return parseTemplate(test::replaced(test::readText(path), from, text), path, {}, &inputs, &carriers);
+}
+
+std::string exactNumber(double value)
+{
+  char text[64];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+TEST(Placement, ExpressionAndCurveChainsFollowMovesAsTheTemplateWould)
+{
+  const Passage& passage = rotor37Passage();
+  const BlockModel& model = passage.model;
+  const int oa = vertexIndex(model, "oa_f_h"), ob = vertexIndex(model, "ob_f_h");
+  const int lo = vertexIndex(model, "lo_f_h"), aIn = vertexIndex(model, "a_in_h");
+  const int loIn = vertexIndex(model, "lo_in_h"), hi = vertexIndex(model, "hi_f_h");
+  // What follows what: expressions (lo_f_h is mid-way between the O corners), and the
+  // periodic line lo_h drawn through lo_f_h, lo_m_h, lo_r_h.
+  const PlacementExpressions& mid = model.vertices[lo].rule.expressions;
+  EXPECT_EQ(mid.form, PlacementExpressions::Form::AxialTheta);
+  EXPECT_EQ(mid.follows, (std::vector<int>{ std::min(oa, ob), std::max(oa, ob) }));
+  EXPECT_EQ(model.vertices[oa].rule.expressions.form, PlacementExpressions::Form::None);
+  const int line = model.findCarrier("lo_h");
+  ASSERT_GE(line, 0);
+  EXPECT_EQ(model.carriers[line].throughVertices,
+    (std::vector<int>{ lo, vertexIndex(model, "lo_m_h"), vertexIndex(model, "lo_r_h") }));
+  const std::vector<std::vector<int>> dependents = vertexDependents(model);
+  for (const int follower : { lo, aIn })
+  {
+    EXPECT_TRUE(std::binary_search(dependents[oa].begin(), dependents[oa].end(), follower))
+      << model.vertices[follower].name;
+  }
+  EXPECT_TRUE(std::binary_search(dependents[lo].begin(), dependents[lo].end(), loIn));
+  EXPECT_TRUE(std::binary_search(dependents[lo].begin(), dependents[lo].end(), hi));
+
+  // oa_f_h moved through the mesh plan, against the template with oa_f_h given there (the
+  // plan moved on from one place to the next; 0.0013 once differed in an O-grid arc whose
+  // end is given by an expression, before `at` expressions were evaluated again).
+  MeshPlan plan(model, passage.carriers);
+  const FreeParameter s = sParameter(freeParameters(plan.model(), plan.carriers()), oa);
+  const std::string corner = test::readText(test::templatePath("axial_passage_oh.yaml"));
+  const std::size_t at = corner.find("  oa_f_h: {on_curve: o_h, at: ");
+  ASSERT_NE(at, std::string::npos);
+  const std::string line0 = corner.substr(at, corner.find('\n', at) - at);
+  for (const double delta : { 0.004, 0.0013, -0.003 })
+  {
+    SCOPED_TRACE(delta);
+    const double moved = model.vertices[oa].constraint.s + delta;
+    const Feasibility feasibility =
+      plan.update(moveParameter(plan.model(), plan.carriers(), s, moved));
+    ASSERT_TRUE(feasibility.feasible()) << feasibility.message;
+    CarrierGeometry carriers;
+    const BlockModel expected = rotor37With(
+      line0, "  oa_f_h: {on_curve: o_h, at: " + exactNumber(moved) + "}", carriers);
+    ASSERT_EQ(expected.vertices[oa].constraint.s, moved);
+    const BlockModel& followed = plan.model();
+    for (std::size_t v = 0; v < model.vertices.size(); ++v)
+    {
+      EXPECT_TRUE(test::sameBits(followed.vertices[v].position, expected.vertices[v].position))
+        << model.vertices[v].name;
+      EXPECT_EQ(followed.vertices[v].constraint.s, expected.vertices[v].constraint.s);
+      EXPECT_EQ(followed.vertices[v].constraint.t, expected.vertices[v].constraint.t);
+    }
+    for (std::size_t e = 0; e < model.edges.size(); ++e)
+    {
+      EXPECT_EQ(followed.edges[e].at, expected.edges[e].at) << model.edges[e].name;
+    }
+    EXPECT_GT((followed.vertices[lo].position - model.vertices[lo].position).norm(), 1e-6);
+    EXPECT_GT((followed.vertices[loIn].position - model.vertices[loIn].position).norm(), 1e-6);
+    EXPECT_EQ(followed.carriers[line].parameterPoints, expected.carriers[line].parameterPoints);
+    // The curve drawn again is the template's, and the plan's grid is the grid of the
+    // moved model (expectSameAsFreshMesher) and, bit for bit, the template's.
+    for (const double u : { 0.0, 0.3, 0.5, 1.0 })
+    {
+      EXPECT_TRUE(test::sameBits(plan.carriers().point(line, u), carriers.point(line, u)));
+    }
+    expectSameAsFreshMesher(plan);
+    const test::Grid grid = test::meshAll(expected);
+    for (int b = 0; b < plan.blockCount(); ++b)
+    {
+      EXPECT_TRUE(test::sameBits(plan.blockNodes(b), grid.xyz[b])) << model.blocks[b].name;
+    }
+  }
+
+  // The middle point of the periodic line moved alone (no edge ends there): the line is
+  // drawn again, and the plan rebuilds the edge on it and the blocks along it.
+  const int middle = vertexIndex(model, "lo_m_h");
+  FreeParameter t;
+  for (const FreeParameter& p : freeParameters(plan.model(), plan.carriers()))
+  {
+    if (p.vertex == middle && p.component == 1)
+    {
+      t = p;
+    }
+  }
+  ASSERT_EQ(t.vertex, middle);
+  const Eigen::Vector2d before = plan.model().carriers[line].parameterPoints[1];
+  const Feasibility shifted = plan.update(
+    moveParameter(plan.model(), plan.carriers(), t, plan.model().vertices[middle].constraint.t + 0.002));
+  ASSERT_TRUE(shifted.feasible()) << shifted.message;
+  EXPECT_NE(plan.model().carriers[line].parameterPoints[1], before);
+  EXPECT_NEAR(plan.model().vertices[middle].constraint.t, before[1] + 0.002, 1e-15);
+  const std::vector<int>& updated = plan.updatedBlocks();
+  EXPECT_NE(std::find(updated.begin(), updated.end(), plan.model().findBlock("M_L")), updated.end());
+  expectSameAsFreshMesher(plan);
+}
+
+TEST(Placement, ManualMovesThroughTheDocumentFollowAsTheTemplateWould)
+{
+  // ControlPointMoves as BlockOptimizer applies them, on the model read back from its
+  // document (what travels between the pipeline's filters).
+  const Passage& passage = rotor37Passage();
+  BlockModel model = readModelDocument(writeModelDocument(passage.model));
+  CarrierGeometry geometry(model);
+  const int ob = vertexIndex(model, "ob_r_s");
+  const double moved = model.vertices[ob].constraint.s - 0.003;
+  optimize::applyMoves(model, geometry, { { "ob_r_s", { moved } } });
+  CarrierGeometry carriers;
+  const std::string text = test::readText(test::templatePath("axial_passage_oh.yaml"));
+  const std::size_t at = text.find("  ob_r_s: {on_curve: o_s, at: ");
+  ASSERT_NE(at, std::string::npos);
+  const BlockModel expected = rotor37With(text.substr(at, text.find('\n', at) - at),
+    "  ob_r_s: {on_curve: o_s, at: " + exactNumber(moved) + "}", carriers);
+  int followed = 0;
+  for (std::size_t v = 0; v < model.vertices.size(); ++v)
+  {
+    EXPECT_TRUE(test::sameBits(model.vertices[v].position, expected.vertices[v].position))
+      << model.vertices[v].name;
+    followed += model.vertices[v].position != passage.model.vertices[v].position ? 1 : 0;
+  }
+  EXPECT_GE(followed, 5); // ob_r_s, b_r_s, lo_r_s, hi_r_s, b_out_s, lo_out_s, ...
+  const int line = model.findCarrier("lo_s");
+  EXPECT_EQ(model.carriers[line].parameterPoints, expected.carriers[line].parameterPoints);
+  const test::Grid grid = test::meshAll(model), reference = test::meshAll(expected);
+  for (std::size_t b = 0; b < grid.xyz.size(); ++b)
+  {
+    EXPECT_TRUE(test::sameBits(grid.xyz[b], reference.xyz[b])) << model.blocks[b].name;
+  }
 }
 
 TEST(Placement, CyclesAreReported)

@@ -1,6 +1,7 @@
 // Grid quality measured in parts (as MPI ranks do, with neighbour layers of the other
 // blocks) and on threads equals the whole grid measured at once, bit for bit; meshing on
 // threads equals meshing on one.
+#include "InvertedCells.h"
 #include "Parallel.h"
 #include "Quality.h"
 #include "Partition.h"
@@ -9,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <stdexcept>
 #include <thread>
 
 namespace blockforge
@@ -334,6 +337,90 @@ TEST(Threads, ChunksAreUsedAndErrorsPropagate)
                    }
                  }),
     GeometryError);
+}
+
+/// Each share of a partition, meshed by a mesher that computes only the share's boundary
+/// (what an MPI rank does), gives the share's blocks the same bits as meshing them all.
+void expectSharesMeshLikeWhole(const std::string& templateFile, const std::string& inf)
+{
+  const MeshedCase whole = meshCase(templateFile, inf, 1.5);
+  model::TemplateInputs inputs;
+  if (!inf.empty())
+  {
+    inputs = test::readTemplateInputs(test::sourcePath(inf));
+  }
+  const BlockModel blockModel = model::loadTemplate(
+    test::sourcePath(templateFile), {}, inf.empty() ? nullptr : &inputs);
+  const int blocks = static_cast<int>(whole.grid.xyz.size());
+  for (const std::vector<int>& share : partitions(blocks))
+  {
+    model::MultiBlockMesher mesher(blockModel, 1.5);
+    mesher.computeBoundaries(share);
+    for (int b : share)
+    {
+      const auto n = mesher.nodeCounts(b);
+      std::vector<double> xyz(3 * static_cast<std::size_t>(n[0]) * n[1] * n[2]);
+      mesher.meshBlock(b, xyz.data());
+      EXPECT_TRUE(test::sameBits(xyz, whole.grid.xyz[b])) << "block " << b;
+    }
+    for (int b = 0; b < blocks; ++b)
+    {
+      if (std::find(share.begin(), share.end(), b) == share.end())
+      {
+        std::vector<double> xyz(3 * whole.grid.xyz[b].size());
+        EXPECT_THROW(mesher.meshBlock(b, xyz.data()), std::logic_error) << "block " << b;
+      }
+    }
+  }
+}
+
+TEST(Partition, SharesMeshTheirBlocksLikeTheWhole)
+{
+  // Periodic faces (images rotated from sources on other ranks), O/H interfaces, surface
+  // faces on the blade, hub and shroud; periodic edges; a degenerate (wedge) block.
+  expectSharesMeshLikeWhole("Templates/axial_passage_oh.yaml", "Data/distributor/BladeGen.inf");
+  for (const std::string& name : test::exampleTemplates())
+  {
+    SCOPED_TRACE(name);
+    expectSharesMeshLikeWhole("Templates/" + name, "");
+  }
+}
+
+TEST(Threads, InvertedCellCheckOnThreadsEqualsOneThread)
+{
+  // A block folded in two places (k-layers far apart, so different chunks): the count,
+  // the index range and the worst cell must not depend on the chunks.
+  const int ni = 9, nj = 7, nk = 40;
+  std::vector<double> xyz(3 * static_cast<std::size_t>(ni) * nj * nk);
+  for (int k = 0; k < nk; ++k)
+    for (int j = 0; j < nj; ++j)
+      for (int i = 0; i < ni; ++i)
+      {
+        double* p = &xyz[3 * ((static_cast<std::size_t>(k) * nj + j) * ni + i)];
+        p[0] = i;
+        p[1] = j;
+        p[2] = k;
+      }
+  auto push = [&](int i, int j, int k, double dz) {
+    xyz[3 * ((static_cast<std::size_t>(k) * nj + j) * ni + i) + 2] += dz;
+  };
+  push(3, 2, 5, 1.6);   // node pushed through the next layer: folds cells of layers 4, 5
+  push(6, 4, 33, -1.9); // and deeper at layers 32, 33
+  const InvertedCells one = findInvertedCells(xyz.data(), ni, nj, nk);
+  ASSERT_GT(one.count, 0);
+  EXPECT_LT(one.lowest[2], 10);
+  EXPECT_GT(one.highest[2], 30);
+  for (int threads : { 2, 3 })
+  {
+    ThreadRunner runner(threads);
+    const InvertedCells many = findInvertedCells(xyz.data(), ni, nj, nk);
+    EXPECT_EQ(many.count, one.count);
+    EXPECT_EQ(many.nonFinite, one.nonFinite);
+    EXPECT_EQ(many.lowest, one.lowest);
+    EXPECT_EQ(many.highest, one.highest);
+    EXPECT_EQ(many.worstCell, one.worstCell);
+    EXPECT_TRUE(test::sameBits(many.worstScaledJacobian, one.worstScaledJacobian));
+  }
 }
 
 TEST(Threads, SequentialByDefault)

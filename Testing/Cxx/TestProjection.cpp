@@ -1,6 +1,7 @@
 // Closest-point projection onto curves and surfaces and arc-length parametrisation,
 // checked against analytic foot points and lengths.
 #include "BSpline.h"
+#include "ArcLength.h"
 #include "Projection.h"
 
 #include <Eigen/Geometry>

@@ -599,7 +599,7 @@ TEST(ModelDocument, ErrorsAfterReloadNameTheTemplateLine)
 TEST(ModelDocument, RejectsNewerAndMalformedDocuments)
 {
   const std::string document = writeModelDocument(parseTemplate(TwoBoxes, TwoBoxesFile));
-  expectError([&] { readModelDocument(replaced(document, "blockforge_model: 1", "blockforge_model: 4")); },
+  expectError([&] { readModelDocument(replaced(document, "blockforge_model: 1", "blockforge_model: 5")); },
     { "<model document>", "newer", "update BlockForge" });
   expectError([&] { readModelDocument("just: text\n"); }, { "<model document>", "not a BlockForge model" });
   expectError([&] { readModelDocument("blockforge_model: 1\nvertices: [{name: a, position: [0, 0]}]\n"); },

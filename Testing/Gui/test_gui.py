@@ -11,7 +11,6 @@ the new screenshot (after a deliberate change).
 """
 import os
 import shutil
-import subprocess
 import sys
 import unittest
 
@@ -53,30 +52,10 @@ class GuiTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.output = bftest.output_path("gui")
-        os.makedirs(cls.output, exist_ok=True)
-        environment = dict(os.environ)
-        environment["BLOCKFORGE_GUI_OUTPUT"] = cls.output
-        environment["PV_PLUGIN_PATH"] = os.path.dirname(os.environ["BLOCKFORGE_PLUGIN"])
-        result = os.path.join(cls.output, "gui_result.txt")
-        cls.log = ""
-        # xvfb-run -a can lose a race for a display number with another X server starting
-        # at the same moment: try again then.
-        for _ in range(3):
-            if os.path.exists(result):
-                os.remove(result)
-            run = subprocess.run(
-                ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24", "paraview", "--dr",
-                 f"--script={SCRIPT}", "--exit"], cwd=bftest.SOURCE, env=environment,
-                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=300)
-            cls.log = run.stdout
-            if os.path.exists(result):
-                break
+        cls.log, lines = bftest.run_gui(SCRIPT, cls.output, "gui_result.txt")
         cls.results = {}
-        if os.path.exists(result):
-            with open(result) as stream:
-                for line in stream:
-                    key, _, value = line.strip().partition(" ")
-                    cls.results.setdefault(key, []).append(value)
+        for key, value in lines:
+            cls.results.setdefault(key, []).append(value)
 
     def test_gui_ran_with_the_plugin(self):
         self.assertIn("plugin_loaded", self.results, self.log[-3000:])

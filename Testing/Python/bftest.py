@@ -49,6 +49,40 @@ def load_plugin(namespace):
     LoadPlugin(os.environ["BLOCKFORGE_PLUGIN"], remote=False, ns=namespace)
 
 
+def run_gui(script, output, result_name, exit_after_script=True):
+    """Runs the ParaView GUI under xvfb-run on `script` (`paraview --dr --script=...`, with
+    `--exit` unless the script ends the process itself), the plugin autoloaded from
+    BLOCKFORGE_PLUGIN's folder and BLOCKFORGE_GUI_OUTPUT = `output`. Returns the GUI's
+    output and the lines the script wrote to `output`/`result_name` as (key, rest) pairs
+    ([] when it wrote none). xvfb-run -a can lose a race for a display number with another
+    X server starting at the same moment: it is tried again then."""
+    import subprocess  # only the GUI tests need it
+
+    os.makedirs(output, exist_ok=True)
+    environment = dict(os.environ)
+    environment["BLOCKFORGE_GUI_OUTPUT"] = output
+    environment["PV_PLUGIN_PATH"] = os.path.dirname(os.environ["BLOCKFORGE_PLUGIN"])
+    result = os.path.join(output, result_name)
+    command = ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24", "paraview", "--dr",
+               f"--script={script}"] + (["--exit"] if exit_after_script else [])
+    log = ""
+    for _ in range(3):
+        if os.path.exists(result):
+            os.remove(result)
+        try:
+            log = subprocess.run(command, cwd=SOURCE, env=environment, stdout=subprocess.PIPE,
+                                 stderr=subprocess.STDOUT, text=True, timeout=300).stdout
+        except subprocess.TimeoutExpired as error:
+            log = str(error.output)
+        if os.path.exists(result):
+            break
+    lines = []
+    if os.path.exists(result):
+        with open(result) as stream:
+            lines = [tuple(line.strip().partition(" ")[::2]) for line in stream]
+    return log, lines
+
+
 def _leaf_iterators(multiblock):
     iterator = multiblock.NewIterator()
     iterator.InitTraversal()

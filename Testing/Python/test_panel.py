@@ -177,7 +177,18 @@ class CachedRanges(unittest.TestCase):
         quality = GridQuality(Input=BlockMesher(Input=source))  # noqa: F821
         quality.UpdatePipeline()
         grid = quality.GetClientSideObject().GetOutputDataObject(0)
+        from vtkmodules.vtkCommonCore import vtkPoints
         for block in bftest.leaves(grid):
+            # The bounds set with the points equal those vtkPoints computes afresh.
+            fresh = vtkPoints()
+            fresh.SetDataTypeToDouble()
+            fresh.DeepCopy(block.GetPoints())
+            self.assertNotEqual(block.GetPoints().GetClassName(), "vtkPoints")
+            self.assertEqual(block.GetPoints().GetBounds(), fresh.GetBounds())
+            self.assertEqual(block.GetBounds(), fresh.GetBounds())
+            values = np.asarray(block.GetPoints().GetData())
+            self.assertEqual(list(block.GetBounds()),
+                             [float(f(values[:, c])) for c in range(3) for f in (np.min, np.max)])
             arrays = [block.GetPoints().GetData()] + [
                 block.GetCellData().GetArray(n) for n in range(block.GetCellData().GetNumberOfArrays())]
             for array in arrays:

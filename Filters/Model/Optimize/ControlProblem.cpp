@@ -102,50 +102,7 @@ bool referredTo(const BlockModel& model, int c)
   return false;
 }
 
-/**
- * Surface curves drawn through moved control points are drawn again: their parameter
- * points take the points' new (s, t). Returns the vertices at the ends of the named edges
- * on redrawn curves (the plan must update them so those edges follow).
- */
-std::vector<int> redrawCurves(model::MeshPlan& plan, const std::vector<ThroughPoint>& through)
-{
-  BlockModel& work = plan.model();
-  std::set<int> redraw;
-  for (const ThroughPoint& point : through)
-  {
-    const model::VertexConstraint& constraint = work.vertices[point.vertex].constraint;
-    Eigen::Vector2d& st = work.carriers[point.carrier].parameterPoints[point.index];
-    if (constraint.s != st[0] || constraint.t != st[1])
-    {
-      st = Eigen::Vector2d(constraint.s, constraint.t);
-      redraw.insert(point.carrier);
-    }
-  }
-  std::vector<int> ends;
-  for (int carrier : redraw)
-  {
-    plan.rebuildCarrier(carrier);
-    for (const model::Edge& edge : work.edges)
-    {
-      if (edge.carrier == carrier)
-      {
-        ends.push_back(edge.from);
-        ends.push_back(edge.to);
-      }
-    }
-  }
-  return ends;
-}
-
-/// Sets component `component` of `vertex`'s parameters (wrapped on closed carriers).
-void setParameter(BlockModel& model, const CarrierGeometry& geometry, int vertex, int component,
-  double value)
-{
-  model::VertexConstraint& constraint = model.vertices[vertex].constraint;
-  const bool closed =
-    component == 0 ? geometry.closedS(constraint.carrier) : geometry.closedT(constraint.carrier);
-  (component == 0 ? constraint.s : constraint.t) = closed ? model::wrapUnit(value) : value;
-}
+using model::setParameter;
 
 /// Block vertices adjacent to each vertex along block edges.
 std::vector<std::set<int>> edgeNeighbours(const BlockModel& model)
@@ -262,6 +219,7 @@ struct ControlProblem::Impl
   /// The grid kept alive between evaluations, and the configuration it holds.
   std::unique_ptr<model::MeshPlan> Plan;
   std::vector<double> Current;
+  bool Unplaced = false; ///< a placement failed: the next one places every vertex
 
   /// Moves the plan to configuration x (only the parameters that changed) and updates it.
   model::Feasibility place(const std::vector<double>& x)
@@ -286,9 +244,30 @@ struct ControlProblem::Impl
       }
     }
     Current = x;
-    std::vector<int> applied = model::applyPlacement(work, Plan->carriers(), moved);
-    const std::vector<int> ends = redrawCurves(*Plan, Through);
-    applied.insert(applied.end(), ends.begin(), ends.end());
+    if (Unplaced)
+    {
+      // the last placement failed half-way: place every vertex again
+      moved.clear();
+      for (std::size_t v = 0; v < work.vertices.size(); ++v)
+      {
+        moved.push_back(static_cast<int>(v));
+      }
+    }
+    std::vector<int> applied;
+    try
+    {
+      // also draws curves through moved points again (the plan follows them)
+      applied = model::applyPlacement(work, Plan->carriers(), moved);
+      Unplaced = false;
+    }
+    catch (const std::exception& error)
+    {
+      Unplaced = true;
+      model::Feasibility failed;
+      failed.problem = model::Feasibility::Problem::ModelError;
+      failed.message = error.what();
+      return failed;
+    }
     return Plan->update(applied);
   }
 };
@@ -300,6 +279,8 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
 {
   P->Base = model;
   P->Geometry = geometry;
+  // Vertices placed by expressions shift from where those put them at the start.
+  model::rebasePlacementExpressions(P->Base, P->Geometry);
   P->Density = densityMultiplier;
   P->Objective = objective;
   const BlockModel& base = P->Base;
@@ -472,10 +453,11 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
     const model::VertexConstraint& constraint = base.vertices[v].constraint;
     const double value = parameter.component == 0 ? constraint.s : constraint.t;
     BlockModel probe = base;
+    CarrierGeometry probeGeometry = P->Geometry; // curves through the probe are drawn again
     const double step = value + probeStep <= parameter.high || parameter.wraps ? probeStep : -probeStep;
     setParameter(probe, P->Geometry, v, parameter.component, value + step);
     bool keeps = true;
-    for (int w : model::applyPlacement(probe, P->Geometry, { v }))
+    for (int w : model::applyPlacement(probe, probeGeometry, { v }))
     {
       keeps = keeps && staysOnBoundary(probe, w);
     }
@@ -734,13 +716,14 @@ BlockModel ControlProblem::modelAt(const std::vector<double>& x)
 std::vector<Vec3> ControlProblem::verticesAt(const std::vector<double>& x) const
 {
   BlockModel work = P->Base;
+  CarrierGeometry geometry = P->Geometry;
   std::vector<int> moved;
   for (std::size_t i = 0; i < Variables.size(); ++i)
   {
-    setVariable(work, P->Geometry, Variables[i], x[i]);
+    setVariable(work, geometry, Variables[i], x[i]);
     moved.push_back(Variables[i].vertex);
   }
-  model::applyPlacement(work, P->Geometry, moved);
+  model::applyPlacement(work, geometry, moved);
   std::vector<Vec3> positions;
   for (const model::Vertex& vertex : work.vertices)
   {
@@ -774,6 +757,8 @@ void applyMoves(BlockModel& model, CarrierGeometry& geometry,
   }
   model::MeshPlan plan(model, geometry);
   BlockModel& work = plan.model();
+  // Vertices placed by expressions land where moved while what they follow stays.
+  model::rebasePlacementExpressions(work, plan.carriers());
   std::vector<int> moved;
   for (const ControlPointMove& move : moves)
   {
@@ -812,19 +797,10 @@ void applyMoves(BlockModel& model, CarrierGeometry& geometry,
     }
     moved.push_back(v);
   }
-  std::vector<int> applied = model::applyPlacement(work, plan.carriers(), moved);
-  std::vector<ThroughPoint> through;
-  for (const ThroughPoint& point : throughPoints(model))
-  {
-    if (!referredTo(model, point.carrier))
-    {
-      through.push_back(point);
-    }
-  }
-  const std::vector<int> ends = redrawCurves(plan, through);
-  applied.insert(applied.end(), ends.begin(), ends.end());
-  // The plan follows carrier edges to their moved ends; a move that folds the grid is
-  // still the user's move (the mesher reports the fold).
+  // Also draws curves through moved points again; the plan follows carrier edges to
+  // their moved ends and onto redrawn curves. A move that folds the grid is still the
+  // user's move (the mesher reports the fold).
+  const std::vector<int> applied = model::applyPlacement(work, plan.carriers(), moved);
   plan.update(applied);
   for (std::size_t c = 0; c < model.carriers.size(); ++c)
   {
