@@ -308,7 +308,11 @@ void TemplateReader::recordExpressionScope()
   }
   ExpressionScope& scope = Model.expressionScope;
   scope.thetaZero = referenceDirection();
-  std::set<std::string> skipped;
+  std::set<std::string> skipped; // built in (pi, deg, ...), definitions
+  for (const auto& builtIn : ExpressionEvaluator().constants())
+  {
+    skipped.insert(builtIn.first);
+  }
   for (const auto& definition : DefinitionIndex)
   {
     skipped.insert(definition.first);
