@@ -8,7 +8,10 @@
 //   angles, then the real grid measured.
 // Not a test (nothing asserts a time). Prints a Markdown table.
 // Usage: bench_optimizer [--repetitions N] [--evaluations N] [--sharpness K] [--step F]
-//          [--algorithm bobyqa|cobyla|subplex] [--blocks] template.yaml input.inf [...]
+//          [--algorithm bobyqa|cobyla|subplex] [--blocks] [--timing] [--csv FILE]
+//          template.yaml input.inf [...]
+// --blocks: where the smallest angles are (block, cell, grid plane) and which variables end
+// on their bounds; --csv: the table's numbers for Benchmark/optimizer_figure.py.
 #include "Optimizer.h"
 
 #include "../Testing/Cxx/TestTurboInputs.h"
@@ -114,6 +117,12 @@ std::vector<double> laplacian(ControlProblem& problem, const model::BlockModel& 
       }
       mean /= static_cast<double>(neighbours[v].size());
       const Vec3 target = positions[v] + 0.5 * (mean - positions[v]);
+      if (variables[i].component >= 2) // a free interior vertex: its coordinate
+      {
+        x[i] = std::min(variables[i].high,
+          std::max(variables[i].low, target[variables[i].component - 2]));
+        continue;
+      }
       double s = 0.0, t = 0.0, distance = 0.0;
       geometry.project(model.vertices[v].constraint.carrier, target, s, t, distance);
       const double value = variables[i].component == 0 ? s : t;
@@ -167,9 +176,71 @@ GridMeasures blockScore(ControlProblem& problem, const model::BlockModel& model,
   return measures;
 }
 
+/// Where the smallest angles of a block are: for its `count` worst cells, the cell
+/// (i, j, k) and the grid plane of the face corner with the smallest angle (ij: the face
+/// of constant k, ...), printed to stderr.
+void printWorstCells(const std::string& block, const std::vector<double>& xyz,
+  const std::array<int, 3>& n, std::size_t count)
+{
+  auto node = [&](int i, int j, int k) {
+    const double* p = xyz.data() + 3 * (i + n[0] * (j + n[1] * static_cast<std::size_t>(k)));
+    return Vec3(p[0], p[1], p[2]);
+  };
+  struct Worst
+  {
+    double angle;
+    int i, j, k;
+    const char* plane;
+    int nodeK; ///< node layer of the corner with the smallest angle
+  };
+  std::vector<Worst> cells;
+  for (int k = 0; k + 1 < n[2]; ++k)
+    for (int j = 0; j + 1 < n[1]; ++j)
+      for (int i = 0; i + 1 < n[0]; ++i)
+      {
+        Worst worst{ 180.0, i, j, k, "", k };
+        // Corner angles between the cell's edges at each of its 8 corners, per plane.
+        for (int c = 0; c < 8; ++c)
+        {
+          const int di = c & 1, dj = (c >> 1) & 1, dk = (c >> 2) & 1;
+          const Vec3 p = node(i + di, j + dj, k + dk);
+          const Vec3 ei = node(i + 1 - di, j + dj, k + dk) - p;
+          const Vec3 ej = node(i + di, j + 1 - dj, k + dk) - p;
+          const Vec3 ek = node(i + di, j + dj, k + 1 - dk) - p;
+          const std::pair<double, const char*> angles[3] = {
+            { std::acos(std::max(-1.0, std::min(1.0, ei.normalized().dot(ej.normalized())))), "ij" },
+            { std::acos(std::max(-1.0, std::min(1.0, ei.normalized().dot(ek.normalized())))), "ik" },
+            { std::acos(std::max(-1.0, std::min(1.0, ej.normalized().dot(ek.normalized())))), "jk" }
+          };
+          for (const auto& [angle, plane] : angles)
+          {
+            const double degrees = angle * 180.0 / M_PI;
+            if (degrees < worst.angle)
+            {
+              worst.angle = degrees;
+              worst.plane = plane;
+              worst.nodeK = k + dk;
+            }
+          }
+        }
+        cells.push_back(worst);
+      }
+  std::sort(cells.begin(), cells.end(),
+    [](const Worst& a, const Worst& b) { return a.angle < b.angle; });
+  const long below40 = std::count_if(
+    cells.begin(), cells.end(), [](const Worst& w) { return w.angle < 40.0; });
+  std::fprintf(stderr, "  block %-6s %ld cells below 40:", block.c_str(), below40);
+  for (std::size_t c = 0; c < std::min(count, cells.size()); ++c)
+  {
+    std::fprintf(stderr, " %.1f at (%d,%d,%d) %s node k %d;", cells[c].angle, cells[c].i,
+      cells[c].j, cells[c].k, cells[c].plane, cells[c].nodeK);
+  }
+  std::fprintf(stderr, "\n");
+}
+
 struct Row
 {
-  std::string name;
+  std::string name, templateName, input;
   GridMeasures before, after, laplace, classy;
   std::size_t variables = 0;
   double seconds = 0.0, cpuSeconds = 0.0, searchSeconds = 0.0, laplaceSeconds = 0.0,
@@ -184,6 +255,7 @@ int main(int argc, char** argv)
   int repetitions = 5;
   bool blocks = false;
   bool timing = false;
+  std::string csvFile;
   OptimizerSettings settings;
   std::vector<std::pair<std::string, std::string>> cases;
   for (int a = 1; a < argc; ++a)
@@ -221,6 +293,10 @@ int main(int argc, char** argv)
     {
       timing = true;
     }
+    else if (arg == "--csv" && a + 1 < argc)
+    {
+      csvFile = argv[++a];
+    }
     else if (a + 1 < argc)
     {
       cases.emplace_back(argv[a], argv[a + 1]);
@@ -235,6 +311,8 @@ int main(int argc, char** argv)
     const model::BlockModel model = model::loadTemplate(templateFile, {}, &inputs, &geometry);
     Row row;
     row.name = baseName(templateFile) + ", " + inputFile;
+    row.templateName = baseName(templateFile);
+    row.input = inputFile;
     if (timing)
     {
       // Cost of one evaluation: one parameter moved (the plan updates its neighbourhood)
@@ -309,19 +387,24 @@ int main(int argc, char** argv)
       row.evaluations, row.seconds, row.cpuSeconds, row.stop.c_str());
     if (blocks)
     {
+      for (std::size_t i = 0; i < result.variables.size(); ++i)
+      {
+        const ControlVariable& v = result.variables[i];
+        const double value = result.search.best.empty() ? v.start : result.search.best[i];
+        std::fprintf(stderr, "  %-10s %.4f in [%.4f, %.4f] from %.4f%s\n", v.name.c_str(), value,
+          v.low, v.high, v.start,
+          std::abs(value - v.low) < 1e-3 * (v.high - v.low) ||
+              std::abs(value - v.high) < 1e-3 * (v.high - v.low)
+            ? "  (at its bound)"
+            : "");
+      }
       const model::CarrierGeometry built(result.model);
       ControlProblem problem(result.model, built, 1.0, settings.objective, {});
       const std::vector<std::vector<double>> grids = problem.gridAt(problem.start());
       model::MeshPlan plan(result.model, built);
       for (std::size_t b = 0; b < grids.size(); ++b)
       {
-        const auto n = plan.nodeCounts(static_cast<int>(b));
-        const BlockAngles angles({ grids[b].data(), n[0], n[1], n[2] });
-        const auto& c = angles.cellMinimum();
-        const auto worst = std::min_element(c.begin(), c.end()) - c.begin();
-        std::fprintf(stderr, "  block %-6s min %6.2f at cell %ld, %ld cells below 40\n",
-          result.model.blocks[b].name.c_str(), c[worst], static_cast<long>(worst),
-          static_cast<long>(std::count_if(c.begin(), c.end(), [](double a) { return a < 40; })));
+        printWorstCells(result.model.blocks[b].name, grids[b], plan.nodeCounts(static_cast<int>(b)), 4);
       }
     }
     rows.push_back(row);
@@ -341,6 +424,39 @@ int main(int argc, char** argv)
       row.evaluations,
       row.evaluations / row.searchSeconds, angleText(row.laplace).c_str(), row.laplaceSeconds,
       angleText(row.classy).c_str(), row.classySeconds);
+  }
+  if (!csvFile.empty())
+  {
+    FILE* csv = std::fopen(csvFile.c_str(), "w");
+    if (!csv)
+    {
+      std::fprintf(stderr, "cannot write %s\n", csvFile.c_str());
+      return 1;
+    }
+    std::fprintf(csv, "template,input,variables,before_min,before_classes,after_min,"
+                      "after_classes,seconds,cpu_seconds,evaluations,evaluations_per_second,"
+                      "laplacian_min,laplacian_seconds,block_score_min,block_score_seconds\n");
+    auto minText = [](const GridMeasures& m) {
+      return m.feasible ? std::to_string(m.minAngle) : std::string("inverted");
+    };
+    auto classText = [](const GridMeasures& m) {
+      std::string text;
+      for (long long c : m.classes)
+      {
+        text += (text.empty() ? "" : " ") + std::to_string(c);
+      }
+      return text;
+    };
+    for (const Row& row : rows)
+    {
+      std::fprintf(csv, "%s,%s,%zu,%.6f,%s,%.6f,%s,%.4f,%.4f,%d,%.2f,%s,%.4f,%s,%.4f\n",
+        row.templateName.c_str(), row.input.c_str(), row.variables, row.before.minAngle,
+        classText(row.before).c_str(), row.after.minAngle, classText(row.after).c_str(),
+        row.seconds, row.cpuSeconds, row.evaluations, row.evaluations / row.searchSeconds,
+        minText(row.laplace).c_str(), row.laplaceSeconds, minText(row.classy).c_str(),
+        row.classySeconds);
+    }
+    std::fclose(csv);
   }
   return 0;
 }

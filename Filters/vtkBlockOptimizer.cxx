@@ -188,6 +188,7 @@ int vtkBlockOptimizer::RequestData(
     settings.search.maxEvaluations = this->MaximumEvaluations;
     settings.search.tolerance = this->Tolerance;
     settings.densityMultiplier = this->DensityMultiplier;
+    settings.maximumMemory = this->MaximumMemory;
     settings.automatic = this->Automatic;
     settings.fixed = this->FixedControlPoints;
     for (const auto& move : this->ControlPointMoves)
@@ -310,6 +311,7 @@ void vtkBlockOptimizer::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MaximumEvaluations: " << this->MaximumEvaluations << "\n";
   os << indent << "Tolerance: " << this->Tolerance << "\n";
   os << indent << "DensityMultiplier: " << this->DensityMultiplier << "\n";
+  os << indent << "MaximumMemory: " << this->MaximumMemory << "\n";
   os << indent << "Automatic: " << this->Automatic << "\n";
   for (const std::string& name : this->FixedControlPoints)
   {

@@ -82,9 +82,18 @@ public:
 
   ///@{
   /// The grid the objective measures: the template's cell counts times this (as
-  /// vtkBlockMesher's DensityMultiplier; default 1).
+  /// vtkBlockMesher's DensityMultiplier; default 1). Give the mesher's value, so the
+  /// optimizer measures the final cells (a coarsened copy above 1e5 nodes).
   vtkSetMacro(DensityMultiplier, double); // validated when run, as the mesher's
   vtkGetMacro(DensityMultiplier, double);
+  ///@}
+
+  ///@{
+  /// The grid at DensityMultiplier must fit in this memory (GB; default 0: what the
+  /// machine has available), as vtkBlockMesher's MaximumMemory: a grid the mesher would
+  /// refuse is refused before the optimizer works on it.
+  vtkSetClampMacro(MaximumMemory, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(MaximumMemory, double);
   ///@}
 
   ///@{
@@ -147,6 +156,7 @@ protected:
   int MaximumEvaluations = 400;
   double Tolerance = 1.0e-3;
   double DensityMultiplier = 1.0;
+  double MaximumMemory = 0.0;
   bool Automatic = true;
   std::vector<std::string> FixedControlPoints;
   std::vector<std::pair<std::string, std::string>> ControlPointMoves;

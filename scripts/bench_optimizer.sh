@@ -1,14 +1,18 @@
 #!/usr/bin/env bash
 # Benchmark of the BlockOptimizer (not a test): both blade-passage templates on every
-# machine in Data/, MinAngle classes before and after, time of the automatic run (median
-# of 5), evaluations per second, and the Laplacian / block-score baselines on the same
-# control points. Writes Benchmark/OPTIMIZER.md.
+# machine in Data/, MinAngle classes before and after, time of the automatic run in process
+# (median of 5, wall and CPU) and evaluations per second, the Laplacian / block-score
+# baselines on the same control points, and the whole native command line (`blockforge
+# TEMPLATE -i INPUT -o grid.xyz`, median of 5) with and without the optimizer. Writes
+# Benchmark/OPTIMIZER.md and doc/optimizer_classes.png (the paper's Fig. 12 layout).
 # Usage: scripts/bench_optimizer.sh [bench_optimizer options, e.g. --repetitions 1]
+# Environment: BLOCKFORGE_BUILD_DIR (default ./build), BENCH_REPETITIONS (default 5).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build="${BLOCKFORGE_BUILD_DIR:-$root/build}"
-"$root/scripts/setup.sh"
-cmake --build "$build" --target bench_optimizer -j"$(nproc)" >/dev/null
+repetitions="${BENCH_REPETITIONS:-5}"
+"$root/scripts/setup.sh" python3-matplotlib
+cmake --build "$build" --target bench_optimizer blockforge -j"$(nproc)" >/dev/null
 cases=()
 for input in Data/distributor/BladeGen.inf Data/rotor37/turbogrid/BladeGen.inf \
   Data/compressor/rotor.inf Data/turbine/Info.txt; do
@@ -18,12 +22,56 @@ for input in Data/distributor/BladeGen.inf Data/rotor37/turbogrid/BladeGen.inf \
   done
 done
 cd "$root"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+# Median wall time of a whole process, in seconds.
+median_seconds() {
+  local times=() start end
+  for ((r = 0; r < repetitions; ++r)); do
+    start=$(date +%s.%N)
+    "$@" >/dev/null
+    end=$(date +%s.%N)
+    times+=("$(echo "$end - $start" | bc -l)")
+  done
+  printf '%s\n' "${times[@]}" | sort -g | awk '{v[NR] = $1} END {
+    if (NR % 2) print v[(NR + 1) / 2]; else print (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+}
+
+process="$work/process.csv"
+echo "template,input,optimize_seconds,no_optimize_seconds" >"$process"
+for ((c = 0; c < ${#cases[@]}; c += 2)); do
+  template=${cases[c]} input=${cases[c + 1]}
+  with=$(median_seconds "$build/bin/blockforge" "$template" -i "$input" -o "$work/grid.xyz")
+  without=$(median_seconds "$build/bin/blockforge" "$template" -i "$input" -o "$work/grid.xyz" \
+    --no-optimize)
+  name=$(basename "$template" .yaml)
+  echo "$name,$input,$with,$without" >>"$process"
+done
+
 {
   echo "# BlockOptimizer benchmark"
   echo
-  echo "\`scripts/bench_optimizer.sh $*\` at commit $(git rev-parse --short HEAD), $(nproc) cores, $(date -u +%Y-%m-%d)."
+  echo "\`scripts/bench_optimizer.sh $*\` at commit $(git rev-parse --short HEAD), $(nproc) cores," \
+    "load average $(cut -d' ' -f1-3 /proc/loadavg), $(date -u +%Y-%m-%d)."
   echo "Classes: cells per MinAngle class 0-20 / 20-40 / 40-60 / 60-80 / 80-90 degrees."
+  echo "In process (\`bench_optimizer\`): the automatic run alone, median of $repetitions."
   echo
-  "$build/bin/bench_optimizer" "$@" "${cases[@]}"
+  "$build/bin/bench_optimizer" --repetitions "$repetitions" --csv "$work/optimizer.csv" "$@" \
+    "${cases[@]}"
+  echo
+  echo "Whole process, the native command line \`blockforge TEMPLATE -i INPUT -o grid.xyz\`"
+  echo "(read, template, optimizer, mesh, Plot3D write), median of $repetitions:"
+  echo
+  echo "| case | with the optimizer | --no-optimize | the optimizer's share |"
+  echo "|---|---|---|---|"
+  tail -n +2 "$process" | while IFS=, read -r name input with without; do
+    printf '| %s, %s | %.2f s | %.2f s | %.2f s |\n' "$name" "$input" "$with" "$without" \
+      "$(echo "$with - $without" | bc -l)"
+  done
 } >Benchmark/OPTIMIZER.md
+cp "$work/optimizer.csv" Benchmark/optimizer.csv
+cp "$process" Benchmark/optimizer_process.csv
+/usr/bin/python3 Benchmark/optimizer_figure.py Benchmark/optimizer.csv doc/optimizer_classes.png \
+  Benchmark/optimizer_process.csv
 cat Benchmark/OPTIMIZER.md

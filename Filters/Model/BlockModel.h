@@ -195,6 +195,9 @@ struct Vertex
   Vec3 position = Vec3::Zero();
   VertexConstraint constraint;
   VertexRule rule;
+  /// The template marks this vertex fixed (`fixed: true`): the block optimizer leaves its
+  /// free parameters (or, for a free interior vertex, its position) alone.
+  bool fixed = false;
   SourceLocation where;
 };
 

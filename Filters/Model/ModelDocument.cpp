@@ -301,7 +301,7 @@ private:
     Vertex vertex;
     const auto keys = entries(
       node, "vertex", { "position", "on", "at", "periodic", "pitches", "rule", "source", "origin",
-        "axis", "angle", "expressions" }, vertex.name, vertex.where);
+        "axis", "angle", "expressions", "fixed" }, vertex.name, vertex.where);
     const std::string entityText = entity("vertex", vertex.name);
     if (Model.findVertex(vertex.name) >= 0)
     {
@@ -328,6 +328,15 @@ private:
       vertex.constraint.periodicSource = -2; // resolved once every vertex is known
     }
     readRule(keys, node, entityText, vertex);
+    if (const MapEntry* fixed = syntax::findEntry(keys, "fixed"))
+    {
+      const std::string mark = text(fixed->value, fixed->line, entityText, "fixed");
+      if (mark != "true" && mark != "false")
+      {
+        fail(fixed->line, entityText, "fixed: expected true or false");
+      }
+      vertex.fixed = mark == "true";
+    }
     if (const MapEntry* expressions = syntax::findEntry(keys, "expressions"))
     {
       readPlacementExpressions(*expressions, entityText, vertex);
@@ -1164,6 +1173,10 @@ std::string writeModelDocument(const BlockModel& model)
         emitVector(out, vertex.rule.axis);
         out << YAML::Key << "angle" << YAML::Value << formatNumber(vertex.rule.angle);
       }
+    }
+    if (vertex.fixed)
+    {
+      out << YAML::Key << "fixed" << YAML::Value << "true";
     }
     const PlacementExpressions& expressions = vertex.rule.expressions;
     if (expressions.form != PlacementExpressions::Form::None)

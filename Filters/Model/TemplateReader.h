@@ -145,6 +145,8 @@ private:
   /// `{position: [x, y, z]}` or `{rotate: v, angle: a, axis: [..], origin: [..]}`: the
   /// mapping form leaves room for the constraints of later format versions.
   void readVertexMapping(const MapEntry& entry, const std::string& entityText, Vertex& vertex);
+  /// The vertex's `fixed: true|false` marker (false without one): the optimizer holds it.
+  bool fixedMark(const MapEntry& entry, const std::string& entityText);
 
   void readEdges();
 

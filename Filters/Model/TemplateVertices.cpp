@@ -44,6 +44,7 @@ void TemplateReader::readVertices()
     else if (entry.value.IsMap())
     {
       readVertexMapping(entry, entityText, vertex);
+      vertex.fixed = fixedMark(entry, entityText);
     }
     else
     {
@@ -60,8 +61,8 @@ void TemplateReader::readVertexMapping(const MapEntry& entry, const std::string&
 {
   const auto keys =
     syntax::mapEntries(entry.value, entry.line, entityText, "the vertex", Report);
-  syntax::checkKeys(keys, { "position", "rotate", "angle", "axis", "origin" }, entityText,
-    Report);
+  syntax::checkKeys(keys, { "position", "rotate", "angle", "axis", "origin", "fixed" },
+    entityText, Report);
   const MapEntry* position = syntax::findEntry(keys, "position");
   const MapEntry* rotate = syntax::findEntry(keys, "rotate");
   if ((position != nullptr) == (rotate != nullptr))
@@ -70,7 +71,7 @@ void TemplateReader::readVertexMapping(const MapEntry& entry, const std::string&
   }
   if (position)
   {
-    if (keys.size() != 1)
+    if (keys.size() != (syntax::findEntry(keys, "fixed") ? 2u : 1u))
     {
       fail(entry.line, entityText, "'angle', 'axis' and 'origin' belong to 'rotate'");
     }
@@ -101,6 +102,16 @@ void TemplateReader::readVertexMapping(const MapEntry& entry, const std::string&
   placeVertex(Model, Geometry, vertex);
 }
 
+bool TemplateReader::fixedMark(const MapEntry& entry, const std::string& entityText)
+{
+  if (!entry.value.IsMap())
+  {
+    return false;
+  }
+  return flag(syntax::mapEntries(entry.value, entry.line, entityText, "the vertex", Report),
+    "fixed", false, entityText);
+}
+
 void TemplateReader::ensureVertex(int index)
 {
   resolveOnce(VertexState, VertexEntries, index, "vertex",
@@ -114,6 +125,7 @@ void TemplateReader::ensureVertex(int index)
         fail(entry.line, entityText, "the position is not finite");
       }
       Model.vertices[index] = vertex;
+      Model.vertices[index].fixed = fixedMark(entry, entityText);
       defineVertexQueries(vertex);
     });
 }
@@ -490,14 +502,14 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
   }
   if (kind->key == "cylindrical")
   {
-    syntax::checkKeys(keys, { "cylindrical" }, entityText, Report);
+    syntax::checkKeys(keys, { "cylindrical", "fixed" }, entityText, Report);
     vertex.position = cylindricalValue(*kind, entityText);
     return;
   }
   VertexConstraint& constraint = vertex.constraint;
   if (kind->key == "on_curve")
   {
-    syntax::checkKeys(keys, { "on_curve", "at" }, entityText, Report);
+    syntax::checkKeys(keys, { "on_curve", "at", "fixed" }, entityText, Report);
     const int curve = carrierRef(kind->value, kind->line, entityText, "on_curve", Want::Curve);
     const MapEntry* at = syntax::findEntry(keys, "at");
     if (!at)
@@ -536,7 +548,7 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
   }
   if (kind->key == "on_surface" && syntax::findEntry(keys, "axial"))
   {
-    syntax::checkKeys(keys, { "on_surface", "axial", "theta" }, entityText, Report);
+    syntax::checkKeys(keys, { "on_surface", "axial", "theta", "fixed" }, entityText, Report);
     const int surface =
       carrierRef(kind->value, kind->line, entityText, "on_surface", Want::Surface);
     const MapEntry* axialEntry = syntax::findEntry(keys, "axial");
@@ -562,7 +574,7 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
   }
   if (kind->key == "on_surface")
   {
-    syntax::checkKeys(keys, { "on_surface", "at" }, entityText, Report);
+    syntax::checkKeys(keys, { "on_surface", "at", "fixed" }, entityText, Report);
     const int surface =
       carrierRef(kind->value, kind->line, entityText, "on_surface", Want::Surface);
     const MapEntry* at = syntax::findEntry(keys, "at");
@@ -598,7 +610,7 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
   }
   if (kind->key == "project")
   {
-    syntax::checkKeys(keys, { "project", "onto" }, entityText, Report);
+    syntax::checkKeys(keys, { "project", "onto", "fixed" }, entityText, Report);
     const MapEntry* onto = syntax::findEntry(keys, "onto");
     if (!onto)
     {
@@ -627,7 +639,7 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
   }
   if (kind->key == "intersect")
   {
-    syntax::checkKeys(keys, { "intersect", "near" }, entityText, Report);
+    syntax::checkKeys(keys, { "intersect", "near", "fixed" }, entityText, Report);
     if (!kind->value.IsSequence() || kind->value.size() != 2)
     {
       fail(here, entityText, "intersect expects [curve, surface]");
@@ -643,7 +655,7 @@ void TemplateReader::readVertexV2(const MapEntry& entry, const std::string& enti
     return;
   }
   // periodic
-  syntax::checkKeys(keys, { "periodic", "pitches" }, entityText, Report);
+  syntax::checkKeys(keys, { "periodic", "pitches", "fixed" }, entityText, Report);
   const int source = vertexRef(kind->value, kind->line, entityText);
   int pitches = 1;
   if (const MapEntry* count = syntax::findEntry(keys, "pitches"))

@@ -119,10 +119,11 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
     model = template
     if optimize:
         optimizer = vtkBlockOptimizer()
-        # The objective is measured on the template's grid (or a coarser one): it ranks
-        # configurations as the finer grid does, and a huge density is the mesher's to
-        # refuse with its memory message.
-        optimizer.SetDensityMultiplier(min(1.0, float(density_multiplier)))
+        # The objective is measured on the final cells: the grid at the density asked for
+        # (a coarsened copy above the optimizer's 1e5 nodes); a grid the mesher would
+        # refuse for memory is refused before the optimizer works on it.
+        optimizer.SetDensityMultiplier(float(density_multiplier))
+        optimizer.SetMaximumMemory(float(maximum_memory))
         optimizer.SetInputConnection(template.GetOutputPort())
         stages.append(("optimize", optimizer))
         model = optimizer

@@ -15,6 +15,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 using namespace blockforge;
 using namespace blockforge::optimize;
@@ -189,6 +191,78 @@ TEST(Optimizer, FixedControlPointStays)
   EXPECT_EQ(result.model.vertices[result.model.findVertex("m0")].constraint.s, 0.3);
 }
 
+TEST(Optimizer, FreeInteriorVertexFindsTheCentre)
+{
+  Loaded loaded;
+  loaded.model = model::loadTemplate(
+    dataPath("optimizer_interior.yaml"), {}, nullptr, &loaded.geometry);
+  OptimizerSettings settings;
+  settings.search.tolerance = 1e-12;
+  settings.search.maxEvaluations = 600;
+  const OptimizerResult result = optimizeModel(loaded.model, loaded.geometry, settings);
+  // Only the centre touches no boundary face: its x, y and z are the variables, within
+  // 45 % of the way to its nearest block-edge neighbour ((2, 1, 1), sqrt(0.66) away).
+  ASSERT_EQ(result.variables.size(), 3u);
+  EXPECT_EQ(result.variables[0].name, "c.x");
+  EXPECT_EQ(result.variables[2].name, "c.z");
+  EXPECT_NEAR(result.variables[0].low, 1.2 - 0.45 * std::sqrt(0.66), 1e-12);
+  const model::Vertex& centre = result.model.vertices[result.model.findVertex("c")];
+  EXPECT_NEAR(centre.position.x(), 1.0, 1e-6);
+  EXPECT_NEAR(centre.position.y(), 1.0, 1e-6);
+  EXPECT_NEAR(centre.position.z(), 1.0, 1e-6);
+  EXPECT_NEAR(result.after.minAngle, 90.0, 1e-3);
+  EXPECT_LT(result.before.minAngle, 80.0);
+  // Every other vertex stays where it was, bit for bit.
+  for (std::size_t v = 0; v < loaded.model.vertices.size(); ++v)
+  {
+    if (loaded.model.vertices[v].name != "c")
+    {
+      EXPECT_EQ(result.model.vertices[v].position, loaded.model.vertices[v].position);
+    }
+  }
+  EXPECT_EQ(meshedMinAngle(result.model), result.after.minAngle);
+}
+
+TEST(Optimizer, TemplateFixedMarkHoldsAVertex)
+{
+  // The same cube with the centre marked `fixed: true`: no variable, nothing moves, and
+  // the mark survives the model document (the pipeline's way between filters).
+  std::ifstream in(dataPath("optimizer_interior.yaml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string centre = "  c: {position: [cx, cy, cz]}";
+  ASSERT_NE(yaml.find(centre), std::string::npos);
+  yaml.replace(yaml.find(centre), centre.size(), "  c: {position: [cx, cy, cz], fixed: true}");
+  const std::string path = ::testing::TempDir() + "blockforge_optimizer_interior_fixed.yaml";
+  std::ofstream(path) << yaml;
+  Loaded loaded;
+  loaded.model = model::loadTemplate(path, {}, nullptr, &loaded.geometry);
+  const int c = loaded.model.findVertex("c");
+  EXPECT_TRUE(loaded.model.vertices[c].fixed);
+  const model::BlockModel reloaded =
+    model::readModelDocument(model::writeModelDocument(loaded.model));
+  EXPECT_TRUE(reloaded.vertices[c].fixed);
+  EXPECT_FALSE(reloaded.vertices[0].fixed);
+  const OptimizerResult result = optimizeModel(reloaded, loaded.geometry, OptimizerSettings{});
+  EXPECT_TRUE(result.variables.empty());
+  EXPECT_EQ(result.model.vertices[c].position, loaded.model.vertices[c].position);
+  // A mark that is not true or false is an error naming the vertex and its line.
+  yaml.replace(yaml.find("fixed: true"), 11, "fixed: maybe");
+  std::ofstream(path) << yaml;
+  try
+  {
+    model::loadTemplate(path, {}, nullptr, &loaded.geometry);
+    FAIL() << "expected an error";
+  }
+  catch (const model::TemplateError& error)
+  {
+    EXPECT_NE(std::string(error.what()).find("vertex 'c': fixed: expected true or false"),
+      std::string::npos)
+      << error.what();
+  }
+}
+
 TEST(Optimizer, BadNamesAndMovesAreErrors)
 {
   Loaded loaded = loadSymmetric();
@@ -302,4 +376,28 @@ TEST(OptimizerPassage, HTemplateNeverWorse)
   EXPECT_TRUE(run.result.after.feasible);
   EXPECT_GE(run.result.after.minAngle, run.result.before.minAngle);
   EXPECT_EQ(meshedMinAngle(run.result.model), run.result.after.minAngle);
+}
+
+TEST(OptimizerPassage, RefusesAGridTheMesherWouldRefuse)
+{
+  // The objective is measured on the final grid: one that would not fit in memory is
+  // refused before any work, with the mesher's message.
+  Loaded loaded = loadPassage("axial_passage_oh", "distributor");
+  OptimizerSettings settings;
+  settings.densityMultiplier = 1000.0;
+  try
+  {
+    optimizeModel(loaded.model, loaded.geometry, settings);
+    FAIL() << "expected a memory error";
+  }
+  catch (const std::exception& error)
+  {
+    EXPECT_NE(std::string(error.what()).find("the grid would need"), std::string::npos)
+      << error.what();
+    EXPECT_NE(std::string(error.what()).find("lower the density multiplier"), std::string::npos)
+      << error.what();
+  }
+  // A density within MaximumMeasuredNodes is measured as it is.
+  EXPECT_EQ(measuredDensity(loaded.model, 2.0), 2.0);
+  EXPECT_LT(measuredDensity(loaded.model, 3.0), 3.0);
 }

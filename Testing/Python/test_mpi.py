@@ -92,8 +92,8 @@ def check_case(label, template, input_file=None, density=1.0):
     else:
         model = BlockTemplateSource(TemplateFile=template)  # noqa: F821
     # Every rank optimizes the whole model (deterministic: the same on every rank and in
-    # the serial run, which mesh_template optimizes by default, on the template's grid).
-    model = BlockOptimizer(Input=model)  # noqa: F821
+    # the serial run, which mesh_template optimizes by default, on the final grid).
+    model = BlockOptimizer(Input=model, DensityMultiplier=density)  # noqa: F821
     grid = BlockMesher(Input=model, DensityMultiplier=density)  # noqa: F821
     quality = GridQuality(Input=grid)  # noqa: F821
     quality.UpdatePipeline()

@@ -187,24 +187,38 @@ class ErrorsTest(unittest.TestCase):
 @unittest.skipUnless(CLI, "BLOCKFORGE_CLI not set")
 class NativeCommandLineTest(unittest.TestCase):
     def test_same_bytes_as_the_python_pipeline(self):
+        """Both command lines run the BlockOptimizer by default and skip it with
+        --no-optimize; either way they write the same bytes."""
         folder = bftest.output_path("native_vs_python")
         shutil.rmtree(folder, ignore_errors=True)
         arguments = [AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "n_span=8"]
-        # The native command line does not run the BlockOptimizer (yet): the Python one
-        # skips it here so both mesh the same model.
-        for label, command in (("python", [sys.executable, "-m", "blockforge", "--no-optimize"]),
-                               ("native", [CLI])):
-            for output in ("case/c.foam", "grid.xyz"):
-                run = subprocess.run(command + arguments + ["-o", os.path.join(folder, label, output)],
-                                     capture_output=True, text=True)
-                self.assertEqual(run.returncode, 0, run.stderr)
-        for name in POLYMESH_FILES:
-            self.assertTrue(filecmp.cmp(os.path.join(folder, "python/case/constant/polyMesh", name),
-                                        os.path.join(folder, "native/case/constant/polyMesh", name),
-                                        shallow=False), name)
-        for name in ("grid.xyz", "grid.nmf"):
-            self.assertTrue(filecmp.cmp(os.path.join(folder, "python", name),
-                                        os.path.join(folder, "native", name), shallow=False))
+        for switch in ([], ["--no-optimize"]):
+            run_folder = os.path.join(folder, "no_optimize" if switch else "optimize")
+            for label, command in (("python", [sys.executable, "-m", "blockforge"]),
+                                   ("native", [CLI])):
+                for output in ("case/c.foam", "grid.xyz"):
+                    run = subprocess.run(command + arguments + switch +
+                                         ["-o", os.path.join(run_folder, label, output)],
+                                         capture_output=True, text=True)
+                    self.assertEqual(run.returncode, 0, run.stderr)
+                    self.assertEqual("optimizer: smallest element angle" in run.stdout,
+                                     not switch, run.stdout)
+            for name in POLYMESH_FILES:
+                self.assertTrue(filecmp.cmp(
+                    os.path.join(run_folder, "python/case/constant/polyMesh", name),
+                    os.path.join(run_folder, "native/case/constant/polyMesh", name),
+                    shallow=False), (switch, name))
+            for name in ("grid.xyz", "grid.nmf"):
+                self.assertTrue(filecmp.cmp(os.path.join(run_folder, "python", name),
+                                            os.path.join(run_folder, "native", name),
+                                            shallow=False), (switch, name))
+        # The optimizer moved the grid's nodes (the connectivity stays).
+        self.assertFalse(filecmp.cmp(os.path.join(folder, "optimize/native/grid.xyz"),
+                                     os.path.join(folder, "no_optimize/native/grid.xyz"),
+                                     shallow=False))
+        self.assertTrue(filecmp.cmp(os.path.join(folder, "optimize/native/grid.nmf"),
+                                    os.path.join(folder, "no_optimize/native/grid.nmf"),
+                                    shallow=False))
 
     def test_errors_name_the_problem(self):
         run = subprocess.run([CLI, os.path.join(SOURCE, "Testing", "Data", "bad_syntax.yaml"),

@@ -1,5 +1,7 @@
 #include "ControlProblem.h"
 
+#include "../../Core/InvertedCells.h"
+
 #include "Errors.h"
 #include "MeshPlan.h"
 #include "ModelSyntax.h"
@@ -10,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -139,6 +142,19 @@ std::vector<int> followers(const std::vector<std::vector<int>>& dependents, int 
   }
   return result;
 }
+
+/// Sets variable `variable` to `value`: a control point's carrier parameter, or a
+/// coordinate of a free interior vertex's position (components 2, 3, 4: x, y, z).
+void setVariable(
+  BlockModel& model, const CarrierGeometry& geometry, const ControlVariable& variable, double value)
+{
+  if (variable.component >= 2)
+  {
+    model.vertices[variable.vertex].position[variable.component - 2] = value;
+    return;
+  }
+  setParameter(model, geometry, variable.vertex, variable.component, value);
+}
 } // namespace
 
 struct ControlProblem::Impl
@@ -147,6 +163,57 @@ struct ControlProblem::Impl
   CarrierGeometry Geometry;
   double Density = 1.0;
   ObjectiveSettings Objective;
+  /// Angles (and neighbour size ratios) of every block of the plan as of the last feasible
+  /// evaluation; empty where a block changed since (an evaluation measures only those).
+  std::vector<std::unique_ptr<BlockAngles>> Angles;
+  std::vector<double> SizeRatios;
+
+  /// Forgets the measured angles of the blocks the last plan update recomputed.
+  void forgetUpdated()
+  {
+    if (!Plan)
+    {
+      Angles.clear();
+      return;
+    }
+    Angles.resize(Plan->blockCount());
+    SizeRatios.resize(Plan->blockCount(), 1.0);
+    for (int b : Plan->updatedBlocks())
+    {
+      Angles[b].reset();
+    }
+  }
+
+  /// The angle objectives of the plan's grid, measuring only the blocks that changed
+  /// (bit for bit what measureGrid gives for the whole grid).
+  GridMeasures measureChanged()
+  {
+    std::vector<const BlockAngles*> blocks;
+    double maxSizeRatio = 1.0;
+    for (int b = 0; b < Plan->blockCount(); ++b)
+    {
+      if (!Angles[b])
+      {
+        const std::array<int, 3> n = Plan->nodeCounts(b);
+        const BlockGrid grid{ Plan->blockNodes(b).data(), n[0], n[1], n[2] };
+        const long long inverted = findInvertedCells(grid.xyz, n[0], n[1], n[2]).count;
+        if (inverted > 0) // only the plan's first grid is not checked by its update
+        {
+          GridMeasures failed;
+          failed.invertedCells = inverted;
+          failed.objective = infeasibleObjective(inverted);
+          failed.failure = std::to_string(inverted) + " inverted cells";
+          return failed;
+        }
+        Angles[b].reset(new BlockAngles(grid));
+        SizeRatios[b] =
+          Objective.kind == ObjectiveKind::MinAngleAndSizeRatio ? maxNeighbourSizeRatio(grid) : 1.0;
+      }
+      blocks.push_back(Angles[b].get());
+      maxSizeRatio = std::max(maxSizeRatio, SizeRatios[b]);
+    }
+    return measureAngles(blocks, maxSizeRatio, Objective);
+  }
   std::vector<ThroughPoint> Through;
   std::vector<ControlVariable> Variables;
   /// The grid kept alive between evaluations, and the configuration it holds.
@@ -172,7 +239,7 @@ struct ControlProblem::Impl
     {
       if (x[i] != Current[i])
       {
-        setParameter(work, Plan->carriers(), Variables[i].vertex, Variables[i].component, x[i]);
+        setVariable(work, Plan->carriers(), Variables[i], x[i]);
         moved.push_back(Variables[i].vertex);
       }
     }
@@ -218,6 +285,13 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
   P->Objective = objective;
   const BlockModel& base = P->Base;
   std::set<int> fixedVertices;
+  for (std::size_t v = 0; v < base.vertices.size(); ++v)
+  {
+    if (base.vertices[v].fixed) // marked `fixed: true` in the template
+    {
+      fixedVertices.insert(static_cast<int>(v));
+    }
+  }
   for (const std::string& name : fixed)
   {
     const int v = base.findVertex(name);
@@ -490,6 +564,65 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
       Variables.push_back(variable);
     }
   }
+  // Free interior vertices: block vertices placed by position alone (no carrier, no rule
+  // that follows another vertex), on no boundary face and no end of an edge that needs
+  // them where they are (carrier edges, arcs), move in x, y and z. On a periodic face only
+  // a source moves (its image follows); bounds keep it within 45 % of the way to its
+  // nearest block-edge neighbour.
+  std::vector<char> onPeriodic(vertexCount, 0);
+  for (int f : periodicFaces)
+  {
+    for (int v : topology.faces[f].ownerIds)
+    {
+      onPeriodic[v] = 1;
+    }
+  }
+  std::vector<char> edgeEnd(vertexCount, 0);
+  for (const model::Edge& edge : base.edges)
+  {
+    if (edge.kind != model::Edge::Kind::Line && edge.kind != model::Edge::Kind::Spline &&
+      edge.kind != model::Edge::Kind::Follow)
+    {
+      edgeEnd[edge.from] = edgeEnd[edge.to] = 1;
+    }
+  }
+  for (int v = 0; v < vertexCount; ++v)
+  {
+    const model::Vertex& vertex = base.vertices[v];
+    if (!inBlock[v] || fixedVertices.count(v) || vertex.rule.kind != model::VertexRule::Kind::Fixed ||
+      vertex.constraint.carrier >= 0 || vertex.constraint.periodicSource >= 0 ||
+      !boundaryOf[v].empty() || edgeEnd[v] || neighbours[v].empty())
+    {
+      continue;
+    }
+    if (onPeriodic[v] &&
+      std::none_of(dependents[v].begin(), dependents[v].end(), [&](int w) {
+        return base.vertices[w].rule.kind == model::VertexRule::Kind::Periodic;
+      }))
+    {
+      continue; // a periodic image placed by position: moving it alone breaks periodicity
+    }
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int w : neighbours[v])
+    {
+      nearest = std::min(nearest, (base.vertices[w].position - vertex.position).norm());
+    }
+    if (!(nearest > 0.0) || !std::isfinite(nearest))
+    {
+      continue;
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      ControlVariable variable;
+      variable.vertex = v;
+      variable.component = 2 + c;
+      variable.start = vertex.position[c];
+      variable.low = variable.start - movingNeighbourShare * nearest;
+      variable.high = variable.start + movingNeighbourShare * nearest;
+      variable.name = vertex.name + "." + "xyz"[c];
+      Variables.push_back(variable);
+    }
+  }
   // Vertices fixed above (surface curve points under other carriers) drop out.
   Variables.erase(std::remove_if(Variables.begin(), Variables.end(),
                     [&](const ControlVariable& v) { return fixedVertices.count(v.vertex) > 0; }),
@@ -535,6 +668,11 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
   try
   {
     const model::Feasibility feasibility = P->place(x);
+    P->forgetUpdated();
+    if (P->Objective.kind != ObjectiveKind::NonOrthogonality && feasibility.feasible())
+    {
+      return P->measureChanged();
+    }
     if (!feasibility.feasible())
     {
       GridMeasures failed;
@@ -559,6 +697,7 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
   {
     // The input model itself fails the mesher's check: nothing to evaluate.
     P->Plan.reset();
+    P->forgetUpdated();
     GridMeasures failed;
     failed.invertedCells = 1;
     failed.objective = infeasibleObjective(1);
@@ -570,6 +709,7 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
 BlockModel ControlProblem::modelAt(const std::vector<double>& x)
 {
   P->place(x);
+  P->forgetUpdated();
   return P->Plan->model();
 }
 
@@ -580,7 +720,7 @@ std::vector<Vec3> ControlProblem::verticesAt(const std::vector<double>& x) const
   std::vector<int> moved;
   for (std::size_t i = 0; i < Variables.size(); ++i)
   {
-    setParameter(work, geometry, Variables[i].vertex, Variables[i].component, x[i]);
+    setVariable(work, geometry, Variables[i], x[i]);
     moved.push_back(Variables[i].vertex);
   }
   model::applyPlacement(work, geometry, moved);
@@ -595,6 +735,7 @@ std::vector<Vec3> ControlProblem::verticesAt(const std::vector<double>& x) const
 std::vector<std::vector<double>> ControlProblem::gridAt(const std::vector<double>& x)
 {
   const model::Feasibility feasibility = P->place(x);
+  P->forgetUpdated();
   if (!feasibility.feasible())
   {
     throw std::runtime_error(feasibility.message);

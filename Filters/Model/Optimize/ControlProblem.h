@@ -5,8 +5,10 @@
  * configuration.
  *
  * Variables are the free parameters of the placement rules (Placement.h): s of a control
- * point on a curve, (s, t) on a surface. A parameter is left out when
- * - its vertex is fixed by name (FixedControlPoints, or moved by hand);
+ * point on a curve, (s, t) on a surface, and (x, y, z) of a free interior vertex (a block
+ * vertex placed by position, on no boundary face). A parameter is left out when
+ * - its vertex is fixed by name (FixedControlPoints, or moved by hand) or marked
+ *   `fixed: true` in the template;
  * - moving it moves no block vertex (directly or through the vertices that follow it);
  * - moving it would change the domain's boundary: a moved vertex (itself or a follower)
  *   on a boundary face leaves that face's surface carrier or, for faces without one,
@@ -37,13 +39,14 @@ namespace blockforge
 {
 namespace optimize
 {
-/// One free parameter: component 0 (s) or 1 (t) of control point `vertex`.
+/// One free parameter: component 0 (s) or 1 (t) of control point `vertex`, or component
+/// 2, 3, 4 (x, y, z) of the position of a free interior vertex.
 struct ControlVariable
 {
   int vertex = -1;
   int component = 0;
   double start = 0.0, low = 0.0, high = 1.0;
-  std::string name; ///< "vertex.s" or "vertex.t"
+  std::string name; ///< "vertex.s", "vertex.t", or "vertex.x", "vertex.y", "vertex.z"
 };
 
 /// A manual move: the control point's new parameters (s on a curve, s and t on a surface).

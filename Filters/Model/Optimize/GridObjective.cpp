@@ -319,6 +319,34 @@ double infeasibleObjective(long long invertedCells)
   return 1.0e4 + static_cast<double>(invertedCells);
 }
 
+GridMeasures measureAngles(const std::vector<const BlockAngles*>& blocks, double maxSizeRatio,
+  const ObjectiveSettings& settings)
+{
+  GridMeasures measures;
+  measures.feasible = true;
+  std::vector<double> angles;
+  for (const BlockAngles* block : blocks)
+  {
+    angles.insert(angles.end(), block->cellMinimum().begin(), block->cellMinimum().end());
+  }
+  measures.minAngle = angles.empty() ? 0.0 : *std::min_element(angles.begin(), angles.end());
+  double sum = 0.0;
+  for (const BlockAngles* block : blocks) // block order: the same sum bit for bit
+  {
+    sum += block->cornerSum(measures.minAngle, settings.angleSharpness);
+  }
+  measures.softMinAngle =
+    sum > 0.0 ? measures.minAngle - std::log(sum) / settings.angleSharpness : measures.minAngle;
+  measures.classes = minAngleClasses(angles.data(), angles.size());
+  measures.objective = -measures.softMinAngle;
+  if (settings.kind == ObjectiveKind::MinAngleAndSizeRatio)
+  {
+    measures.maxSizeRatio = maxSizeRatio;
+    measures.objective += settings.sizeRatioWeight * (maxSizeRatio - 1.0);
+  }
+  return measures;
+}
+
 GridMeasures measureGrid(const std::vector<BlockGrid>& blocks,
   const std::vector<PeriodicSideLink>& periodic, const ObjectiveSettings& settings)
 {
@@ -334,37 +362,24 @@ GridMeasures measureGrid(const std::vector<BlockGrid>& blocks,
     measures.objective = infeasibleObjective(measures.invertedCells);
     return measures;
   }
-  measures.feasible = true;
   std::vector<BlockAngles> fields;
   fields.reserve(blocks.size());
-  std::vector<double> angles;
+  std::vector<const BlockAngles*> pointers;
+  double maxSizeRatio = 1.0;
   for (const BlockGrid& grid : blocks)
   {
     fields.emplace_back(grid);
-    angles.insert(angles.end(), fields.back().cellMinimum().begin(),
-      fields.back().cellMinimum().end());
+    pointers.push_back(&fields.back());
+    if (settings.kind == ObjectiveKind::MinAngleAndSizeRatio)
+    {
+      maxSizeRatio = std::max(maxSizeRatio, maxNeighbourSizeRatio(grid));
+    }
   }
-  measures.minAngle = angles.empty() ? 0.0 : *std::min_element(angles.begin(), angles.end());
-  double sum = 0.0;
-  for (const BlockAngles& field : fields) // block order: the same sum bit for bit
-  {
-    sum += field.cornerSum(measures.minAngle, settings.angleSharpness);
-  }
-  measures.softMinAngle =
-    sum > 0.0 ? measures.minAngle - std::log(sum) / settings.angleSharpness : measures.minAngle;
-  measures.classes = minAngleClasses(angles.data(), angles.size());
+  measures = measureAngles(pointers, maxSizeRatio, settings);
   switch (settings.kind)
   {
     case ObjectiveKind::MinAngle:
-      measures.objective = -measures.softMinAngle;
-      break;
     case ObjectiveKind::MinAngleAndSizeRatio:
-      for (const BlockGrid& grid : blocks)
-      {
-        measures.maxSizeRatio = std::max(measures.maxSizeRatio, maxNeighbourSizeRatio(grid));
-      }
-      measures.objective =
-        -measures.softMinAngle + settings.sizeRatioWeight * (measures.maxSizeRatio - 1.0);
       break;
     case ObjectiveKind::NonOrthogonality:
     {

@@ -120,6 +120,15 @@ double infeasibleObjective(long long invertedCells);
 GridMeasures measureGrid(const std::vector<BlockGrid>& blocks,
   const std::vector<PeriodicSideLink>& periodic, const ObjectiveSettings& settings);
 
+/**
+ * The angle objectives (MinAngle, MinAngleAndSizeRatio with the grid's largest neighbour
+ * size ratio `maxSizeRatio`) of a feasible grid from the angles of its blocks, in block
+ * order: what measureGrid gives, bit for bit, so an optimizer may keep the angles of the
+ * blocks a step did not change.
+ */
+GridMeasures measureAngles(const std::vector<const BlockAngles*>& blocks, double maxSizeRatio,
+  const ObjectiveSettings& settings);
+
 /// Whether `candidate` is no worse than `reference` by the objective's own criterion
 /// (smallest angle for the angle objectives, largest non-orthogonality otherwise).
 bool notWorse(const GridMeasures& candidate, const GridMeasures& reference, ObjectiveKind kind);

@@ -26,6 +26,23 @@ double nodeCount(const model::BlockModel& model, double density)
   }
   return nodes;
 }
+
+/// Node counts of every block at density multiplier `density` (for the memory check; the
+/// density is valid, checkDensityMultiplier, so every count fits an int).
+model::BlockNodeCounts nodeCounts(const model::BlockModel& model, double density)
+{
+  model::BlockNodeCounts counts;
+  for (const model::Block& block : model.blocks)
+  {
+    std::array<int, 3> n{};
+    for (int d = 0; d < 3; ++d)
+    {
+      n[d] = static_cast<int>(std::max(1.0, std::round(block.cells[d] * density))) + 1;
+    }
+    counts.push_back(n);
+  }
+  return counts;
+}
 } // namespace
 
 double measuredDensity(const model::BlockModel& model, double densityMultiplier)
@@ -44,6 +61,8 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
   // The mesher's rules for the density (errors, not clamps): a density it would refuse is
   // refused here too, before any work.
   model::checkDensityMultiplier(model, requested.densityMultiplier);
+  model::checkGridMemory(nodeCounts(model, requested.densityMultiplier),
+    requested.maximumMemory, "lower the density multiplier or the cell counts");
   OptimizerSettings settings = requested;
   settings.densityMultiplier = measuredDensity(model, requested.densityMultiplier);
   OptimizerResult result;
