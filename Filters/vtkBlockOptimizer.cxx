@@ -231,6 +231,15 @@ int vtkBlockOptimizer::RequestData(
       vtkWarningMacro(<< "The optimized model still cannot be meshed without inverted cells: "
                       << result.after.failure);
     }
+    if (result.keptStep < 1.0)
+    {
+      vtkWarningMacro(<< "The optimizer measured a coarsened copy (density "
+                      << result.densityMultiplier << "); at DensityMultiplier "
+                      << this->DensityMultiplier << " its best model folds or is worse than the start, so "
+                      << (result.keptStep > 0.0 ? "part of its move was kept ("
+                                                : "the template's model is kept (")
+                      << result.keptStep << " of the way)");
+    }
     // For the GUI: the points a move can take, and where the handle's point is now.
     this->ControlPointNames->Initialize();
     for (const blockforge::model::Vertex& vertex : result.model.vertices)
@@ -250,9 +259,25 @@ int vtkBlockOptimizer::RequestData(
     }
     this->LocatedControlPoint = handle >= 0 ? this->HandleControlPoint : "";
     const std::string moved = blockforge::model::writeModelDocument(result.model);
-    blockforge::vtkglue::meshModel(result.model, moved, 1.0, this->PreviewCells, piece,
-      pieceCount, output, [this](double fraction) { this->UpdateProgress(0.9 + 0.1 * fraction); },
-      &geometry, blockforge::vtkglue::InvertedCellPolicy::Skip);
+    try
+    {
+      blockforge::vtkglue::meshModel(result.model, moved, 1.0, this->PreviewCells, piece,
+        pieceCount, output,
+        [this](double fraction) { this->UpdateProgress(0.9 + 0.1 * fraction); }, &geometry,
+        blockforge::vtkglue::InvertedCellPolicy::Skip);
+    }
+    catch (const std::exception& previewError)
+    {
+      // The model was optimized (and is feasible) at DensityMultiplier; the coarse preview
+      // has other first cells and may fold where the real grid does not. The model still
+      // goes downstream: the mesher checks it at the density it meshes.
+      vtkWarningMacro(<< "The preview of the optimized model (at most " << this->PreviewCells
+                      << " cells per edge) cannot be drawn, the model is passed on without it: "
+                      << blockforge::vtkglue::printable(previewError.what()));
+      vtkNew<vtkMultiBlockDataSet> modelOnly;
+      blockforge::vtkglue::attachModel(modelOnly->GetFieldData(), moved);
+      output->ShallowCopy(modelOnly);
+    }
     vtkFieldData* fields = output->GetFieldData();
     fields->AddArray(classArray("MinAngleClassCountsBefore", result.before));
     fields->AddArray(classArray("MinAngleClassCountsAfter", result.after));

@@ -488,6 +488,24 @@ class OptimizerTest(unittest.TestCase):
         self.assertAlmostEqual(placed, math.degrees(math.atan2(1.0, 0.4)), places=9)
         self.assertGreater(optimized, 89.9)
 
+    def test_blade_row_at_other_densities(self):
+        # The optimized model meshes at every density asked for: at 0.5 its coarse preview
+        # (PreviewCells per edge) folds where the real grid does not, which must not stop
+        # the pipeline; at 4 the optimizer measures a coarsened copy (above 1e5 nodes) and
+        # steps back towards the start until the real grid is valid and no worse.
+        template = os.path.join(SOURCE, "Templates", "axial_passage_h.yaml")
+        for density in (0.5, 4.0):
+            warnings = []
+            placed = self.min_angle(blockforge.mesh_template(
+                template, density_multiplier=density, input_file=ROTOR37_INF, optimize=False))
+            optimized = self.min_angle(blockforge._run_pipeline(
+                template, density_multiplier=density, input_file=ROTOR37_INF,
+                warnings=warnings))
+            self.assertGreaterEqual(optimized, placed, density)
+            if density == 0.5:
+                self.assertTrue(any("preview" in w for w in warnings), warnings)
+                self.assertGreater(optimized, placed + 3.0)
+
     def test_command_line_switch(self):
         for arguments, expected in (((), "optimize"), (("--no-optimize",), None)):
             out, err = io.StringIO(), io.StringIO()

@@ -103,6 +103,45 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
   {
     result.before = result.search.start;
   }
+  if (settings.densityMultiplier != requested.densityMultiplier && result.after.feasible)
+  {
+    // The search measured a coarsened copy, whose first cells differ from the grid the
+    // mesher will make: that grid must be valid and no worse than the start's at the
+    // requested density. Otherwise step back towards the start (halving the step); the
+    // start itself is what the template gave.
+    ControlProblem fine(
+      result.model, geometry, requested.densityMultiplier, settings.objective, fixed);
+    const std::vector<double> start = problem.start();
+    const std::vector<double> best = result.search.best;
+    const GridMeasures fineStart = fine.evaluate(start);
+    std::vector<double> x = best;
+    double step = 1.0;
+    for (;;)
+    {
+      const GridMeasures measured = fine.evaluate(x);
+      if (measured.feasible &&
+        (!fineStart.feasible || notWorse(measured, fineStart, settings.objective.kind)))
+      {
+        break;
+      }
+      step *= 0.5;
+      if (step < 1.0 / 64.0)
+      {
+        x = start;
+        break;
+      }
+      for (std::size_t i = 0; i < x.size(); ++i)
+      {
+        x[i] = start[i] + step * (best[i] - start[i]);
+      }
+    }
+    if (x != best)
+    {
+      result.search.best = x;
+      result.after = problem.evaluate(x);
+      result.keptStep = x == start ? 0.0 : step;
+    }
+  }
   const model::BlockModel moved = result.model;
   result.model = problem.modelAt(result.search.best);
   // Surface curves drawn through points that moved are drawn again in `geometry`.

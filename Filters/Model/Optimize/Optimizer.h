@@ -52,6 +52,9 @@ struct OptimizerResult
   std::vector<ControlVariable> variables;
   std::vector<std::string> boundaryLocked;
   double densityMultiplier = 1.0;    ///< the density the objective was measured at
+  /// Fraction of the search's move kept so that the grid at the requested density (not
+  /// only the coarsened copy measured) is valid: 1 = all of it, 0 = the start.
+  double keptStep = 1.0;
 };
 
 /**
