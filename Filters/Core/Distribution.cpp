@@ -526,6 +526,9 @@ std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
     case DistributionLaw::Kind::Match:
       return matchedNodes(law.firstCellSize, law.lastCellSize, edgeLength, nodeCount,
         law.expansionRatio);
+    case DistributionLaw::Kind::ProjectFrom:
+      throw GeometryError("the nodes of a project_from edge are the projections of another "
+                          "edge's nodes, which only the mesher knows");
   }
   throw GeometryError("unknown distribution law");
 }

@@ -22,10 +22,14 @@ struct DistributionLaw
     TwoSided,  ///< cells grow by ExpansionRatio from both ends towards the middle
     FirstCell, ///< first cell of FirstCellSize, growing by at most ExpansionRatio
     Ends,      ///< first and last cells FirstCellSize and LastCellSize times the mean cell
-    Match      ///< first and last cells of given lengths (FirstCellSize, LastCellSize; 0:
+    Match,     ///< first and last cells of given lengths (FirstCellSize, LastCellSize; 0:
                ///< free), cells growing from both ends by ExpansionRatio up to a uniform
                ///< middle; the mesher sets the end lengths to those of the cells continuing
                ///< the edge across block interfaces
+    ProjectFrom ///< the nodes are the closest points on this edge of the nodes of another
+                ///< edge (SourceEdge, an index the model layer gives meaning to): on a curve
+                ///< offset from that edge's, the normal offsets of its nodes. Placed by the
+                ///< mesher; distributeNodes has no nodes for it.
   };
   Kind kind = Kind::Uniform;
   /// Geometric/TwoSided: ratio of successive cell sizes (k in eq. 7, > 0).
@@ -44,11 +48,14 @@ struct DistributionLaw
   /// cells match at one density match at all.
   /// Match: length of the last cell (0: free).
   double lastCellSize = 0.0;
+  /// ProjectFrom: the edge whose nodes are projected (the model's named edge index).
+  int sourceEdge = -1;
 
   bool operator==(const DistributionLaw& o) const
   {
     return kind == o.kind && expansionRatio == o.expansionRatio &&
-      firstCellSize == o.firstCellSize && lastCellSize == o.lastCellSize;
+      firstCellSize == o.firstCellSize && lastCellSize == o.lastCellSize &&
+      sourceEdge == o.sourceEdge;
   }
   bool operator!=(const DistributionLaw& o) const { return !(*this == o); }
 };
@@ -58,7 +65,8 @@ struct DistributionLaw
  * (>= 2) on an edge of length `edgeLength` (used only by FirstCell). Throws
  * GeometryError when the law cannot be met (non-positive ratio, first cell too large
  * or too small for the edge with the given ratio, a cell below 1e-12 of the edge, whose
- * nodes would coincide once placed), the message says why in user terms.
+ * nodes would coincide once placed; a ProjectFrom law, whose nodes come from another
+ * edge), the message says why in user terms.
  */
 std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
   double edgeLength = 1.0);

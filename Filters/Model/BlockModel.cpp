@@ -130,6 +130,18 @@ int BlockModel::findEdge(int a, int b) const
   return -1;
 }
 
+int BlockModel::findNamedEdge(const std::string& edgeName) const
+{
+  for (std::size_t i = 0; i < edges.size(); ++i)
+  {
+    if (edges[i].name == edgeName)
+    {
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
 namespace
 {
 const char* const FaceNames[6] = { "i0", "i1", "j0", "j1", "k0", "k1" };

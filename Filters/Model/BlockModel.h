@@ -326,6 +326,8 @@ struct BlockModel
   int requiredFormat() const;
   /// Index into `edges` of the edge joining a and b in either direction, -1 if straight.
   int findEdge(int a, int b) const;
+  /// Index into `edges` of the edge called `name`, -1 if absent.
+  int findNamedEdge(const std::string& name) const;
 };
 
 /// Face index names used in templates and messages: "i0", "i1", "j0", "j1", "k0", "k1".

@@ -216,6 +216,10 @@ std::vector<int> matchEdgeEnds(const BlockModel& model, MeshTopology& topology)
     for (const int key : group)
     {
       const UniqueEdge& edge = topology.edges[key / 2];
+      if (edge.projectedAfterMatch)
+      {
+        continue; // its nodes come from a matched edge, after these
+      }
       if (!edge.matched)
       {
         gradedLogs += std::log(std::max(endCell(edge, key % 2), 1e-300));

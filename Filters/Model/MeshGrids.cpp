@@ -43,8 +43,9 @@ std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int c
  * the node parameters of every edge, checked on shared edges: the same laws must put the
  * nodes at the same places.
  */
-MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedCurve>& curves,
-  const std::vector<std::array<int, 3>>& nodes, bool allowFallback)
+MeshTopology buildMeshTopology(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::vector<NamedCurve>& curves, const std::vector<std::array<int, 3>>& nodes,
+  bool allowFallback)
 {
   MeshTopology topology;
   topology.connectivity = buildConnectivity(model, nodes);
@@ -69,26 +70,11 @@ MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedC
     static_cast<BlockLinks&>(mesh) = links;
     topology.blocks.push_back(std::move(mesh));
   }
-  // graded edges first: matched edges take their end cells from them
+  // graded edges first: matched edges take their end cells from them, projected edges
+  // their nodes
   buildMatchGroups(model, topology);
-  for (std::size_t e = 0; e < topology.edges.size(); ++e)
-  {
-    if (!topology.edges[e].matched)
-    {
-      computeEdgeParameters(model, topology, static_cast<int>(e), allowFallback);
-    }
-  }
-  if (!topology.matchGroups.empty())
-  {
-    matchEdgeEnds(model, topology);
-  }
-  for (std::size_t e = 0; e < topology.edges.size(); ++e)
-  {
-    if (topology.edges[e].matched)
-    {
-      computeEdgeParameters(model, topology, static_cast<int>(e), allowFallback);
-    }
-  }
+  buildProjections(model, topology);
+  computeEdgeGrading(model, curves, geometry, topology, nullptr, allowFallback);
   for (int b = 0; b < static_cast<int>(model.blocks.size()); ++b)
   {
     computeCollapsedParameters(model, topology, b);
@@ -311,51 +297,54 @@ void faceFromEdges(const BlockModel& model, const MeshTopology& topology, int bl
 void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& curves,
   const CarrierGeometry& geometry, UniqueEdge& edge)
 {
-  const Vec3& start = model.vertices[edge.a].position;
-  const Vec3& end = model.vertices[edge.b].position;
   const int n = edge.nodeCount;
   edge.xyz.resize(3 * n);
-  const NamedCurve* named = edge.named >= 0 ? &curves[edge.named] : nullptr;
-  if (named && model.edges[edge.named].kind == Edge::Kind::Periodic)
+  if (edge.named >= 0 && model.edges[edge.named].kind == Edge::Kind::Periodic)
   {
     return; // rotated from its source edge afterwards
   }
-  // The named edge may run b -> a; its curve is evaluated at the mirrored fraction.
-  const bool curveReversed = named && model.edges[edge.named].from != edge.a;
   for (int i = 0; i < n; ++i)
   {
-    Vec3 point;
-    if (i == 0)
-    {
-      point = start; // end nodes are the vertices themselves, bit for bit
-    }
-    else if (i == n - 1)
-    {
-      point = end;
-    }
-    else if (!named || model.edges[edge.named].kind == Edge::Kind::Line ||
-      model.edges[edge.named].kind == Edge::Kind::Project)
-    {
-      point = (1.0 - edge.params[i]) * start + edge.params[i] * end;
-      if (named && named->projectOnto >= 0)
-      {
-        double s = 0.0, t = 0.0, distance = 0.0;
-        geometry.project(named->projectOnto, point, s, t, distance);
-        point = geometry.point(named->projectOnto, s, t);
-      }
-    }
-    else
-    {
-      const double fraction = curveReversed ? 1.0 - edge.params[i] : edge.params[i];
-      const double t =
-        named->lengthTable ? named->lengthTable->parameterAtFraction(fraction) : fraction;
-      point = named->curve->point(t);
-    }
+    const Vec3 point = edgeNodePoint(model, curves, geometry, edge, i);
     for (int c = 0; c < 3; ++c)
     {
       edge.xyz[3 * i + c] = point[c];
     }
   }
+}
+
+Vec3 edgeNodePoint(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const CarrierGeometry& geometry, const UniqueEdge& edge, int i)
+{
+  const Vec3& start = model.vertices[edge.a].position;
+  const Vec3& end = model.vertices[edge.b].position;
+  if (i == 0)
+  {
+    return start; // end nodes are the vertices themselves, bit for bit
+  }
+  if (i == edge.nodeCount - 1)
+  {
+    return end;
+  }
+  const NamedCurve* named = edge.named >= 0 ? &curves[edge.named] : nullptr;
+  if (!named || model.edges[edge.named].kind == Edge::Kind::Line ||
+    model.edges[edge.named].kind == Edge::Kind::Project)
+  {
+    Vec3 point = (1.0 - edge.params[i]) * start + edge.params[i] * end;
+    if (named && named->projectOnto >= 0)
+    {
+      double s = 0.0, t = 0.0, distance = 0.0;
+      geometry.project(named->projectOnto, point, s, t, distance);
+      point = geometry.point(named->projectOnto, s, t);
+    }
+    return point;
+  }
+  // The named edge may run b -> a; its curve is evaluated at the mirrored fraction.
+  const bool curveReversed = model.edges[edge.named].from != edge.a;
+  const double fraction = curveReversed ? 1.0 - edge.params[i] : edge.params[i];
+  const double t =
+    named->lengthTable ? named->lengthTable->parameterAtFraction(fraction) : fraction;
+  return named->curve->point(t);
 }
 
 std::map<std::pair<int, int>, int> edgeLookup(const MeshTopology& topology)

@@ -99,6 +99,11 @@ struct UniqueEdge : TopologyEdge
   bool matched = false;
   double matchRatio = DefaultMatchRatio;
   double matchFirst = 0.0, matchLast = 0.0;
+  /// Law `project_from` in its blocks: the unique edge whose nodes are projected onto this
+  /// one (-1: none), and whether that edge's nodes come after the matched edges' (a chain
+  /// of projections from a matched edge).
+  int projectedFrom = -1;
+  bool projectedAfterMatch = false;
   std::vector<double> params;
   std::vector<double> xyz;
 };
@@ -126,14 +131,17 @@ struct MeshTopology
   std::vector<std::vector<int>> matchGroups;
   /// (image, source) edge ends of periodic faces: the image end takes the source's cell.
   std::vector<std::pair<int, int>> matchCopies;
+  /// Projected unique edges, each after the edge it projects from.
+  std::vector<int> projectionOrder;
 };
 
 /// Node counts of a block at a density multiplier (max(1, round(cells * m)) cells per
 /// direction, at most `cap` when cap > 0), plus one.
 std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int cap);
 
-MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedCurve>& curves,
-  const std::vector<std::array<int, 3>>& nodes, bool allowFallback);
+MeshTopology buildMeshTopology(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::vector<NamedCurve>& curves, const std::vector<std::array<int, 3>>& nodes,
+  bool allowFallback);
 /// Node parameters of unique edge `e` from the laws of the blocks that use it (checked to
 /// agree), with its current length.
 void computeEdgeParameters(const BlockModel& model, MeshTopology& topology, int e, bool allowFallback);
@@ -154,6 +162,31 @@ void buildMatchGroups(const BlockModel& model, MeshTopology& topology);
  * edges whose end lengths changed.
  */
 std::vector<int> matchEdgeEnds(const BlockModel& model, MeshTopology& topology);
+/**
+ * Marks the edges whose law is `project_from` (all their blocks must say so, naming the
+ * same edge) with the unique edge they project from, and orders them sources first: a
+ * cycle, a source used by no block or a periodic source is a TemplateError naming the
+ * edges. After buildMatchGroups (a chain from a matched edge comes after the matched
+ * edges).
+ */
+void buildProjections(const BlockModel& model, MeshTopology& topology);
+/**
+ * Node parameters of projected edge `e`: the closest points on its curve of the interior
+ * nodes of the edge it projects from (whose parameters must be current), as arc-length
+ * fractions; fails naming both edges when their cell counts differ or the projections are
+ * not in order along the edge.
+ */
+void projectEdgeParameters(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const CarrierGeometry& geometry, MeshTopology& topology, int e);
+/**
+ * Node parameters of the unique edges marked in `changed` (all when null) and of those
+ * that depend on them, in dependency order: graded edges, edges projected from them,
+ * matched edges (matchEdgeEnds), edges projected from matched edges. The edges whose
+ * parameters were recomputed because others changed are marked in `changed`.
+ */
+void computeEdgeGrading(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const CarrierGeometry& geometry, MeshTopology& topology, std::vector<char>* changed,
+  bool allowFallback);
 /// Parameters of the collapsed edges of block `b`.
 void computeCollapsedParameters(const BlockModel& model, MeshTopology& topology, int b);
 
@@ -182,6 +215,10 @@ void faceFromEdges(const BlockModel& model, const MeshTopology& topology, int bl
   std::vector<double>& out);
 void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& curves,
   const CarrierGeometry& geometry, UniqueEdge& edge);
+/// Node i of `edge` from its parameters as computeEdgeNodes places it (not for named
+/// periodic edges, whose nodes are rotated copies).
+Vec3 edgeNodePoint(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const CarrierGeometry& geometry, const UniqueEdge& edge, int i);
 std::map<std::pair<int, int>, int> edgeLookup(const MeshTopology& topology);
 int findUniqueEdge(const std::map<std::pair<int, int>, int>& lookup, int a, int b);
 /// A unique edge whose nodes are the rotated nodes of another.

@@ -154,7 +154,7 @@ MeshPlan::MeshPlan(const BlockModel& model, const CarrierGeometry& carriers, dou
     nodes.push_back(scaledNodeCounts(block, densityMultiplier, 0));
   }
   P->AllowFallback = nodes != baseNodeCounts(P->Model);
-  P->Topo = buildMeshTopology(P->Model, P->Curves, nodes, P->AllowFallback);
+  P->Topo = buildMeshTopology(P->Model, P->Geometry, P->Curves, nodes, P->AllowFallback);
   computeAllBoundaries(P->Model, P->Geometry, P->Curves, P->Topo);
   P->Copies = periodicEdgeCopies(P->Model, P->Topo);
   P->OnSurface = surfaceFaceCarriers(P->Model, P->Topo);
@@ -315,29 +315,16 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
     edge.length = edge.named >= 0
       ? Curves[edge.named].length
       : (model.vertices[edge.b].position - model.vertices[edge.a].position).norm();
-    if (!edge.matched)
-    {
-      computeEdgeParameters(model, Topo, static_cast<int>(u), AllowFallback);
-    }
   }
-  // matched edges follow the graded edges and the lengths at their ends
-  if (!Topo.matchGroups.empty())
-  {
-    for (const int u : matchEdgeEnds(model, Topo))
-    {
-      changedEdge[u] = 1;
-    }
-  }
+  // matched edges follow the graded edges and the lengths at their ends, projected edges
+  // the edges they project from
+  computeEdgeGrading(model, Curves, Geometry, Topo, &changedEdge, AllowFallback);
   std::vector<int> nodeEdges;
   for (std::size_t u = 0; u < Topo.edges.size(); ++u)
   {
     if (!changedEdge[u])
     {
       continue;
-    }
-    if (Topo.edges[u].matched)
-    {
-      computeEdgeParameters(model, Topo, static_cast<int>(u), AllowFallback);
     }
     nodeEdges.push_back(static_cast<int>(u));
     for (const int b : EdgeBlocks[u])

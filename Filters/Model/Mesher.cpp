@@ -98,7 +98,7 @@ void MultiBlockMesher::computeBoundaries(const std::vector<int>& blocks)
   const bool everyBlock =
     std::find(P->Meshable.begin(), P->Meshable.end(), 0) == P->Meshable.end();
   const bool countsChanged = nodes != baseNodeCounts(model);
-  P->Topo = buildMeshTopology(model, P->Curves, nodes, countsChanged);
+  P->Topo = buildMeshTopology(model, P->Geometry, P->Curves, nodes, countsChanged);
   computeAllBoundaries(model, P->Geometry, P->Curves, P->Topo, everyBlock ? nullptr : &P->Meshable);
   P->Ready = true;
 }

@@ -199,6 +199,17 @@ void checkBasics(const BlockModel& model)
         fail(block.where, entity("block", block.name), "cells must be at least 1");
       }
     }
+    for (int e = 0; e < 12; ++e)
+    {
+      const DistributionLaw& law = block.laws[e];
+      if (law.kind == DistributionLaw::Kind::ProjectFrom &&
+        (law.sourceEdge < 0 || law.sourceEdge >= static_cast<int>(model.edges.size())))
+      {
+        fail(block.where, entity("block", block.name),
+          "the law project_from of " + syntax::edgeLabel(e) + " refers to edge #" +
+            std::to_string(law.sourceEdge) + ", which does not exist");
+      }
+    }
   }
 }
 
@@ -359,7 +370,7 @@ void checkModelWith(const BlockModel& model, const CarrierGeometry& geometry)
   const double size = modelSize(model);
   checkCarriers(model, geometry, size);
   const std::vector<NamedCurve> curves = buildNamedCurves(model, geometry);
-  MeshTopology topology = buildMeshTopology(model, curves, baseNodeCounts(model), false);
+  MeshTopology topology = buildMeshTopology(model, geometry, curves, baseNodeCounts(model), false);
   checkNamedEdgesUsed(model, topology);
   checkSurfaceFaces(model, geometry, topology, size);
   checkOrientation(model, curves, size);

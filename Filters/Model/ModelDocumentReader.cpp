@@ -585,18 +585,7 @@ private:
     else if (known && (edge.kind == Edge::Kind::Periodic || edge.kind == Edge::Kind::Follow))
     {
       const MapEntry& source = required(keys, "source", node, entityText);
-      const std::string sourceName = text(source.value, source.line, entityText, "source");
-      for (std::size_t e = 0; e < Model.edges.size(); ++e)
-      {
-        if (Model.edges[e].name == sourceName)
-        {
-          edge.source = static_cast<int>(e);
-        }
-      }
-      if (edge.source < 0)
-      {
-        fail(source.line, entityText, "unknown source edge '" + sourceName + "'");
-      }
+      edge.source = edgeRef(source.value, source.line, entityText, "source");
       if (edge.kind == Edge::Kind::Periodic)
       {
         const MapEntry& pitches = required(keys, "pitches", node, entityText);
@@ -648,12 +637,29 @@ private:
                                           const std::string& what) {
       return number(value, line, entityText, what);
     };
+    const syntax::EdgeReader edges = [this, &entityText](const YAML::Node& value, int line,
+                                       const std::string& what) {
+      return edgeRef(value, line, entityText, what);
+    };
     for (int e = 0; e < 12; ++e)
     {
-      block.laws[e] = syntax::parseLaw(
-        laws.value[e], laws.line, entityText, "law " + syntax::edgeLabel(e), reader, Report);
+      block.laws[e] = syntax::parseLaw(laws.value[e], laws.line, entityText,
+        "law " + syntax::edgeLabel(e), reader, Report, edges);
     }
     Model.blocks.push_back(block);
+  }
+
+  /// The named edge called by `node` (read above).
+  int edgeRef(const YAML::Node& node, int line, const std::string& entityText,
+    const std::string& what)
+  {
+    const std::string edgeName = text(node, line, entityText, what);
+    const int index = Model.findNamedEdge(edgeName);
+    if (index < 0)
+    {
+      fail(line, entityText, what + ": unknown edge '" + edgeName + "'");
+    }
+    return index;
   }
 
   void readPatch(const YAML::Node& node)

@@ -360,7 +360,7 @@ std::string writeModelDocument(const BlockModel& model)
     out << YAML::Key << "laws" << YAML::Value << YAML::Flow << YAML::BeginSeq;
     for (const DistributionLaw& law : block.laws)
     {
-      syntax::emitLaw(out, law);
+      syntax::emitLaw(out, law, model);
     }
     out << YAML::EndSeq;
     emitWhere(out, block.where, model);

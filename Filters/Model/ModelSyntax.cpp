@@ -265,11 +265,12 @@ namespace
 {
 const char* const LawSyntax =
   "uniform, {geometric: k}, {two_sided: k}, {first_cell: h, ratio: r}, "
-  "{ends: [a, b]}, match or {match: r}";
+  "{ends: [a, b]}, match, {match: r} or {project_from: edge}";
 }
 
 DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entityText,
-  const std::string& what, const NumberReader& number, const Reporter& reporter)
+  const std::string& what, const NumberReader& number, const Reporter& reporter,
+  const EdgeReader& edges)
 {
   const int here = lineOf(node) ? lineOf(node) : line;
   DistributionLaw law;
@@ -294,8 +295,23 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
   }
   const std::vector<MapEntry> entries = mapEntries(node, here, entityText, what, reporter);
   checkKeys(
-    entries, { "geometric", "two_sided", "first_cell", "ratio", "ends", "match" }, entityText,
-    reporter);
+    entries, { "geometric", "two_sided", "first_cell", "ratio", "ends", "match", "project_from" },
+    entityText, reporter);
+  if (const MapEntry* project = findEntry(entries, "project_from"))
+  {
+    if (entries.size() != 1)
+    {
+      reporter.fail(project->line, entityText, what + ": expected {project_from: edge} alone");
+    }
+    if (!edges)
+    {
+      reporter.fail(project->line, entityText, what + ": project_from names an edge, and "
+        "there are no named edges here");
+    }
+    law.kind = DistributionLaw::Kind::ProjectFrom;
+    law.sourceEdge = edges(project->value, project->line, what + " project_from");
+    return law;
+  }
   if (const MapEntry* match = findEntry(entries, "match"))
   {
     if (entries.size() != 1)
@@ -375,7 +391,7 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
   return law;
 }
 
-void emitLaw(YAML::Emitter& out, const DistributionLaw& law)
+void emitLaw(YAML::Emitter& out, const DistributionLaw& law, const BlockModel& model)
 {
   switch (law.kind)
   {
@@ -406,6 +422,10 @@ void emitLaw(YAML::Emitter& out, const DistributionLaw& law)
       // the end cells are the mesher's, from the neighbour edges: only the ratio is the law's
       out << YAML::Flow << YAML::BeginMap << YAML::Key << "match" << YAML::Value
           << formatNumber(law.expansionRatio) << YAML::EndMap;
+      return;
+    case DistributionLaw::Kind::ProjectFrom:
+      out << YAML::Flow << YAML::BeginMap << YAML::Key << "project_from" << YAML::Value
+          << model.edges.at(law.sourceEdge).name << YAML::EndMap;
       return;
   }
 }

@@ -82,16 +82,23 @@ std::string shortNumber(double value);
 /// Converts a scalar node to a number (a literal or an expression) or fails itself.
 using NumberReader = std::function<double(const YAML::Node& node, int line, const std::string& what)>;
 
+/// Converts a scalar node naming an edge to the index of the model's named edge or fails
+/// itself (unknown names).
+using EdgeReader = std::function<int(const YAML::Node& node, int line, const std::string& what)>;
+
 /**
  * A grading law: `uniform`, `{geometric: k}`, `{two_sided: k}`,
  * `{first_cell: h, ratio: r}` (ratio optional), `{ends: [a, b]}`, `match` or `{match: r}`
- * (end cells from the neighbour edges, growing by r, default DefaultMatchRatio). `what` names the law in messages
- * ("grading j", "grading E9").
+ * (end cells from the neighbour edges, growing by r, default DefaultMatchRatio), or
+ * `{project_from: edge}` (the nodes of that named edge projected onto this one; needs
+ * `edges`). `what` names the law in messages ("grading j", "grading E9").
  */
 DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entity,
-  const std::string& what, const NumberReader& number, const Reporter& reporter);
-/// Writes a law in the syntax parseLaw reads, numbers with formatNumber.
-void emitLaw(YAML::Emitter& out, const DistributionLaw& law);
+  const std::string& what, const NumberReader& number, const Reporter& reporter,
+  const EdgeReader& edges = EdgeReader());
+/// Writes a law in the syntax parseLaw reads, numbers with formatNumber, edges by their
+/// names in `model`.
+void emitLaw(YAML::Emitter& out, const DistributionLaw& law, const BlockModel& model);
 } // namespace syntax
 } // namespace model
 } // namespace blockforge

@@ -94,6 +94,27 @@ double TemplateReader::number(const YAML::Node& node, int line, const std::strin
   }
 }
 
+int TemplateReader::edgeRef(const YAML::Node& node, int line, const std::string& entityText,
+  const std::string& what, const std::string& advice)
+{
+  const std::string edgeName = name(node, line, entityText, what);
+  const int index = Model.findNamedEdge(edgeName);
+  if (index < 0)
+  {
+    std::vector<std::string> names;
+    for (const Edge& other : Model.edges)
+    {
+      names.push_back(other.name);
+    }
+    const std::string suggestion = syntax::closestName(edgeName, names);
+    fail(line, entityText,
+      what + ": unknown edge '" + edgeName + "'" +
+        (suggestion.empty() ? std::string() : " (did you mean '" + suggestion + "'?)") +
+        "; " + advice);
+  }
+  return index;
+}
+
 syntax::NumberReader TemplateReader::numberReader(const std::string& entityText)
 {
   return [this, entityText](const YAML::Node& node, int line, const std::string& what) {
@@ -380,6 +401,13 @@ void TemplateReader::readBlocks()
   }
 }
 
+syntax::EdgeReader TemplateReader::edgeReader(const std::string& entityText)
+{
+  return [this, entityText](const YAML::Node& node, int line, const std::string& what) {
+    return edgeRef(node, line, entityText, what, "name an edge of the edges section");
+  };
+}
+
 void TemplateReader::readGrading(const MapEntry& grading, const std::string& entityText, Block& block)
 {
   const auto keys =
@@ -391,7 +419,7 @@ void TemplateReader::readGrading(const MapEntry& grading, const std::string& ent
     if (const MapEntry* law = syntax::findEntry(keys, direction))
     {
       const DistributionLaw value = syntax::parseLaw(law->value, law->line, entityText,
-        "grading " + direction, numberReader(entityText), Report);
+        "grading " + direction, numberReader(entityText), Report, edgeReader(entityText));
       for (int e = 0; e < 12; ++e)
       {
         if (edgeDirection(e) == d)
@@ -415,7 +443,7 @@ void TemplateReader::readGrading(const MapEntry& grading, const std::string& ent
     {
       const int e = std::stoi(law.key.substr(1)) - 1;
       block.laws[e] = syntax::parseLaw(law.value, law.line, entityText,
-        "grading " + law.key, numberReader(entityText), Report);
+        "grading " + law.key, numberReader(entityText), Report, edgeReader(entityText));
     }
   }
 }
@@ -712,27 +740,8 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
         "a " + kind->key + " edge takes its shape from its source edge, not from 'at'");
     }
     edge.kind = edgeKind;
-    const std::string sourceName = name(kind->value, kind->line, entityText, kind->key);
-    for (std::size_t e = 0; e < Model.edges.size(); ++e)
-    {
-      if (Model.edges[e].name == sourceName)
-      {
-        edge.source = static_cast<int>(e);
-      }
-    }
-    if (edge.source < 0)
-    {
-      std::vector<std::string> names;
-      for (const Edge& other : Model.edges)
-      {
-        names.push_back(other.name);
-      }
-      const std::string suggestion = syntax::closestName(sourceName, names);
-      fail(kind->line, entityText,
-        kind->key + ": unknown edge '" + sourceName + "'" +
-          (suggestion.empty() ? std::string() : " (did you mean '" + suggestion + "'?)") +
-          "; the source edge must be defined above this one");
-    }
+    edge.source = edgeRef(
+      kind->value, kind->line, entityText, kind->key, "the source edge must be defined above this one");
   }
   if (edgeKind == Edge::Kind::Periodic)
   {

@@ -120,6 +120,7 @@ private:
     const std::string& what);
 
   syntax::NumberReader numberReader(const std::string& entityText);
+  syntax::EdgeReader edgeReader(const std::string& entityText);
 
   Vec3 vector3(const YAML::Node& node, int line, const std::string& entityText,
     const std::string& what);
@@ -130,6 +131,11 @@ private:
   std::vector<std::string> vertexNames() const;
 
   int vertexRef(const YAML::Node& node, int line, const std::string& entityText);
+
+  /// The named edge called by `node` (`what` names the reference in messages, `advice`
+  /// ends the message for an unknown name).
+  int edgeRef(const YAML::Node& node, int line, const std::string& entityText,
+    const std::string& what, const std::string& advice);
 
   void checkEntityName(const MapEntry& entry, const std::string& kind);
 

@@ -1,0 +1,269 @@
+// Projected edges (grading law `project_from`): an edge whose interior nodes are the
+// closest points on its own curve of the interior nodes of another edge. On a curve that
+// is a normal offset of the other edge's curve (an O-grid's outer boundary offset from the
+// blade) these are exactly the normal offsets of its nodes, so the lines joining
+// corresponding nodes are normal to both curves however the nodes are graded: arc-length
+// nodes on the two curves drift apart where the curvature changes, and with cells
+// clustered there that drift shears a thin layer inside out.
+//
+// Also the order in which the mesher computes the node parameters of all edges: graded
+// edges, edges projected from them, matched edges (their end cells from the graded and
+// projected ones), then edges projected from matched edges.
+#include "MeshInternals.h"
+
+#include "../Core/Projection.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace blockforge
+{
+namespace model
+{
+using syntax::entity;
+using syntax::shortNumber;
+
+namespace
+{
+const DistributionLaw& useLaw(const BlockModel& model, const EdgeUse& use)
+{
+  return model.blocks[use.block].laws[use.localEdge];
+}
+
+[[noreturn]] void failOnUse(const BlockModel& model, const EdgeUse& use, const std::string& what)
+{
+  fail(model.blocks[use.block].where, blockEntity(model, use.block), what);
+}
+
+std::string uniqueEdgeText(const BlockModel& model, const UniqueEdge& edge)
+{
+  return "edge " + edgeText(model, edge.a, edge.b);
+}
+
+/// The named edge every use of `edge` projects from, -1 when none does; fails when some
+/// uses do and others do not, or name different edges.
+int projectedSource(const BlockModel& model, const UniqueEdge& edge)
+{
+  const EdgeUse* projecting = nullptr;
+  for (const EdgeUse& use : edge.uses)
+  {
+    if (useLaw(model, use).kind == DistributionLaw::Kind::ProjectFrom)
+    {
+      projecting = &use;
+      break;
+    }
+  }
+  if (!projecting)
+  {
+    return -1;
+  }
+  const int source = useLaw(model, *projecting).sourceEdge;
+  for (const EdgeUse& use : edge.uses)
+  {
+    const DistributionLaw& law = useLaw(model, use);
+    if (law.kind != DistributionLaw::Kind::ProjectFrom || law.sourceEdge != source)
+    {
+      failOnUse(model, use,
+        uniqueEdgeText(model, edge) + " (" + syntax::edgeLabel(use.localEdge) +
+          ") takes its nodes from edge '" + model.edges[source].name + "' in block '" +
+          model.blocks[projecting->block].name + "': give it the same law {project_from: " +
+          model.edges[source].name + "} here");
+    }
+  }
+  return source;
+}
+} // namespace
+
+void buildProjections(const BlockModel& model, MeshTopology& topology)
+{
+  topology.projectionOrder.clear();
+  std::vector<int> namedUnique(model.edges.size(), -1);
+  for (std::size_t u = 0; u < topology.edges.size(); ++u)
+  {
+    if (topology.edges[u].named >= 0)
+    {
+      namedUnique[topology.edges[u].named] = static_cast<int>(u);
+    }
+  }
+  bool any = false;
+  for (UniqueEdge& edge : topology.edges)
+  {
+    edge.projectedFrom = -1;
+    edge.projectedAfterMatch = false;
+    const int source = projectedSource(model, edge);
+    if (source < 0)
+    {
+      continue;
+    }
+    any = true;
+    const EdgeUse& use = edge.uses.front();
+    const Edge& sourceEdge = model.edges[source];
+    if (namedUnique[source] < 0)
+    {
+      failOnUse(model, use,
+        uniqueEdgeText(model, edge) + ": project_from: edge '" + sourceEdge.name +
+          "' is not an edge of any block");
+    }
+    if (sourceEdge.kind == Edge::Kind::Periodic)
+    {
+      failOnUse(model, use,
+        uniqueEdgeText(model, edge) + ": project_from: edge '" + sourceEdge.name +
+          "' is a periodic copy; project from the edge it copies");
+    }
+    if (edge.named >= 0 &&
+      (model.edges[edge.named].kind == Edge::Kind::Periodic ||
+        model.edges[edge.named].kind == Edge::Kind::Project))
+    {
+      failOnUse(model, use,
+        uniqueEdgeText(model, edge) + ": project_from needs an edge with a curve of its own "
+          "(line, arc, spline, on_curve, on_surface or follow), not a " +
+          edgeKindNames()[static_cast<int>(model.edges[edge.named].kind)] + " edge");
+    }
+    edge.projectedFrom = namedUnique[source];
+  }
+  if (!any)
+  {
+    return;
+  }
+  // Sources first (depth-first); a chain that comes back to itself is a cycle.
+  std::vector<char> state(topology.edges.size(), 0); // 1: on the chain, 2: ordered
+  for (std::size_t start = 0; start < topology.edges.size(); ++start)
+  {
+    if (topology.edges[start].projectedFrom < 0 || state[start] == 2)
+    {
+      continue;
+    }
+    std::vector<int> chain;
+    int u = static_cast<int>(start);
+    while (u >= 0 && topology.edges[u].projectedFrom >= 0 && state[u] == 0)
+    {
+      state[u] = 1;
+      chain.push_back(u);
+      u = topology.edges[u].projectedFrom;
+    }
+    if (u >= 0 && state[u] == 1)
+    {
+      std::string names;
+      const auto first = std::find(chain.begin(), chain.end(), u);
+      for (auto it = first; it != chain.end(); ++it)
+      {
+        names += edgeText(model, topology.edges[*it].a, topology.edges[*it].b) + " -> ";
+      }
+      names += edgeText(model, topology.edges[u].a, topology.edges[u].b);
+      failOnUse(model, topology.edges[u].uses.front(),
+        "edges " + names + " take their nodes from one another (project_from): give one of "
+          "them another law");
+    }
+    // the root: a graded or matched edge, or a projected edge ordered before
+    const bool afterMatch = topology.edges[u].matched || topology.edges[u].projectedAfterMatch;
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it)
+    {
+      topology.edges[*it].projectedAfterMatch = afterMatch;
+      topology.projectionOrder.push_back(*it);
+      state[*it] = 2;
+    }
+  }
+}
+
+void projectEdgeParameters(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const CarrierGeometry& geometry, MeshTopology& topology, int e)
+{
+  UniqueEdge& edge = topology.edges[e];
+  const UniqueEdge& source = topology.edges[edge.projectedFrom];
+  const EdgeUse& use = edge.uses.front();
+  const int n = edge.nodeCount;
+  const std::string names = uniqueEdgeText(model, edge) + " takes its nodes from " +
+    uniqueEdgeText(model, source) + " (project_from)";
+  if (source.nodeCount != n)
+  {
+    failOnUse(model, use,
+      names + ", but has " + std::to_string(n - 1) + " cells against its " +
+        std::to_string(source.nodeCount - 1) + "; give both the same cell count");
+  }
+  // The target's curve in its canonical direction (a -> b) as computeEdgeNodes places
+  // nodes on it: arc-length fractions, a named curve possibly running b -> a.
+  const NamedCurve* named = edge.named >= 0 ? &curves[edge.named] : nullptr;
+  const Vec3& start = model.vertices[edge.a].position;
+  const Vec3& end = model.vertices[edge.b].position;
+  const bool curveReversed = named && model.edges[edge.named].from != edge.a;
+  const CurvePtr curve = named ? named->curve : std::make_shared<LineCurve>(start, end);
+  const CurveProjector projector(curve);
+  // The source runs the same way or the other way round: its nearer ends decide.
+  const Vec3& sourceStart = model.vertices[source.a].position;
+  const Vec3& sourceEnd = model.vertices[source.b].position;
+  const bool crossed = (start - sourceEnd).norm() + (end - sourceStart).norm() <
+    (start - sourceStart).norm() + (end - sourceEnd).norm();
+  std::vector<double> params(n, 0.0);
+  params[n - 1] = 1.0;
+  for (int i = 1; i < n - 1; ++i)
+  {
+    const Vec3 node = edgeNodePoint(model, curves, geometry, source, crossed ? n - 1 - i : i);
+    const double t = projector.project(node).t;
+    double fraction = named && named->lengthTable
+      ? named->lengthTable->lengthAt(t) / named->lengthTable->totalLength()
+      : t;
+    params[i] = curveReversed ? 1.0 - fraction : fraction;
+    if (!(params[i] > params[i - 1]) || !(params[i] < 1.0))
+    {
+      failOnUse(model, use,
+        names + ", but the projection of node " + std::to_string(i) +
+          " is not between those of its neighbours (at " + shortNumber(params[i]) +
+          " of the edge): the edges are too far apart or too differently curved for their "
+          "nodes to project in order");
+    }
+  }
+  edge.params = std::move(params);
+}
+
+void computeEdgeGrading(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  const CarrierGeometry& geometry, MeshTopology& topology, std::vector<char>* changed,
+  bool allowFallback)
+{
+  const auto isChanged = [&](int u) { return !changed || (*changed)[u]; };
+  const auto project = [&](bool afterMatch) {
+    for (const int u : topology.projectionOrder)
+    {
+      UniqueEdge& edge = topology.edges[u];
+      if (edge.projectedAfterMatch != afterMatch ||
+        !(isChanged(u) || isChanged(edge.projectedFrom)))
+      {
+        continue;
+      }
+      if (changed)
+      {
+        (*changed)[u] = 1;
+      }
+      projectEdgeParameters(model, curves, geometry, topology, u);
+    }
+  };
+  const int count = static_cast<int>(topology.edges.size());
+  for (int u = 0; u < count; ++u)
+  {
+    const UniqueEdge& edge = topology.edges[u];
+    if (!edge.matched && edge.projectedFrom < 0 && isChanged(u))
+    {
+      computeEdgeParameters(model, topology, u, allowFallback);
+    }
+  }
+  project(false);
+  if (!topology.matchGroups.empty())
+  {
+    for (const int u : matchEdgeEnds(model, topology))
+    {
+      if (changed)
+      {
+        (*changed)[u] = 1;
+      }
+    }
+  }
+  for (int u = 0; u < count; ++u)
+  {
+    if (topology.edges[u].matched && isChanged(u))
+    {
+      computeEdgeParameters(model, topology, u, allowFallback);
+    }
+  }
+  project(true);
+}
+} // namespace model
+} // namespace blockforge

@@ -1,0 +1,333 @@
+// The grading law `project_from`: an edge's interior nodes are the closest points on its
+// curve of another edge's nodes. Checked on analytic shapes: a circular arc and its
+// concentric offset (the projected nodes at the source's angles), parallel straight
+// edges, with graded and matched sources, at density multipliers, through the model
+// document and the mesh plan; and the errors for mismatched counts, cycles and names.
+#include "MeshPlan.h"
+#include "Mesher.h"
+#include "ModelDocument.h"
+#include "Template.h"
+
+#include "TestHelpers.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+using namespace blockforge;
+using namespace blockforge::model;
+
+namespace
+{
+/**
+ * A quarter ring between radii 1 and 1.5 about the z axis, 1 high: i runs clockwise along
+ * the arcs from (0, 1) to (1, 0), j outwards, k up. The inner arcs (in0 and in1 on E1 and
+ * E5) are graded by `innerLaw`, the outer ones (out0, out1 on E3 and E7) by `outerLaw`, a
+ * '#' in a law standing for the layer (0 at the bottom, 1 at the top). The outer arcs are
+ * defined against the block's i direction and the inner ones with it, so both
+ * orientations are used.
+ */
+std::string quarterRing(const std::string& innerLaw, const std::string& outerLaw, int cells = 8)
+{
+  const auto layer = [](std::string law, int k) {
+    const std::size_t at = law.find('#');
+    if (at != std::string::npos)
+    {
+      law.replace(at, 1, std::to_string(k));
+    }
+    return law;
+  };
+  return "blockforge: 1\n"
+         "parameters:\n"
+         "  n: " + std::to_string(cells) + "\n"
+         "vertices:\n"
+         "  p0: [0, 1, 0]\n"
+         "  p1: [1, 0, 0]\n"
+         "  p2: [1.5, 0, 0]\n"
+         "  p3: [0, 1.5, 0]\n"
+         "  p4: [0, 1, 1]\n"
+         "  p5: [1, 0, 1]\n"
+         "  p6: [1.5, 0, 1]\n"
+         "  p7: [0, 1.5, 1]\n"
+         "edges:\n"
+         "  in0: {arc: [p0, p1], centre: [0, 0, 0]}\n"
+         "  out0: {arc: [p2, p3], centre: [0, 0, 0]}\n"
+         "  in1: {arc: [p4, p5], centre: [0, 0, 1]}\n"
+         "  out1: {arc: [p6, p7], centre: [0, 0, 1]}\n"
+         "blocks:\n"
+         "  ring: {vertices: [p0, p1, p2, p3, p4, p5, p6, p7], cells: [n, 4, 2], grading: "
+         "{edges: {E1: " + layer(innerLaw, 0) + ", E5: " + layer(innerLaw, 1) + ", E3: " +
+    layer(outerLaw, 0) + ", E7: " + layer(outerLaw, 1) + "}}}\n";
+}
+
+double angleOf(const Vec3& p)
+{
+  return std::atan2(p.y(), p.x());
+}
+
+/// Node (i, j, k) of block b.
+Vec3 node(const test::Grid& grid, int b, int i, int j, int k)
+{
+  return grid.at(b, i, j, k);
+}
+
+/// Every inner arc node of block b and the outer arc node of the same i lie at the same
+/// angle (within 1e-12), the outer ones on the radius 1.5; returns the largest difference.
+double largestAngleDifference(const test::Grid& grid, int b)
+{
+  const auto& n = grid.nodes[b];
+  double largest = 0.0;
+  for (int k : { 0, n[2] - 1 })
+  {
+    for (int i = 0; i < n[0]; ++i)
+    {
+      const Vec3 inner = node(grid, b, i, 0, k);
+      const Vec3 outer = node(grid, b, i, n[1] - 1, k);
+      EXPECT_NEAR(Vec3(outer.x(), outer.y(), 0).norm(), 1.5, 1e-12) << i;
+      largest = std::max(largest, std::abs(angleOf(inner) - angleOf(outer)));
+    }
+  }
+  return largest;
+}
+
+std::string errorOf(const std::string& text)
+{
+  try
+  {
+    test::meshAll(parseTemplate(text, "projected.yaml"));
+  }
+  catch (const std::exception& error)
+  {
+    return error.what();
+  }
+  ADD_FAILURE() << "no error";
+  return std::string();
+}
+
+bool contains(const std::string& text, const std::string& part)
+{
+  return text.find(part) != std::string::npos;
+}
+} // namespace
+
+TEST(ProjectedEdges, OffsetArcTakesTheAnglesOfItsSourceAtEveryDensity)
+{
+  for (const std::string law :
+    { "{geometric: 1.3}", "{two_sided: 1.25}", "{ends: [0.1, 4]}", "{first_cell: 0.02}" })
+  {
+    SCOPED_TRACE(law);
+    const BlockModel layered =
+      parseTemplate(quarterRing(law, "{project_from: in#}"), "ring.yaml");
+    for (const double density : { 1.0, 2.0, 0.5 })
+    {
+      SCOPED_TRACE(density);
+      const test::Grid grid = test::meshAll(layered, density);
+      EXPECT_EQ(grid.nodes[0][0], static_cast<int>(std::round(8 * density)) + 1);
+      EXPECT_LT(largestAngleDifference(grid, 0), 1e-12);
+      // graded: the projection is not the arc-length distribution of the outer arc
+      const double first = angleOf(node(grid, 0, 1, 0, 0)) - angleOf(node(grid, 0, 0, 0, 0));
+      const double middle = angleOf(node(grid, 0, grid.nodes[0][0] / 2 + 1, 0, 0)) -
+        angleOf(node(grid, 0, grid.nodes[0][0] / 2, 0, 0));
+      EXPECT_GT(std::abs(first - middle), 1e-3);
+    }
+  }
+}
+
+TEST(ProjectedEdges, InnerArcTakesTheAnglesOfTheOuterOne)
+{
+  // The other way round: the graded outer arc gives its nodes to the inner arc.
+  const test::Grid grid = test::meshAll(
+    parseTemplate(quarterRing("{project_from: out#}", "{geometric: 0.8}"), "ring.yaml"));
+  EXPECT_LT(largestAngleDifference(grid, 0), 1e-12);
+}
+
+TEST(ProjectedEdges, ParallelStraightEdgesKeepTheirNodesAcross)
+{
+  // A box turned by 30 degrees about z: its bottom front edge graded, the back edge (not
+  // named, straight) takes its nodes; each back node lies straight across from its front
+  // node (the same coordinate along the edge).
+  const std::string text = R"yaml(blockforge: 1
+parameters:
+  c: 0.8660254037844386
+  s: 0.5
+vertices:
+  a0: [0, 0, 0]
+  a1: [2*c, 2*s, 0]
+  a2: [2*c - s, 2*s + c, 0]
+  a3: [-s, c, 0]
+  a4: [0, 0, 1]
+  a5: [2*c, 2*s, 1]
+  a6: [2*c - s, 2*s + c, 1]
+  a7: [-s, c, 1]
+edges:
+  front: {line: [a0, a1]}
+blocks:
+  box: {vertices: [a0, a1, a2, a3, a4, a5, a6, a7], cells: [7, 3, 1], grading: {edges: {E1: {geometric: 1.4}, E3: {project_from: front}}}}
+)yaml";
+  const test::Grid grid = test::meshAll(parseTemplate(text, "box.yaml"));
+  const Vec3 along(0.8660254037844386, 0.5, 0.0);
+  for (int i = 0; i < grid.nodes[0][0]; ++i)
+  {
+    const Vec3 front = node(grid, 0, i, 0, 0);
+    const Vec3 back = node(grid, 0, i, grid.nodes[0][1] - 1, 0);
+    EXPECT_NEAR(front.dot(along), back.dot(along), 1e-12) << i;
+  }
+  // the front edge is graded, so the back edge is too
+  const double first = (node(grid, 0, 1, 3, 0) - node(grid, 0, 0, 3, 0)).norm();
+  const double last = (node(grid, 0, 7, 3, 0) - node(grid, 0, 6, 3, 0)).norm();
+  EXPECT_NEAR(last / first, std::pow(1.4, 6), 1e-9);
+}
+
+TEST(ProjectedEdges, ProjectedFromMatchedEdgesComeAfterThem)
+{
+  // Two quarter-ring halves of 4 and 12 cells whose inner arcs are matched (their cells
+  // meet at 45 degrees with one length); the outer arcs take the inner arcs' nodes, so
+  // they follow the matched distribution.
+  const std::string text = R"yaml(blockforge: 1
+vertices:
+  a0: [0, 1, 0]
+  m0: [sqrt(0.5), sqrt(0.5), 0]
+  b0: [1, 0, 0]
+  a3: [0, 1.5, 0]
+  m3: [1.5*sqrt(0.5), 1.5*sqrt(0.5), 0]
+  b3: [1.5, 0, 0]
+  a4: [0, 1, 1]
+  m4: [sqrt(0.5), sqrt(0.5), 1]
+  b4: [1, 0, 1]
+  a7: [0, 1.5, 1]
+  m7: [1.5*sqrt(0.5), 1.5*sqrt(0.5), 1]
+  b7: [1.5, 0, 1]
+edges:
+  ia0: {arc: [a0, m0], centre: [0, 0, 0]}
+  ib0: {arc: [m0, b0], centre: [0, 0, 0]}
+  oa0: {arc: [a3, m3], centre: [0, 0, 0]}
+  ob0: {arc: [m3, b3], centre: [0, 0, 0]}
+  ia1: {arc: [a4, m4], centre: [0, 0, 1]}
+  ib1: {arc: [m4, b4], centre: [0, 0, 1]}
+  oa1: {arc: [a7, m7], centre: [0, 0, 1]}
+  ob1: {arc: [m7, b7], centre: [0, 0, 1]}
+blocks:
+  A: {vertices: [a0, m0, m3, a3, a4, m4, m7, a7], cells: [4, 3, 1], grading: {edges: {E1: match, E5: match, E3: {project_from: ia0}, E7: {project_from: ia1}}}}
+  B: {vertices: [m0, b0, b3, m3, m4, b4, b7, m7], cells: [12, 3, 1], grading: {edges: {E1: match, E5: match, E3: {project_from: ib0}, E7: {project_from: ib1}}}}
+)yaml";
+  const BlockModel model = parseTemplate(text, "halves.yaml");
+  for (const double density : { 1.0, 2.0 })
+  {
+    SCOPED_TRACE(density);
+    const test::Grid grid = test::meshAll(model, density);
+    for (int b = 0; b < 2; ++b)
+    {
+      EXPECT_LT(largestAngleDifference(grid, b), 1e-12) << b;
+    }
+    // matched: the inner cells at 45 degrees are one length, so the outer ones are too
+    const int na = grid.nodes[0][0];
+    const double innerA = (node(grid, 0, na - 1, 0, 0) - node(grid, 0, na - 2, 0, 0)).norm();
+    const double innerB = (node(grid, 1, 1, 0, 0) - node(grid, 1, 0, 0, 0)).norm();
+    const double outerA = (node(grid, 0, na - 1, 3, 0) - node(grid, 0, na - 2, 3, 0)).norm();
+    const double outerB = (node(grid, 1, 1, 3, 0) - node(grid, 1, 0, 3, 0)).norm();
+    EXPECT_NEAR(innerA, innerB, 1e-12);
+    EXPECT_NEAR(outerA / innerA, 1.5, 1e-12);
+    EXPECT_NEAR(outerB / innerB, 1.5, 1e-12);
+  }
+}
+
+TEST(ProjectedEdges, TheLawTravelsInTheModelDocument)
+{
+  const BlockModel model =
+    parseTemplate(quarterRing("{geometric: 1.2}", "{project_from: in#}"), "ring.yaml");
+  const std::string document = writeModelDocument(model);
+  EXPECT_TRUE(contains(document, "{project_from: in1}")) << document;
+  const BlockModel reread = readModelDocument(document);
+  EXPECT_EQ(reread.blocks[0].laws, model.blocks[0].laws);
+  EXPECT_EQ(reread.blocks[0].laws[2].kind, DistributionLaw::Kind::ProjectFrom);
+  EXPECT_EQ(reread.blocks[0].laws[2].sourceEdge, reread.findNamedEdge("in0"));
+  const test::Grid original = test::meshAll(model);
+  const test::Grid again = test::meshAll(reread);
+  EXPECT_TRUE(test::sameBits(original.xyz[0], again.xyz[0]));
+  // an unknown edge in a document is an error naming it
+  std::string broken = document;
+  const std::size_t at = broken.find("{project_from: in1}");
+  broken.replace(at, 19, "{project_from: in9}");
+  try
+  {
+    readModelDocument(broken);
+    ADD_FAILURE() << "no error for an unknown edge";
+  }
+  catch (const TemplateError& error)
+  {
+    EXPECT_TRUE(contains(error.what(), "unknown edge 'in9'")) << error.what();
+  }
+}
+
+TEST(ProjectedEdges, MovingTheSourceUpdatesTheProjectionAsAFreshMesherDoes)
+{
+  const BlockModel model =
+    parseTemplate(quarterRing("{two_sided: 1.3}", "{project_from: in#}"), "ring.yaml");
+  const CarrierGeometry carriers(model);
+  MeshPlan plan(model, carriers);
+  const int p1 = plan.model().findVertex("p1");
+  // p1 (the inner arc's end, not on the outer arc) slides 5 degrees round the circle
+  const double angle = 5.0 * test::Pi / 180.0;
+  plan.model().vertices[p1].position = Vec3(std::cos(angle), std::sin(angle), 0.0);
+  const Feasibility feasibility = plan.update({ p1 });
+  ASSERT_TRUE(feasibility.feasible()) << feasibility.message;
+  const test::Grid fresh = test::meshAll(plan.model());
+  EXPECT_TRUE(test::sameBits(plan.blockNodes(0), fresh.xyz[0]));
+  // the outer arc's nodes moved with the inner ones though none of its vertices did
+  const test::Grid before = test::meshAll(model);
+  EXPECT_FALSE(test::sameBits(node(fresh, 0, 3, 4, 0), node(before, 0, 3, 4, 0)));
+  EXPECT_LT(largestAngleDifference(fresh, 0), 1e-12);
+}
+
+TEST(ProjectedEdges, ErrorsNameTheEdges)
+{
+  // different cell counts: the source in one block, the projected edge in another
+  const std::string counts = R"yaml(blockforge: 1
+vertices:
+  a0: [0, 0, 0]
+  a1: [1, 0, 0]
+  a2: [1, 1, 0]
+  a3: [0, 1, 0]
+  a4: [0, 0, 1]
+  a5: [1, 0, 1]
+  a6: [1, 1, 1]
+  a7: [0, 1, 1]
+  b0: [0, 2, 0]
+  b1: [1, 2, 0]
+  b2: [1, 3, 0]
+  b3: [0, 3, 0]
+  b4: [0, 2, 1]
+  b5: [1, 2, 1]
+  b6: [1, 3, 1]
+  b7: [0, 3, 1]
+edges:
+  front: {line: [a0, a1]}
+  other: {line: [b0, b1]}
+blocks:
+  A: {vertices: [a0, a1, a2, a3, a4, a5, a6, a7], cells: [4, 1, 1]}
+  B: {vertices: [b0, b1, b2, b3, b4, b5, b6, b7], cells: [6, 1, 1], grading: {edges: {E1: {project_from: front}}}}
+)yaml";
+  const std::string mismatch = errorOf(counts);
+  EXPECT_TRUE(contains(mismatch, "edge 'other' (b0-b1) takes its nodes from edge 'front' (a0-a1)"))
+    << mismatch;
+  EXPECT_TRUE(contains(mismatch, "has 6 cells against its 4")) << mismatch;
+  EXPECT_TRUE(contains(mismatch, "block 'B'")) << mismatch;
+
+  // two edges taking their nodes from one another
+  const std::string cycle = errorOf(test::replaced(counts,
+    "  A: {vertices: [a0, a1, a2, a3, a4, a5, a6, a7], cells: [4, 1, 1]}",
+    "  A: {vertices: [a0, a1, a2, a3, a4, a5, a6, a7], cells: [6, 1, 1], grading: {edges: {E1: "
+    "{project_from: other}}}}"));
+  EXPECT_TRUE(contains(cycle, "take their nodes from one another")) << cycle;
+  EXPECT_TRUE(contains(cycle, "'front'") && contains(cycle, "'other'")) << cycle;
+
+  // an edge that projects from itself
+  const std::string self = errorOf(test::replaced(counts, "project_from: front", "project_from: other"));
+  EXPECT_TRUE(contains(self, "take their nodes from one another")) << self;
+
+  // an unknown name, with the nearest one suggested
+  const std::string unknown = errorOf(test::replaced(counts, "project_from: front", "project_from: frnt"));
+  EXPECT_TRUE(contains(unknown, "grading E1 project_from: unknown edge 'frnt' (did you mean 'front'?)"))
+    << unknown;
+}
