@@ -56,11 +56,7 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   blade one pitch below) through the front, middle and rear O corners. Upstream and
 #   downstream the H lines leave the O-grid along the camber direction at the edges
 #   (follow_le, follow_te: 1 = the blade angle, 0 = axial) to the inlet and outlet planes;
-#   on staggered blades much below 0.5 folds cells where they meet the O-grid. Where such a
-#   straight line would leave its O corner at less than h_min from the O-grid's outer curve
-#   (a corner moved off a thin edge lies where that curve runs along the side), it is bent
-#   there: it passes a point h_normal O-grid widths out at h_min (at most half the angle to
-#   the H line across the passage, so the block between them keeps its corner).
+#   on staggered blades much below 0.5 folds cells where they meet the O-grid.
 # - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
@@ -94,8 +90,6 @@ parameters:
   n_o: 6                  # cells across the O-grid
   n_span: 12              # cells from hub to shroud
   k_o: 1.15               # expansion ratio away from the blade in the O-grid
-  h_min: 35deg            # the H lines to the inlet and outlet leave the O corners at least this far from the O-grid (bent there, within half the angle to the line across the passage)
-  h_normal: 1             # ... bent over this many O-grid widths
   k_span: 1.05            # expansion ratio away from hub and shroud (two-sided)
   grade: 0                # blade sides: end cells (edge cell size / side mean cell)^grade; 1 matches the edge blocks' cells, 0 uniform (above 0.3 some machines fold at density 2 and more)
 """
@@ -164,29 +158,6 @@ def template_text():
             w(f'  {e}_vy0_{l}: "rm_{l}*(pa_{e}_{l}.theta - pb_{e}_{l}.theta) - ((pa_{e}_{l}.axial - pb_{e}_{l}.axial)*{e}_ux_{l} + rm_{l}*(pa_{e}_{l}.theta - pb_{e}_{l}.theta)*{e}_uy_{l})*{e}_uy_{l}"')
             w(f'  {e}_vx_{l}: "{e}_vx0_{l}/sqrt({e}_vx0_{l}^2 + {e}_vy0_{l}^2)"      # unit normal of the camber towards side a')
             w(f'  {e}_vy_{l}: "{e}_vy0_{l}/sqrt({e}_vx0_{l}^2 + {e}_vy0_{l}^2)"')
-        # H lines to the inlet (outlet) leaving the O corners: each corner's outward normal n and
-        # tangent t towards its edge (unrolled); a line whose straight direction to the inlet
-        # (outlet) would leave the O-grid at less than h_min from it is bent there
-        for v, e in (('a_f', 'le'), ('b_f', 'le'), ('a_r', 'te'), ('b_r', 'te')):
-            o, f = f'o{v}_{l}', f'{v}_{l}'
-            w(f'  nx_{v}_{l}: "({o}.axial - {f}.axial)/sqrt(({o}.axial - {f}.axial)^2 + (rm_{l}*({o}.theta - {f}.theta))^2)"')
-            w(f'  ny_{v}_{l}: "rm_{l}*({o}.theta - {f}.theta)/sqrt(({o}.axial - {f}.axial)^2 + (rm_{l}*({o}.theta - {f}.theta))^2)"')
-            w(f'  sg_{v}_{l}: "-ny_{v}_{l}*({e}_{l}.axial - {o}.axial) + nx_{v}_{l}*rm_{l}*({e}_{l}.theta - {o}.theta) > 0 ? 1 : -1"')
-            w(f'  tx_{v}_{l}: "-sg_{v}_{l}*ny_{v}_{l}"')
-            w(f'  ty_{v}_{l}: "sg_{v}_{l}*nx_{v}_{l}"')
-        for v, target in (('a_f', 'a_in'), ('b_f', 'b_in'), ('a_r', 'a_out'), ('b_r', 'b_out')):
-            o = f'o{v}_{l}'
-            wx = f'({target}_{l}.axial - {o}.axial)'
-            wy = f'(rm_{l}*({target}_{l}.theta - {o}.theta))'
-            w(f'  phi_{v}_{l}: "atan2({wx}*nx_{v}_{l} + {wy}*ny_{v}_{l}, {wx}*tx_{v}_{l} + {wy}*ty_{v}_{l})"')
-            px, sh = {'a_f': ('lo_f', ''), 'b_f': ('lo_f', ' + pitch'), 'a_r': ('lo_r', ''), 'b_r': ('lo_r', ' + pitch')}[v]
-            xx = f'({px}_{l}.axial - {o}.axial)'
-            xy = f'(rm_{l}*({px}_{l}.theta{sh} - {o}.theta))'
-            w(f'  phx_{v}_{l}: "atan2({xx}*nx_{v}_{l} + {xy}*ny_{v}_{l}, {xx}*tx_{v}_{l} + {xy}*ty_{v}_{l})"')
-            w(f'  phc_{v}_{l}: "max(phi_{v}_{l}, min(h_min, phx_{v}_{l}/2))"')
-            w(f'  len_{v}_{l}: "min(h_normal*o_width*chord_{l}, 0.4*sqrt({wx}^2 + {wy}^2))"')
-            w(f'  qx_{v}_{l}: "{o}.axial + len_{v}_{l}*(cos(phc_{v}_{l})*tx_{v}_{l} + sin(phc_{v}_{l})*nx_{v}_{l})"')
-            w(f'  qy_{v}_{l}: "{o}.theta + len_{v}_{l}*(cos(phc_{v}_{l})*ty_{v}_{l} + sin(phc_{v}_{l})*ny_{v}_{l})/rm_{l}"')
         # the corners moved off the tip are taken where the edge block's outer chord is at most
         # o_fan times its blade chord; sharper edges keep their corners on the tip (a fan)
         for e, (a, b) in (('le', ('a_f', 'b_f')), ('te', ('a_r', 'b_r'))):
@@ -218,8 +189,6 @@ def template_text():
         w(f'  blade_{l}: {{intersect: [blade, {S}]}}')
         w(f'  o_{l}: {{offset: blade_{l}, on: {S}, distance: "o_width*chord_{l}"}}      # outer boundary of the O-grid')
         w(f'  lo_{l}: {{surface_curve: {S}, through: [lo_f_{l}, lo_m_{l}, lo_r_{l}]}}      # periodic_low line, mid-passage')
-        for v, io in (('a_f', 'a_in'), ('b_f', 'b_in'), ('a_r', 'a_out'), ('b_r', 'b_out')):
-            w(f'  h{v}_{l}: {{surface_curve: {S}, through: [o{v}_{l}, q{v}_{l}, {io}_{l}]}}')
     w('')
     w('vertices:')
     for l, S in L.items():
@@ -242,17 +211,22 @@ def template_text():
             dy = f'(cos({c})*{e}_uy_{l} {side} sin({c})*{e}_vy_{l})'
             far = f'o{e}_{l}.s {towards} dir_{l}*o_window'
             b = v[1:]  # the corner's foot on the blade
-            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}}}')
-            w(f'  f{b}_{l}: {{project: c{b}_{l}, onto: blade_{l}}}')
+            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+            # (nearest points by a search, not `project`: a search only places a helper once,
+            # a projection would be redone at every step of the optimizer)
+            near = lambda P: f'"(x - {P}.x)^2 + (y - {P}.y)^2 + (z - {P}.z)^2"'
+            w(f'  f{b}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"c{b}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
             # the foot kept o_tip (fraction of the loop) from the edge: at a sharp edge every
             # point of the O curve's arc round the tip projects onto the tip itself
             x = f'dir_{l}*(f{b}_{l}.s - {e}_{l}.s)'
             off = f'({x} - rint({x}))'
             lim = f'max({off}, o_tip)' if towards == '+' else f'min({off}, -o_tip)'
-            w(f'  k{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{lim}"}}')
-            w(f'  r{b}_{l}: {{project: k{b}_{l}, onto: o_{l}}}')
-            w(f'  {b}_{l}: {{on_curve: blade_{l}, at: "off_{e}_{l} ? k{b}_{l}.s : f{b}_{l}.s"}}')
-            w(f'  {v}_{l}: {{on_curve: o_{l}, at: "off_{e}_{l} ? r{b}_{l}.s : c{b}_{l}.s"}}')
+            w(f'  k{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{lim}", fixed: true}}')
+            w(f'  r{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"k{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
+            dr = f'(x - r{b}_{l}.x)^2 + (y - r{b}_{l}.y)^2 + (z - r{b}_{l}.z)^2'
+            dc = f'(x - c{b}_{l}.x)^2 + (y - c{b}_{l}.y)^2 + (z - c{b}_{l}.z)^2'
+            w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {dr} : {dc}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
+            w(f'  {b}_{l}: {{project: {v}_{l}, onto: blade_{l}}}')
         w(f'  a_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s + dir_{l}*side_a_{l}/2"}}')
         w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
         w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')
@@ -262,8 +236,6 @@ def template_text():
             w(f'  lo_{f}_{l}: {{on_surface: {S}, axial: "(oa_{f}_{l}.axial + ob_{f}_{l}.axial)/2", theta: "(oa_{f}_{l}.theta + ob_{f}_{l}.theta - pitch)/2"}}')
         w(f'  hi_f_{l}: {{periodic: lo_f_{l}}}')
         w(f'  hi_r_{l}: {{periodic: lo_r_{l}}}')
-        for v in ('a_f', 'b_f', 'a_r', 'b_r'):
-            w(f'  q{v}_{l}: {{on_surface: {S}, axial: qx_{v}_{l}, theta: qy_{v}_{l}}}')
         w(f'  # inlet and outlet: on the axial planes, H lines leaving the O-grid along slope_in/out')
         for v, src in (('lo_in', 'lo_f'), ('a_in', 'oa_f'), ('b_in', 'ob_f')):
             w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "{src}_{l}.theta + ({src}_{l}.axial - inlet_axial)*slope_in_{l}/rm_{l}"}}')
@@ -280,13 +252,10 @@ def template_text():
         for name, a, b, g in (('ol_le', 'ob_f', 'oa_f', 'ogap_le'), ('ol_a', 'oa_f', 'oa_r', 'ogap_a'), ('ol_te', 'oa_r', 'ob_r', 'ogap_te'), ('ol_b', 'ob_r', 'ob_f', 'ogap_b')):
             w(f'  {name}_{l}: {{on_curve: o_{l}, between: [{a}_{l}, {b}_{l}], at: [{a}_{l}.s, "{a}_{l}.s + dir_{l}*{g}_{l}"]}}')
         w(f'  lo_f_lo_r_{l}: {{on_curve: lo_{l}, between: [lo_f_{l}, lo_r_{l}]}}')
-        for v, io in (('a_f', 'a_in'), ('b_f', 'b_in'), ('a_r', 'a_out'), ('b_r', 'b_out')):
-            a, b = (io, 'o' + v) if io.endswith('in') else ('o' + v, io)
-            w(f'  {a}_{b}_{l}: {{on_curve: h{v}_{l}, between: [{a}_{l}, {b}_{l}]}}')
         for a, b in (('a_f', 'oa_f'), ('a_r', 'oa_r'), ('b_f', 'ob_f'), ('b_r', 'ob_r'),
                      ('lo_in', 'a_in'), ('a_in', 'b_in'), ('b_in', 'hi_in'), ('lo_f', 'oa_f'), ('ob_f', 'hi_f'),
                      ('lo_r', 'oa_r'), ('ob_r', 'hi_r'), ('lo_out', 'a_out'), ('a_out', 'b_out'), ('b_out', 'hi_out'),
-                     ('lo_in', 'lo_f'), ('lo_r', 'lo_out')):
+                     ('lo_in', 'lo_f'), ('lo_r', 'lo_out'), ('a_in', 'oa_f'), ('b_in', 'ob_f'), ('oa_r', 'a_out'), ('ob_r', 'b_out')):
             w(f'  {a}_{b}_{l}: {{on_surface: {S}, between: [{a}_{l}, {b}_{l}]}}')
     w('  # --- spanwise on the blade, and the O-grid\'s outer corners following them (a straight line')
     w('  # between the hub and shroud corners could cut a thin O-grid at a bowed blade edge)')
