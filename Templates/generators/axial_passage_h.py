@@ -47,8 +47,8 @@ HEADER = """# Written by Templates/generators/axial_passage_h.py: edit that, the
 # parameters mesh Data/rotor37/turbogrid (36 blades, leaning +theta) and Data/distributor
 # (16 vanes, leaning -theta). theta is measured from the blade (machine: theta_zero).
 # Where the hub and shroud contours end nearer the blade than asked (the inlet or outlet
-# then sits where they end), the upstream and downstream blocks get fewer cells, about the
-# blade blocks' mean cell long, instead of n_up (n_down) cells squeezed into the short gap.
+# then sits where they end), the upstream and downstream blocks get fewer cells, 0.4 of the
+# blade blocks' mean axial cell long, instead of n_up (n_down) cells squeezed into the gap.
 blockforge: 2
 name: axial_passage_h
 description: H-grid of one blade passage from hub, shroud and blade sections.
@@ -66,6 +66,7 @@ parameters:
   n_pitch: 8              # cells across each half pitch
   n_span: 12              # cells from hub to shroud
   k_match: 1.2            # largest growth ratio of the cells along the axis and across the pitch, whose end cells match their neighbours' (law match)
+  lean: 75deg             # blade sides: the first cell at a leading or trailing edge leans at most this much from the side's chord (a round edge is left across the pitch: its cell is lengthened, and the cells continuing it too)
 
 definitions:
   blade_axial: "max(te_h.axial, te_s.axial) - min(le_h.axial, le_s.axial)"   # axial extent of the blade
@@ -75,11 +76,13 @@ definitions:
   # end when they are nearer (a hair inside, so that both surfaces reach the plane)
   inlet_axial: "max(inlet_wanted, max(hub.axial_min, shroud.axial_min) + 1e-9*blade_axial)"
   outlet_axial: "min(outlet_wanted, min(hub.axial_max, shroud.axial_max) - 1e-9*blade_axial)"
-  # cells upstream and downstream: n_up (n_down), but no more than cells of the blade
-  # blocks' mean axial length (blade_axial/(2 n_chord)) fill the gap; where the contours
-  # end close to the blade, n_up cells there would be thin slabs (aspect ratio up to 60)
-  cells_up: "min(n_up, max(1, rint((min(le_h.axial, le_s.axial) - inlet_axial)/(blade_axial/(2*n_chord)))))"
-  cells_down: "min(n_down, max(1, rint((outlet_axial - max(te_h.axial, te_s.axial))/(blade_axial/(2*n_chord)))))"
+  # cells upstream and downstream: n_up (n_down), but no more than cells of 0.4 times the
+  # blade blocks' mean axial cell (blade_axial/(2 n_chord)) fill the gap: where the
+  # contours end close to the blade, n_up cells there were thin slabs (aspect ratio up to
+  # 60, failing checkMesh's determinant check); much larger cells there coarsen the
+  # edges' first cells through the match law (passage volume off by 0.6 % at density 0.5)
+  cells_up: "min(n_up, max(1, rint((min(le_h.axial, le_s.axial) - inlet_axial)/(blade_axial/(5*n_chord)))))"
+  cells_down: "min(n_down, max(1, rint((outlet_axial - max(te_h.axial, te_s.axial))/(blade_axial/(5*n_chord)))))"
 
 carriers:
   hub: {revolve: hub, axis: machine, extend: extend}
@@ -92,10 +95,10 @@ carriers:
 FOOTER = """blocks:
   UL: {vertices: [lo_in_h, mi_h, le_h, lo_le_h, lo_in_s, mi_s, le_s, lo_le_s], cells: [n_pitch, cells_up, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
   UR: {vertices: [mi_h, hi_in_h, hi_le_h, le_h, mi_s, hi_in_s, hi_le_s, le_s], cells: [n_pitch, cells_up, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
-  BL: {vertices: [lo_le_h, le_h, a_mid_h, lo_mid_h, lo_le_s, le_s, a_mid_s, lo_mid_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
-  BR: {vertices: [le_h, hi_le_h, hi_mid_h, b_mid_h, le_s, hi_le_s, hi_mid_s, b_mid_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
-  AL: {vertices: [lo_mid_h, a_mid_h, te_h, lo_te_h, lo_mid_s, a_mid_s, te_s, lo_te_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
-  AR: {vertices: [b_mid_h, hi_mid_h, hi_te_h, te_h, b_mid_s, hi_mid_s, hi_te_s, te_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
+  BL: {vertices: [lo_le_h, le_h, a_mid_h, lo_mid_h, lo_le_s, le_s, a_mid_s, lo_mid_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}}}
+  BR: {vertices: [le_h, hi_le_h, hi_mid_h, b_mid_h, le_s, hi_le_s, hi_mid_s, b_mid_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}}}
+  AL: {vertices: [lo_mid_h, a_mid_h, te_h, lo_te_h, lo_mid_s, a_mid_s, te_s, lo_te_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}}}
+  AR: {vertices: [b_mid_h, hi_mid_h, hi_te_h, te_h, b_mid_s, hi_mid_s, hi_te_s, te_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}}}
   DL: {vertices: [lo_te_h, te_h, mo_h, lo_out_h, lo_te_s, te_s, mo_s, lo_out_s], cells: [n_pitch, cells_down, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
   DR: {vertices: [te_h, hi_te_h, hi_out_h, mo_h, te_s, hi_te_s, hi_out_s, mo_s], cells: [n_pitch, cells_down, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
 
