@@ -122,18 +122,25 @@ notes:
 """
 
 
+def side_parameters(l):
+    """Curve parameters on blade_<l> (written out in full, for the template's expressions):
+    fwd, the parameter distance from le to te in increasing s; the mid-point and the end (te)
+    of side a (towards periodic_low) and of side b. dir (+1 when side a lies in increasing s
+    from le) is found from the mid-points fm and bm of the two arcs."""
+    fwd = f'(te_{l}.s < le_{l}.s ? te_{l}.s - le_{l}.s + 1 : te_{l}.s - le_{l}.s)'
+    d = f'(sin(fm_{l}.theta - bm_{l}.theta) < 0 ? 1 : -1)'
+    side_a = f'({d} > 0 ? {fwd} : 1 - {fwd})'
+    return (fwd, f'le_{l}.s + {d}*{side_a}/2', f'le_{l}.s + {d}*{side_a}',
+            f'le_{l}.s - {d}*(1 - {side_a})/2', f'le_{l}.s - {d}*(1 - {side_a})')
+
+
 def template_text():
     out = [HEADER]
     w = out.append
     layers = {'h': 'hub', 's': 'shroud'}
     w('vertices:')
     for l, S in layers.items():
-        # fwd: parameter distance from le to te in increasing s; dir: +1 when side a (towards
-        # periodic_low) lies in increasing s from le; the expressions are written out in full
-        fwd = f'(te_{l}.s < le_{l}.s ? te_{l}.s - le_{l}.s + 1 : te_{l}.s - le_{l}.s)'
-        d = f'(sin(fm_{l}.theta - bm_{l}.theta) < 0 ? 1 : -1)'
-        a_mid = f'le_{l}.s + {d}*({d} > 0 ? {fwd} : 1 - {fwd})/2'
-        b_mid = f'le_{l}.s - {d}*(1 - ({d} > 0 ? {fwd} : 1 - {fwd}))/2'
+        fwd, a_mid, _, b_mid, _ = side_parameters(l)
         w(f'  # --- {S}: fm/bm are the mid-points of the two arcs le -> te (forward and backward in s)')
         w(f'  le_{l}:     {{on_curve: blade_{l}, at: {{min: axial}}}}')
         w(f'  te_{l}:     {{on_curve: blade_{l}, at: {{max: axial}}}}')
@@ -153,13 +160,7 @@ def template_text():
     w('')
     w('edges:')
     for l, S in layers.items():
-        fwd = f'(te_{l}.s < le_{l}.s ? te_{l}.s - le_{l}.s + 1 : te_{l}.s - le_{l}.s)'
-        d = f'(sin(fm_{l}.theta - bm_{l}.theta) < 0 ? 1 : -1)'
-        side_a = f'({d} > 0 ? {fwd} : 1 - {fwd})'
-        a_mid = f'le_{l}.s + {d}*{side_a}/2'
-        a_end = f'le_{l}.s + {d}*{side_a}'
-        b_mid = f'le_{l}.s - {d}*(1 - {side_a})/2'
-        b_end = f'le_{l}.s - {d}*(1 - {side_a})'
+        _, a_mid, a_end, b_mid, b_end = side_parameters(l)
         w(f'  # --- on the {S}: blade sides (side a from le in the direction of a_mid), then lines straight in (s, t)')
         w(f'  le_a_{l}:  {{on_curve: blade_{l}, between: [le_{l}, a_mid_{l}], at: [le_{l}.s, "{a_mid}"]}}')
         w(f'  a_te_{l}:  {{on_curve: blade_{l}, between: [a_mid_{l}, te_{l}], at: ["{a_mid}", "{a_end}"]}}')
