@@ -80,6 +80,7 @@ MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedC
   }
   if (!topology.matchGroups.empty())
   {
+    computeMatchFloors(model, curves, topology);
     matchEdgeEnds(model, topology);
   }
   for (std::size_t e = 0; e < topology.edges.size(); ++e)
