@@ -1,6 +1,7 @@
 #include "Optimizer.h"
 
 #include "MemoryBudget.h"
+#include "Topology.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,38 +12,28 @@ namespace optimize
 {
 namespace
 {
-/// Nodes of the grid of `model` at density multiplier `density` (as the mesher rounds).
-double nodeCount(const model::BlockModel& model, double density)
-{
-  double nodes = 0.0;
-  for (const model::Block& block : model.blocks)
-  {
-    double product = 1.0;
-    for (int cells : block.cells)
-    {
-      product *= std::max(1.0, std::round(cells * density)) + 1.0;
-    }
-    nodes += product;
-  }
-  return nodes;
-}
-
-/// Node counts of every block at density multiplier `density` (for the memory check; the
-/// density is valid, checkDensityMultiplier, so every count fits an int).
+/// Node counts of every block at density multiplier `density` (as the mesher makes them).
 model::BlockNodeCounts nodeCounts(const model::BlockModel& model, double density)
 {
   model::BlockNodeCounts counts;
   for (const model::Block& block : model.blocks)
   {
-    std::array<int, 3> n{};
-    for (int d = 0; d < 3; ++d)
-    {
-      n[d] = static_cast<int>(std::max(1.0, std::round(block.cells[d] * density))) + 1;
-    }
-    counts.push_back(n);
+    counts.push_back(model::scaledNodeCounts(block, density));
   }
   return counts;
 }
+
+/// Nodes of the grid of `model` at density multiplier `density`.
+double nodeCount(const model::BlockModel& model, double density)
+{
+  double nodes = 0.0;
+  for (const std::array<int, 3>& n : nodeCounts(model, density))
+  {
+    nodes += static_cast<double>(n[0]) * n[1] * n[2];
+  }
+  return nodes;
+}
+
 } // namespace
 
 double measuredDensity(const model::BlockModel& model, double densityMultiplier)
