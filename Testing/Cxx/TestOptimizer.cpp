@@ -181,6 +181,32 @@ TEST(Optimizer, ManualMoveIsHeld)
   EXPECT_EQ(reread.vertices[m0].constraint.s, 0.42);
 }
 
+TEST(Optimizer, ManualMovesOnlyFillTheHistory)
+{
+  // Automatic off: the history holds the input and the moved model (the result).
+  Loaded loaded = loadSymmetric("0.3");
+  OptimizerSettings settings;
+  settings.automatic = false;
+  settings.moves = { { "m0", { 0.42 } } };
+  const OptimizerResult moved = optimizeModel(loaded.model, loaded.geometry, settings);
+  ASSERT_EQ(moved.search.history.size(), 2u);
+  EXPECT_EQ(moved.search.evaluations, 2);
+  EXPECT_EQ(moved.search.history[0].evaluation, 1);
+  EXPECT_EQ(moved.search.history[1].evaluation, 2);
+  EXPECT_NEAR(moved.search.history[0].minAngle, std::atan2(1.0, 0.4) * 180.0 / M_PI, 1e-9);
+  EXPECT_EQ(moved.search.history[1].minAngle, moved.after.minAngle);
+  EXPECT_NEAR(moved.after.minAngle, std::atan2(1.0, 0.16) * 180.0 / M_PI, 1e-9);
+  EXPECT_EQ(moved.search.history[1].objective, moved.after.objective);
+  EXPECT_LT(moved.search.history[1].objective, moved.search.history[0].objective);
+  EXPECT_LE(moved.search.history[0].seconds, moved.search.history[1].seconds);
+  // Nothing moved: one row, the input as it is.
+  settings.moves.clear();
+  const OptimizerResult unchanged = optimizeModel(loaded.model, loaded.geometry, settings);
+  ASSERT_EQ(unchanged.search.history.size(), 1u);
+  EXPECT_EQ(unchanged.search.history[0].minAngle, unchanged.before.minAngle);
+  EXPECT_EQ(unchanged.before.minAngle, unchanged.after.minAngle);
+}
+
 TEST(Optimizer, FixedControlPointStays)
 {
   Loaded loaded = loadSymmetric("0.3");

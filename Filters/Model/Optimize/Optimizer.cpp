@@ -4,6 +4,7 @@
 #include "Topology.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 namespace blockforge
@@ -34,6 +35,19 @@ double nodeCount(const model::BlockModel& model, double density)
   return nodes;
 }
 
+/// A history row for an evaluation made outside the search (manual moves only).
+HistoryEntry historyEntry(
+  int evaluation, const GridMeasures& measures, std::chrono::steady_clock::time_point begin)
+{
+  HistoryEntry entry;
+  entry.evaluation = evaluation;
+  entry.objective = measures.objective;
+  entry.minAngle = measures.feasible ? measures.minAngle : 0.0;
+  entry.feasible = measures.feasible;
+  entry.seconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  return entry;
+}
 } // namespace
 
 double measuredDensity(const model::BlockModel& model, double densityMultiplier)
@@ -54,6 +68,7 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
   model::checkDensityMultiplier(model, requested.densityMultiplier);
   model::checkGridMemory(nodeCounts(model, requested.densityMultiplier),
     requested.maximumMemory, "lower the density multiplier or the cell counts");
+  const std::chrono::steady_clock::time_point begin = std::chrono::steady_clock::now();
   OptimizerSettings settings = requested;
   settings.densityMultiplier = measuredDensity(model, requested.densityMultiplier);
   OptimizerResult result;
@@ -78,11 +93,25 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
   result.boundaryLocked = problem.boundaryLocked();
   if (!settings.automatic)
   {
+    // Manual moves only: the history holds the input (evaluation 1) and, when points
+    // were moved, the moved model (evaluation 2), which is the result.
     result.after = problem.evaluate(problem.start());
     if (settings.moves.empty())
     {
       result.before = result.after;
     }
+    SearchResult& record = result.search;
+    record.start = result.before;
+    record.bestMeasures = result.after;
+    record.best = problem.start();
+    record.history.push_back(historyEntry(1, result.before, begin));
+    if (!settings.moves.empty())
+    {
+      record.history.push_back(historyEntry(2, result.after, begin));
+    }
+    record.evaluations = static_cast<int>(record.history.size());
+    record.seconds = record.history.back().seconds;
+    record.stopReason = "manual moves only";
     return result;
   }
   result.search = search(problem.start(), problem.low(), problem.high(),
