@@ -427,3 +427,28 @@ TEST(OptimizerPassage, RefusesAGridTheMesherWouldRefuse)
   EXPECT_EQ(measuredDensity(loaded.model, 2.0), 2.0);
   EXPECT_LT(measuredDensity(loaded.model, 3.0), 3.0);
 }
+
+TEST(OptimizerPassage, TrialsLeftOutChangeNoStep)
+{
+  // The control problem's TrialFilter leaves out trials that cannot gain (inert helper
+  // points, moves of blocks outside the smooth minimum's window): the same steps and
+  // result bit for bit as evaluating every trial, with fewer evaluations.
+  Loaded loaded = loadPassage("axial_passage_oh", "rotor37/turbogrid");
+  SearchSettings settings;
+  settings.maxEvaluations = 120;
+  auto run = [&](bool filtered) {
+    ControlProblem problem(loaded.model, loaded.geometry, 1.0, ObjectiveSettings{}, {});
+    return search(problem.start(), problem.low(), problem.high(), ObjectiveKind::MinAngle,
+      [&](const std::vector<double>& x) { return problem.evaluate(x); }, settings, {},
+      filtered ? TrialFilter([&](std::size_t variable, const GridMeasures& current) {
+        return problem.mayGain(variable, current);
+      })
+               : TrialFilter());
+  };
+  const SearchResult all = run(false), filtered = run(true);
+  EXPECT_GT(filtered.skipped, 5);
+  EXPECT_EQ(filtered.evaluations + filtered.skipped, all.evaluations);
+  EXPECT_EQ(filtered.best, all.best);
+  EXPECT_TRUE(test::sameBits(filtered.bestMeasures.objective, all.bestMeasures.objective));
+  EXPECT_EQ(filtered.bestMeasures.minAngle, all.bestMeasures.minAngle);
+}

@@ -117,7 +117,10 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
   result.search = search(problem.start(), problem.low(), problem.high(),
     settings.objective.kind,
     [&](const std::vector<double>& x) { return problem.evaluate(x); }, settings.search,
-    progress);
+    progress,
+    [&](std::size_t variable, const GridMeasures& current) {
+      return problem.mayGain(variable, current);
+    });
   result.after = result.search.bestMeasures;
   if (settings.moves.empty())
   {
