@@ -221,9 +221,15 @@ struct ControlProblem::Impl
   std::vector<std::vector<char>> VariableBlocks;
   std::vector<std::size_t> LastMoved; ///< variables the last place() changed
 
-  /// Notes the blocks the last (feasible) update recomputed against the variables it moved.
+  /// Notes the blocks the last (feasible) update recomputed against the variable it moved,
+  /// when it moved one (a step that also moved back the last trial's variable recomputes
+  /// that one's blocks too).
   void learnBlocks()
   {
+    if (LastMoved.size() != 1)
+    {
+      return;
+    }
     for (std::size_t i : LastMoved)
     {
       std::vector<char>& blocks = VariableBlocks[i];
