@@ -457,19 +457,12 @@ class BadInputTest(unittest.TestCase):
 
 def observe(algorithm):
     """(errors, warnings): the messages `algorithm` reports from now on."""
-    errors, warnings = [], []
-
-    @calldata_type(VTK_STRING)
-    def on_error(_caller, _event, message):
-        errors.append(message)
-
-    @calldata_type(VTK_STRING)
-    def on_warning(_caller, _event, message):
-        warnings.append(message)
-
-    algorithm.AddObserver(vtkCommand.ErrorEvent, on_error)
-    algorithm.AddObserver(vtkCommand.WarningEvent, on_warning)
-    return errors, warnings
+    found = {vtkCommand.ErrorEvent: [], vtkCommand.WarningEvent: []}
+    for event, messages in found.items():
+        collect = calldata_type(VTK_STRING)(lambda _caller, _event, message, into=messages:
+                                            into.append(message))
+        algorithm.AddObserver(event, collect)
+    return found[vtkCommand.ErrorEvent], found[vtkCommand.WarningEvent]
 
 
 class PreviewFoldTest(unittest.TestCase):
