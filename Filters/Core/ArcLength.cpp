@@ -1,5 +1,8 @@
 #include "ArcLength.h"
 
+#include "Parallel.h"
+#include "RootFinding.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -21,24 +24,37 @@ ArcLength::ArcLength(CurvePtr curve, int pieces, bool keepDerivatives)
   {
     Derivatives.resize(5 * static_cast<std::size_t>(pieces));
   }
+  // The pieces' lengths are independent: they go to threads when a runner is installed
+  // (Parallel.h), each into its own slot, and are added up afterwards in piece order, so
+  // the table is the same bits on any number of threads.
+  std::vector<double> lengths(pieces, 0.0);
+  const long chunks = chunkCount(pieces, 32, 64);
+  forEachChunk(chunks, [&](long chunk) {
+    const int first = static_cast<int>(chunk * pieces / chunks);
+    const int last = static_cast<int>((chunk + 1) * pieces / chunks);
+    for (int k = first; k < last; ++k)
+    {
+      const double a = static_cast<double>(k) / pieces, b = static_cast<double>(k + 1) / pieces;
+      if (!keepDerivatives)
+      {
+        lengths[k] = piece(a, b);
+        continue;
+      }
+      // piece(a, b), remembering the derivatives
+      const double half = 0.5 * (b - a), centre = 0.5 * (a + b);
+      double sum = 0.0;
+      for (int g = 0; g < 5; ++g)
+      {
+        Vec3& derivative = Derivatives[5 * static_cast<std::size_t>(k) + g];
+        derivative = TheCurve->derivative(centre + half * GaussX[g], 1);
+        sum += GaussW[g] * derivative.norm();
+      }
+      lengths[k] = sum * half;
+    }
+  });
   for (int k = 0; k < pieces; ++k)
   {
-    const double a = static_cast<double>(k) / pieces, b = static_cast<double>(k + 1) / pieces;
-    if (!keepDerivatives)
-    {
-      Cumulative[k + 1] = Cumulative[k] + piece(a, b);
-      continue;
-    }
-    // piece(a, b), remembering the derivatives
-    const double half = 0.5 * (b - a), centre = 0.5 * (a + b);
-    double sum = 0.0;
-    for (int g = 0; g < 5; ++g)
-    {
-      Vec3& derivative = Derivatives[5 * static_cast<std::size_t>(k) + g];
-      derivative = TheCurve->derivative(centre + half * GaussX[g], 1);
-      sum += GaussW[g] * derivative.norm();
-    }
-    Cumulative[k + 1] = Cumulative[k] + sum * half;
+    Cumulative[k + 1] = Cumulative[k] + lengths[k];
   }
 }
 
@@ -92,36 +108,12 @@ double ArcLength::parameterAtFraction(double fraction) const
   k = std::max(0, std::min(k, pieces - 1));
   const double a = static_cast<double>(k) / pieces, b = static_cast<double>(k + 1) / pieces;
   const double span = Cumulative[k + 1] - Cumulative[k];
-  double low = a, high = b;
-  double t = span > 0.0 ? a + (target - Cumulative[k]) / span * (b - a) : a;
-  for (int iteration = 0; iteration < 60; ++iteration)
-  {
-    const double error = Cumulative[k] + piece(a, t) - target;
-    if (error > 0.0)
-    {
-      high = t;
-    }
-    else
-    {
-      low = t;
-    }
-    if (std::abs(error) <= 1e-15 * total)
-    {
-      break;
-    }
-    const double speed = TheCurve->derivative(t, 1).norm();
-    double next = speed > 0.0 ? t - error / speed : 0.5 * (low + high);
-    if (!(next > low && next < high))
-    {
-      next = 0.5 * (low + high);
-    }
-    if (next == t)
-    {
-      break;
-    }
-    t = next;
-  }
-  return t;
+  const double t = span > 0.0 ? a + (target - Cumulative[k]) / span * (b - a) : a;
+  NewtonStop stop;
+  stop.iterations = 60;
+  stop.valueTolerance = 1e-15 * total;
+  return newtonInBracket([&](double at) { return Cumulative[k] + piece(a, at) - target; },
+    [&](double at) { return TheCurve->derivative(at, 1).norm(); }, a, b, t, stop);
 }
 
 double ArcLength::lengthAt(double t) const

@@ -1,5 +1,7 @@
 #include "Projection.h"
 
+#include "RootFinding.h"
+
 #include "WorkBudget.h"
 
 #include "BSpline.h"
@@ -134,34 +136,16 @@ double solveBracketed(const CurveEvaluator& curve, const Vec3& p, double lo, dou
   {
     t = 0.5 * (lo + hi);
   }
-  double previousStep = hi - lo, lastStep = previousStep;
   CurveJet jet;
-  for (int iteration = 0; iteration < 200; ++iteration)
-  {
-    curve.evaluate(t, jet);
-    const double g = gradient(jet, p);
-    if (g == 0.0)
-    {
-      return t;
-    }
-    (g < 0.0 ? lo : hi) = t;
-    const double slope = jet.D1.squaredNorm() + (jet.P - p).dot(jet.D2);
-    double next = slope > 0.0 ? t - g / slope : lo - 1.0;
-    // Bisect when Newton leaves the bracket or does not halve the step every two
-    // iterations (the rtsafe rule), so the bracket shrinks geometrically.
-    if (!(next > lo && next < hi) || std::abs(next - t) > 0.5 * previousStep)
-    {
-      next = 0.5 * (lo + hi);
-    }
-    previousStep = lastStep;
-    lastStep = std::abs(next - t);
-    t = next;
-    if (lastStep <= tolerance || hi - lo <= tolerance)
-    {
-      break;
-    }
-  }
-  return t;
+  const auto g = [&](double at) {
+    curve.evaluate(at, jet);
+    return gradient(jet, p);
+  };
+  const auto slope = [&](double) { return jet.D1.squaredNorm() + (jet.P - p).dot(jet.D2); };
+  NewtonStop stop;
+  stop.stepTolerance = tolerance;
+  stop.halveEveryTwoSteps = true; // the bracket shrinks geometrically
+  return newtonInBracket(g, slope, lo, hi, t, stop);
 }
 
 // ---------------------------------------------------------------------------------------

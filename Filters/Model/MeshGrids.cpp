@@ -499,20 +499,30 @@ void ProjectionCache::project(
 {
   Key key{ carrier, {} };
   std::memcpy(key.bits.data(), p.data(), sizeof(key.bits));
-  const auto found = Known.find(key);
-  if (found != Known.end())
   {
-    s = found->second.first;
-    t = found->second.second;
-    return;
+    std::lock_guard<std::mutex> guard(Lock);
+    const auto found = Known.find(key);
+    if (found != Known.end())
+    {
+      s = found->second.first;
+      t = found->second.second;
+      return;
+    }
   }
+  double distance = 0.0;
+  geometry.project(carrier, p, s, t, distance);
+  std::lock_guard<std::mutex> guard(Lock);
   if (Known.size() > 1000000)
   {
     Known.clear(); // bounded: a long optimisation must not grow it without end
   }
-  double distance = 0.0;
-  geometry.project(carrier, p, s, t, distance);
   Known.emplace(key, std::make_pair(s, t));
+}
+
+void ProjectionCache::clear()
+{
+  std::lock_guard<std::mutex> guard(Lock);
+  Known.clear();
 }
 
 std::size_t ProjectionCache::KeyHash::operator()(const Key& key) const

@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <unordered_map>
 #include <map>
+#include <mutex>
 #include <memory>
 #include <string>
 #include <vector>
@@ -197,12 +198,15 @@ void copyPeriodicEdge(const BlockModel& model, MeshTopology& topology, const Edg
  * Projections of points onto carriers already made, by carrier and exact coordinates:
  * CarrierGeometry::project is a function of these alone, so a remembered result is the
  * same bits as a new projection. The mesh plan keeps one, so that a surface face whose
- * boundary changed in one edge projects only that edge's nodes again.
+ * boundary changed in one edge projects only that edge's nodes again. Faces may be
+ * computed on threads: the lookups and insertions are serialised, the projections not.
  */
 class ProjectionCache
 {
 public:
   void project(const CarrierGeometry& geometry, int carrier, const Vec3& p, double& s, double& t);
+  /// Forgets every projection (the carriers' shapes changed).
+  void clear();
 
 private:
   struct Key
@@ -216,6 +220,7 @@ private:
     std::size_t operator()(const Key& key) const;
   };
   std::unordered_map<Key, std::pair<double, double>, KeyHash> Known;
+  std::mutex Lock;
 };
 
 void surfaceFace(const BlockModel& model, const MeshTopology& topology, const CarrierGeometry& geometry,

@@ -5,6 +5,7 @@
 #include "Mesher.h"
 
 #include "../Core/InvertedCells.h"
+#include "../Core/Parallel.h"
 
 #include <Eigen/Geometry>
 
@@ -246,7 +247,7 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
   }
   if (std::find(changedCarrier.begin(), changedCarrier.end(), 1) != changedCarrier.end())
   {
-    Projections = ProjectionCache(); // it remembers projections onto the old shapes
+    Projections.clear(); // it remembers projections onto the old shapes
   }
 
   // Named edge curves: those ending at a moved vertex, those on a carrier drawn again,
@@ -327,23 +328,28 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
       changedEdge[u] = 1;
     }
   }
+  std::vector<int> nodeEdges;
   for (std::size_t u = 0; u < Topo.edges.size(); ++u)
   {
     if (!changedEdge[u])
     {
       continue;
     }
-    UniqueEdge& edge = Topo.edges[u];
-    if (edge.matched)
+    if (Topo.edges[u].matched)
     {
       computeEdgeParameters(model, Topo, static_cast<int>(u), AllowFallback);
     }
-    computeEdgeNodes(model, Curves, Geometry, edge);
+    nodeEdges.push_back(static_cast<int>(u));
     for (const int b : EdgeBlocks[u])
     {
       addUnique(blocks, b);
     }
   }
+  // The nodes of each edge depend on its own curve and parameters alone: on threads when
+  // a runner is installed (Core/Parallel.h), the same bits, the first failing edge's error.
+  forEachChunk(static_cast<long>(nodeEdges.size()), [&](long n) {
+    computeEdgeNodes(model, Curves, Geometry, Topo.edges[nodeEdges[n]]);
+  });
   for (const int b : blocks)
   {
     computeCollapsedParameters(model, Topo, b);
@@ -383,13 +389,19 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
       changedFace[onSurface.first] = 1;
     }
   }
+  std::vector<int> gridFaces;
   for (std::size_t f = 0; f < Topo.faces.size(); ++f)
   {
     if (changedFace[f] && !IsImage[f])
     {
-      computeFaceGrid(model, Geometry, OnSurface, Topo, static_cast<int>(f), &Projections);
+      gridFaces.push_back(static_cast<int>(f));
     }
   }
+  // Each face grid is made from its own edges into its own storage (as in
+  // computeAllBoundaries): on threads when a runner is installed, the same bits.
+  forEachChunk(static_cast<long>(gridFaces.size()), [&](long n) {
+    computeFaceGrid(model, Geometry, OnSurface, Topo, gridFaces[n], &Projections);
+  });
   for (const PeriodicPair& pair : Topo.connectivity.periodic)
   {
     if (changedFace[pair.source] || changedFace[pair.image])
@@ -463,17 +475,20 @@ Feasibility MeshPlan::update(const std::vector<int>& moved)
       return infeasible(Feasibility::Problem::FoldedCorner, b, error.what());
     }
   }
-  for (const int b : P->Updated)
-  {
-    meshBlockNodes(P->Model, P->Topo, b, P->Nodes[b].data());
-  }
   P->Pending.clear();
-  for (const int b : P->Updated)
+  // Blocks are meshed and checked each on its own (on threads when a runner is
+  // installed); the first infeasible block in block order is the one reported.
+  std::vector<Feasibility> cells(P->Updated.size());
+  forEachChunk(static_cast<long>(P->Updated.size()), [&](long n) {
+    const int b = P->Updated[n];
+    meshBlockNodes(P->Model, P->Topo, b, P->Nodes[b].data());
+    cells[n] = checkCells(P->Nodes[b].data(), P->Topo.blocks[b].nodes, b);
+  });
+  for (const Feasibility& block : cells)
   {
-    const Feasibility cells = checkCells(P->Nodes[b].data(), P->Topo.blocks[b].nodes, b);
-    if (!cells.feasible())
+    if (!block.feasible())
     {
-      return cells;
+      return block;
     }
   }
   return Feasibility();

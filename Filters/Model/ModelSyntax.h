@@ -20,6 +20,9 @@ namespace model
 {
 namespace syntax
 {
+/// The file name errors of the model document carry (it has no file of its own).
+constexpr const char* ModelDocumentFile = "<model document>";
+
 /// 17 significant digits, independent of the C locale: parseNumber gives back the same double.
 std::string formatNumber(double value);
 /// Parses the whole of `text` as a double, independent of the C locale.

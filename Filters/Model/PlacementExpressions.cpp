@@ -72,7 +72,11 @@ void revolutionParametersAt(const BlockModel& model, const CarrierGeometry& geom
     }
     else if ((fa < 0.0) != (fb < 0.0))
     {
-      root = bisectedRoot(f, a, b, fa, 1e-16);
+      // the sign of f switches at the crossing: bisect that predicate to rounding
+      const bool negative = fa < 0.0;
+      double low = a, high = b;
+      bisect([&](double u) { return (f(u) < 0.0) == negative; }, low, high, 1e-16, 200);
+      root = 0.5 * (low + high);
       found = true;
     }
     a = b;

@@ -8,6 +8,8 @@
 #include "Mesher.h"
 #include "Template.h"
 
+#include "Parallel.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -18,6 +20,7 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace blockforge
@@ -176,5 +179,36 @@ inline Grid meshAll(const model::BlockModel& model, double multiplier = 1.0, int
   }
   return grid;
 }
+/// Installs a runner on `threads` std::threads (chunks handed out in turn) and removes it
+/// when it goes out of scope. `grainScale` makes even small grids split into chunks.
+class ThreadRunner
+{
+public:
+  explicit ThreadRunner(int threads, double grainScale = 1e-4)
+  {
+    setChunkRunner(
+      [threads](long count, const std::function<void(long, long)>& body)
+      {
+        std::vector<std::thread> pool;
+        for (int t = 0; t < threads; ++t)
+        {
+          pool.emplace_back(
+            [=, &body]
+            {
+              for (long chunk = t; chunk < count; chunk += threads)
+              {
+                body(chunk, chunk + 1);
+              }
+            });
+        }
+        for (std::thread& thread : pool)
+        {
+          thread.join();
+        }
+      },
+      threads, grainScale);
+  }
+  ~ThreadRunner() { setChunkRunner({}, 1); }
+};
 } // namespace test
 } // namespace blockforge

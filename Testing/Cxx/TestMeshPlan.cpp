@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include <memory>
+
 using namespace blockforge;
 using namespace blockforge::model;
 
@@ -406,6 +408,39 @@ TEST(MeshPlan, MovingOneControlPointUpdatesOnlyItsBlocks)
   {
     EXPECT_TRUE(test::sameBits(plan.blockNodes(b), initial.xyz[b])) << "block " << b;
   }
+}
+
+TEST(MeshPlan, ThreadsGiveTheSameBits)
+{
+  // The update runs its arc-length tables, edges, faces and blocks in chunks on threads
+  // when a runner is installed: the same moves on two threads (chunks as small as they
+  // go) and on one give the same grids, and those are the fresh mesher's.
+  const Passage& passage = rotor37Passage();
+  MeshPlan serial(passage.model, passage.carriers);
+  MeshPlan threaded(passage.model, passage.carriers);
+  const int oa = vertexIndex(serial.model(), "oa_f_h");
+  const FreeParameter s = sParameter(freeParameters(serial.model(), serial.carriers()), oa);
+  const double original = serial.model().vertices[oa].constraint.s;
+  const auto move = [&](MeshPlan& plan, double value, int threads) {
+    std::unique_ptr<test::ThreadRunner> runner;
+    if (threads > 1)
+    {
+      runner.reset(new test::ThreadRunner(threads));
+    }
+    return plan.update(moveParameter(plan.model(), plan.carriers(), s, value));
+  };
+  for (const double delta : { 0.0035, -0.0021 })
+  {
+    SCOPED_TRACE(delta);
+    ASSERT_TRUE(move(serial, original + delta, 1).feasible());
+    ASSERT_TRUE(move(threaded, original + delta, 2).feasible());
+    EXPECT_EQ(threaded.updatedBlocks(), serial.updatedBlocks());
+    for (int b = 0; b < serial.blockCount(); ++b)
+    {
+      EXPECT_TRUE(test::sameBits(threaded.blockNodes(b), serial.blockNodes(b))) << "block " << b;
+    }
+  }
+  expectSameAsFreshMesher(threaded);
 }
 
 TEST(MeshPlan, InfeasibleMovesAreValuesNamingTheBlock)

@@ -178,37 +178,7 @@ void expectPartsEqualWhole(const MeshedCase& c)
   }
 }
 
-/// Installs a runner on `threads` std::threads (chunks handed out in turn) and removes it
-/// when it goes out of scope. `grainScale` makes even small grids split into chunks.
-class ThreadRunner
-{
-public:
-  explicit ThreadRunner(int threads, double grainScale = 1e-4)
-  {
-    setChunkRunner(
-      [threads](long count, const std::function<void(long, long)>& body)
-      {
-        std::vector<std::thread> pool;
-        for (int t = 0; t < threads; ++t)
-        {
-          pool.emplace_back(
-            [=, &body]
-            {
-              for (long chunk = t; chunk < count; chunk += threads)
-              {
-                body(chunk, chunk + 1);
-              }
-            });
-        }
-        for (std::thread& thread : pool)
-        {
-          thread.join();
-        }
-      },
-      threads, grainScale);
-  }
-  ~ThreadRunner() { setChunkRunner({}, 1); }
-};
+using test::ThreadRunner;
 
 TEST(Partition, DistributorPartsEqualWhole)
 {
