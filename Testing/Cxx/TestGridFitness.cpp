@@ -239,16 +239,6 @@ double surfaceDistance(const CarrierGeometry& geometry, int carrier, const Vec3&
   return d;
 }
 
-double chordOf(const TemplateInputs& inputs)
-{
-  const auto& p = inputs.pointSets[2].curves[0].points;
-  double chord = 0.0;
-  for (const Vec3& a : p)
-    for (const Vec3& b : p)
-      chord = std::max(chord, (a - b).norm());
-  return chord;
-}
-
 void checkFitness(const std::string& templateName, const Machine& machine)
 {
   const TemplateInputs inputs = test::readTemplateInputs(machine.file);
@@ -258,7 +248,7 @@ void checkFitness(const std::string& templateName, const Machine& machine)
     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const Cylindrical cyl(inputs.axis);
   const double pitch = 2.0 * Pi / model.machine.bladeCount;
-  const double chord = chordOf(inputs);
+  const double chord = test::chordOf(inputs);
   const CarrierGeometry geometry(model);
   for (double density : { 0.5, 1.0, 2.0, 4.0 })
   {

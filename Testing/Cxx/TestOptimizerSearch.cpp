@@ -3,6 +3,8 @@
 #include "GridObjective.h"
 #include "Search.h"
 
+#include "TestBlockNodes.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,29 +19,8 @@ namespace
 {
 const double degrees = 180.0 / M_PI;
 
-struct Grid
-{
-  int ni, nj, nk;
-  std::vector<double> xyz;
-  BlockGrid block() const { return { xyz.data(), ni, nj, nk }; }
-};
-
-Grid makeGrid(int ni, int nj, int nk, const std::function<Vec3(int, int, int)>& at)
-{
-  Grid g{ ni, nj, nk, {} };
-  for (int k = 0; k < nk; ++k)
-  {
-    for (int j = 0; j < nj; ++j)
-    {
-      for (int i = 0; i < ni; ++i)
-      {
-        const Vec3 p = at(i, j, k);
-        g.xyz.insert(g.xyz.end(), { p.x(), p.y(), p.z() });
-      }
-    }
-  }
-  return g;
-}
+using Grid = test::BlockNodes;
+const auto makeGrid = test::makeBlockNodes;
 
 /// A unit-spaced block whose layers k > 0 are sheared along x by tan(angle) per layer.
 Grid shearedBlock(int n, double angle)

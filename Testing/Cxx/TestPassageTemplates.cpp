@@ -135,16 +135,6 @@ double passageVolume(const TemplateInputs& inputs, double pitch, double z0, doub
   return annulus - std::abs(blade);
 }
 
-double chordOf(const TemplateInputs& inputs)
-{
-  const auto& p = inputs.pointSets[2].curves[0].points;
-  double chord = 0.0;
-  for (const Vec3& a : p)
-    for (const Vec3& b : p)
-      chord = std::max(chord, (a - b).norm());
-  return chord;
-}
-
 struct Checked
 {
   std::array<long long, 5> classes{};
@@ -164,7 +154,7 @@ Checked checkPassage(const std::string& templateName, const DataSet& data,
   const double pitch = 2.0 * Pi / model.machine.bladeCount;
   const Grid grid = meshAll(model);
   const CarrierGeometry geometry(model);
-  const double chord = chordOf(inputs);
+  const double chord = test::chordOf(inputs);
 
   // patches
   std::set<std::string> names;

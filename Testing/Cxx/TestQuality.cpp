@@ -1,6 +1,8 @@
 // Cell quality measures (Filters/Core/Quality.h).
 #include "Quality.h"
 
+#include "TestBlockNodes.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -34,35 +36,8 @@ Corners shearedCube(double angle)
   return c;
 }
 
-/// Nodes of a structured block from a function of the node indices.
-struct Grid
-{
-  int ni, nj, nk;
-  std::vector<double> xyz;
-  StructuredBlock block() const { return { xyz.data(), ni, nj, nk }; }
-  Vec3 node(int i, int j, int k) const
-  {
-    const long n = i + static_cast<long>(ni) * (j + static_cast<long>(nj) * k);
-    return Vec3(xyz[3 * n], xyz[3 * n + 1], xyz[3 * n + 2]);
-  }
-};
-
-Grid makeGrid(int ni, int nj, int nk, const std::function<Vec3(int, int, int)>& at)
-{
-  Grid g{ ni, nj, nk, {} };
-  for (int k = 0; k < nk; ++k)
-  {
-    for (int j = 0; j < nj; ++j)
-    {
-      for (int i = 0; i < ni; ++i)
-      {
-        const Vec3 p = at(i, j, k);
-        g.xyz.insert(g.xyz.end(), { p.x(), p.y(), p.z() });
-      }
-    }
-  }
-  return g;
-}
+using Grid = test::BlockNodes;
+const auto makeGrid = test::makeBlockNodes;
 
 Corners cellCorners(const Grid& g, int i, int j, int k)
 {

@@ -49,6 +49,44 @@ def load_plugin(namespace):
     LoadPlugin(os.environ["BLOCKFORGE_PLUGIN"], remote=False, ns=namespace)
 
 
+def mpi_ranks(failures, expected=2):
+    """The number of ranks of the running pvbatch (ParaView's global controller); appends
+    to `failures` when it is not `expected`."""
+    from paraview import servermanager  # not at the top: python3 has no paraview
+
+    controller = servermanager.vtkProcessModule.GetProcessModule().GetGlobalController()
+    ranks = controller.GetNumberOfProcesses()
+    if ranks != expected:
+        failures.append(f"expected {expected} MPI ranks, got {ranks}")
+    return ranks
+
+
+def optimized_pipeline(namespace, template, input_file=None, density=1.0):
+    """reader -> BlockTemplate (or BlockTemplateSource without input) -> BlockOptimizer ->
+    BlockMesher -> GridQuality, built from the proxy constructors load_plugin put in
+    `namespace`, and updated. The optimizer runs at the mesher's density, as
+    blockforge.mesh_template does, so a serial mesh_template run is the reference."""
+    if input_file:
+        reader = namespace["TurboPointSetsReader"](FileName=input_file)
+        model = namespace["BlockTemplate"](Input=reader, TemplateFile=template)
+    else:
+        model = namespace["BlockTemplateSource"](TemplateFile=template)
+    model = namespace["BlockOptimizer"](Input=model, DensityMultiplier=density)
+    grid = namespace["BlockMesher"](Input=model, DensityMultiplier=density)
+    quality = namespace["GridQuality"](Input=grid)
+    quality.UpdatePipeline()
+    return quality
+
+
+def check_written_by_every_rank(label, folder, ranks, failures):
+    """Appends to `failures` unless ParaView's parallel .vtm writer wrote blocks of every
+    rank into `folder` (it names a block's file <name>_<block>_<rank>.vts), which shows the
+    blocks were shared out between the ranks."""
+    writers = sorted({name.rsplit("_", 1)[1].split(".")[0] for name in os.listdir(folder)})
+    if writers != [str(r) for r in range(ranks)]:
+        failures.append(f"{label}: blocks written by ranks {writers}, expected every rank")
+
+
 def run_gui(script, output, result_name, exit_after_script=True):
     """Runs the ParaView GUI under xvfb-run on `script` (`paraview --dr --script=...`, with
     `--exit` unless the script ends the process itself), the plugin autoloaded from

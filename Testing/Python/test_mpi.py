@@ -22,11 +22,8 @@ import bftest
 
 bftest.load_plugin(globals())
 
-controller = servermanager.vtkProcessModule.GetProcessModule().GetGlobalController()
-ranks = controller.GetNumberOfProcesses()
 failures = []
-if ranks != 2:
-    failures.append(f"expected 2 MPI ranks, got {ranks}")
+ranks = bftest.mpi_ranks(failures)
 
 
 def bits(array):
@@ -86,17 +83,9 @@ def compare_fields(label, parallel, serial):
 
 
 def check_case(label, template, input_file=None, density=1.0):
-    if input_file:
-        reader = TurboPointSetsReader(FileName=input_file)  # noqa: F821
-        model = BlockTemplate(Input=reader, TemplateFile=template)  # noqa: F821
-    else:
-        model = BlockTemplateSource(TemplateFile=template)  # noqa: F821
     # Every rank optimizes the whole model (deterministic: the same on every rank and in
     # the serial run, which mesh_template optimizes by default, on the final grid).
-    model = BlockOptimizer(Input=model, DensityMultiplier=density)  # noqa: F821
-    grid = BlockMesher(Input=model, DensityMultiplier=density)  # noqa: F821
-    quality = GridQuality(Input=grid)  # noqa: F821
-    quality.UpdatePipeline()
+    quality = bftest.optimized_pipeline(globals(), template, input_file, density)
 
     # The same pipeline in plain VTK, one process, no pieces.
     serial = blockforge.mesh_template(template, density_multiplier=density,
@@ -115,10 +104,8 @@ def check_case(label, template, input_file=None, density=1.0):
     compare_grids(label + " (written)", reader.GetOutput(), serial_grid)
     # Both ranks meshed and wrote a share: the parallel writer names a block's file
     # <name>_<block>_<rank>.vts.
-    written = os.listdir(os.path.join(os.path.dirname(path), f"mpi_{label}"))
-    writers = sorted({name.rsplit("_", 1)[1].split(".")[0] for name in written})
-    if writers != [str(r) for r in range(ranks)]:
-        failures.append(f"{label}: blocks written by ranks {writers}, expected every rank")
+    bftest.check_written_by_every_rank(
+        label, os.path.join(os.path.dirname(path), f"mpi_{label}"), ranks, failures)
 
     print(f"{label}: {cells} cells equal the serial run in every array")
 

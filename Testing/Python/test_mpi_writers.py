@@ -17,7 +17,6 @@ import os
 import shutil
 import subprocess
 
-from paraview import servermanager
 from paraview.simple import SaveData
 
 import blockforge
@@ -27,11 +26,8 @@ import bftest
 
 bftest.load_plugin(globals())
 
-controller = servermanager.vtkProcessModule.GetProcessModule().GetGlobalController()
-ranks = controller.GetNumberOfProcesses()
 failures = []
-if ranks != 2:
-    failures.append(f"expected 2 MPI ranks, got {ranks}")
+ranks = bftest.mpi_ranks(failures)
 
 # (extension, options of SaveData, binary flag of the serial writer)
 FORMATS = [("foam", {}, True), ("foam", {"Binary": 0}, False),
@@ -66,15 +62,7 @@ def compare_folders(label, parallel, serial):
 
 
 def check_case(label, template, input_file=None):
-    if input_file:
-        reader = TurboPointSetsReader(FileName=input_file)  # noqa: F821
-        model = BlockTemplate(Input=reader, TemplateFile=template)  # noqa: F821
-    else:
-        model = BlockTemplateSource(TemplateFile=template)  # noqa: F821
-    model = BlockOptimizer(Input=model)  # noqa: F821 (mesh_template optimizes too)
-    grid = BlockMesher(Input=model)  # noqa: F821
-    quality = GridQuality(Input=grid)  # noqa: F821
-    quality.UpdatePipeline()
+    quality = bftest.optimized_pipeline(globals(), template, input_file)
     serial = blockforge.mesh_template(template, input_file=input_file).GetOutputDataObject(0)
 
     root = bftest.output_path(f"mpi_writers_{label}")
@@ -93,10 +81,8 @@ def check_case(label, template, input_file=None):
     # block's file <name>_<block>_<rank>.vts.
     vtm = os.path.join(root, "mpi", "pieces.vtm")
     SaveData(vtm, proxy=quality)
-    written = os.listdir(os.path.join(root, "mpi", "pieces"))
-    writing_ranks = sorted({name.rsplit("_", 1)[1].split(".")[0] for name in written})
-    if writing_ranks != [str(r) for r in range(ranks)]:
-        failures.append(f"{label}: blocks meshed by ranks {writing_ranks}, expected every rank")
+    bftest.check_written_by_every_rank(label, os.path.join(root, "mpi", "pieces"), ranks,
+                                       failures)
     print(f"{label}: {compared} files written under MPI equal the serial run's", flush=True)
     return quality
 
