@@ -104,6 +104,10 @@ struct UniqueEdge : TopologyEdge
   /// of projections from a matched edge).
   int projectedFrom = -1;
   bool projectedAfterMatch = false;
+  /// Match with a lean limit (DistributionLaw::leanLimit, 0: none): the shortest end
+  /// cells at a and b that lean no more than that from the edge's chord (0: any).
+  double matchLean = 0.0;
+  std::array<double, 2> matchFloor{ { 0.0, 0.0 } };
   std::vector<double> params;
   std::vector<double> xyz;
 };
@@ -134,10 +138,6 @@ struct MeshTopology
   /// Projected unique edges, each after the edge it projects from.
   std::vector<int> projectionOrder;
 };
-
-/// Node counts of a block at a density multiplier (max(1, round(cells * m)) cells per
-/// direction, at most `cap` when cap > 0), plus one.
-std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int cap);
 
 MeshTopology buildMeshTopology(const BlockModel& model, const CarrierGeometry& geometry,
   const std::vector<NamedCurve>& curves, const std::vector<std::array<int, 3>>& nodes,
@@ -187,6 +187,16 @@ void projectEdgeParameters(const BlockModel& model, const std::vector<NamedCurve
 void computeEdgeGrading(const BlockModel& model, const std::vector<NamedCurve>& curves,
   const CarrierGeometry& geometry, MeshTopology& topology, std::vector<char>* changed,
   bool allowFallback);
+/**
+ * The end-cell floors of the matched edges with a lean limit (UniqueEdge::matchFloor): at
+ * each end, the arc length along the edge's curve at which the chord from the end first
+ * leans no more than the limit from the edge's chord (bisection on the curve, the same
+ * bits every time). Straight edges and ends that already comply get 0. Run again when the
+ * edges' vertices moved, before matchEdgeEnds, which makes every group's cell at least
+ * its members' floors.
+ */
+void computeMatchFloors(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  MeshTopology& topology);
 /// Parameters of the collapsed edges of block `b`.
 void computeCollapsedParameters(const BlockModel& model, MeshTopology& topology, int b);
 
