@@ -284,52 +284,59 @@ TEST(ProjectedEdges, MovingTheSourceUpdatesTheProjectionAsAFreshMesherDoes)
 
 TEST(ProjectedEdges, ErrorsNameTheEdges)
 {
-  // different cell counts: the source in one block, the projected edge in another
-  const std::string counts = R"yaml(blockforge: 1
-vertices:
-  a0: [0, 0, 0]
-  a1: [1, 0, 0]
-  a2: [1, 1, 0]
-  a3: [0, 1, 0]
-  a4: [0, 0, 1]
-  a5: [1, 0, 1]
-  a6: [1, 1, 1]
-  a7: [0, 1, 1]
-  b0: [0, 2, 0]
-  b1: [1, 2, 0]
-  b2: [1, 3, 0]
-  b3: [0, 3, 0]
-  b4: [0, 2, 1]
-  b5: [1, 2, 1]
-  b6: [1, 3, 1]
-  b7: [0, 3, 1]
-edges:
-  front: {line: [a0, a1]}
-  other: {line: [b0, b1]}
-blocks:
-  A: {vertices: [a0, a1, a2, a3, a4, a5, a6, a7], cells: [4, 1, 1]}
-  B: {vertices: [b0, b1, b2, b3, b4, b5, b6, b7], cells: [6, 1, 1], grading: {edges: {E1: {project_from: front}}}}
-)yaml";
-  const std::string mismatch = errorOf(counts);
-  EXPECT_TRUE(contains(mismatch, "edge 'other' (b0-b1) takes its nodes from edge 'front' (a0-a1)"))
+  // Two unit cubes side by side along x (Testing/Data/two_blocks.yaml), their bottom front
+  // edges named: 'front' (a0-a1, left block E1) and 'other' (a1-b1, right block E1).
+  BlockModel base = loadTemplate(test::sourcePath("Testing/Data/two_blocks.yaml"));
+  for (const auto& ends : { std::make_pair("a0", "a1"), std::make_pair("a1", "b1") })
+  {
+    Edge edge;
+    edge.name = base.edges.empty() ? "front" : "other";
+    edge.from = base.findVertex(ends.first);
+    edge.to = base.findVertex(ends.second);
+    base.edges.push_back(edge);
+  }
+  DistributionLaw fromFront;
+  fromFront.kind = DistributionLaw::Kind::ProjectFrom;
+  fromFront.sourceEdge = 0;
+  DistributionLaw fromOther = fromFront;
+  fromOther.sourceEdge = 1;
+  const auto errorFor = [](const BlockModel& model) {
+    try
+    {
+      test::meshAll(model);
+    }
+    catch (const TemplateError& error)
+    {
+      return std::string(error.what());
+    }
+    ADD_FAILURE() << "no error";
+    return std::string();
+  };
+
+  // different cell counts
+  BlockModel counts = base;
+  counts.blocks[1].cells[0] = 6;
+  counts.blocks[1].laws[0] = fromFront;
+  const std::string mismatch = errorFor(counts);
+  EXPECT_TRUE(contains(mismatch, "edge 'other' (a1-b1) takes its nodes from edge 'front' (a0-a1)"))
     << mismatch;
   EXPECT_TRUE(contains(mismatch, "has 6 cells against its 4")) << mismatch;
-  EXPECT_TRUE(contains(mismatch, "block 'B'")) << mismatch;
+  EXPECT_TRUE(contains(mismatch, "block 'right'")) << mismatch;
 
-  // two edges taking their nodes from one another
-  const std::string cycle = errorOf(test::replaced(counts,
-    "  A: {vertices: [a0, a1, a2, a3, a4, a5, a6, a7], cells: [4, 1, 1]}",
-    "  A: {vertices: [a0, a1, a2, a3, a4, a5, a6, a7], cells: [6, 1, 1], grading: {edges: {E1: "
-    "{project_from: other}}}}"));
-  EXPECT_TRUE(contains(cycle, "take their nodes from one another")) << cycle;
-  EXPECT_TRUE(contains(cycle, "'front'") && contains(cycle, "'other'")) << cycle;
+  // two edges taking their nodes from one another, and an edge from itself
+  BlockModel cycle = base;
+  cycle.blocks[0].laws[0] = fromOther;
+  cycle.blocks[1].laws[0] = fromFront;
+  const std::string both = errorFor(cycle);
+  EXPECT_TRUE(contains(both, "take their nodes from one another")) << both;
+  EXPECT_TRUE(contains(both, "'front'") && contains(both, "'other'")) << both;
+  BlockModel self = base;
+  self.blocks[1].laws[0] = fromOther;
+  EXPECT_TRUE(contains(errorFor(self), "take their nodes from one another"));
 
-  // an edge that projects from itself
-  const std::string self = errorOf(test::replaced(counts, "project_from: front", "project_from: other"));
-  EXPECT_TRUE(contains(self, "take their nodes from one another")) << self;
-
-  // an unknown name, with the nearest one suggested
-  const std::string unknown = errorOf(test::replaced(counts, "project_from: front", "project_from: frnt"));
-  EXPECT_TRUE(contains(unknown, "grading E1 project_from: unknown edge 'frnt' (did you mean 'front'?)"))
+  // an unknown name in a template, with the nearest one suggested
+  const std::string unknown = errorOf(quarterRing("{geometric: 1.2}", "{project_from: im#}"));
+  EXPECT_TRUE(
+    contains(unknown, "grading E3 project_from: unknown edge 'im0' (did you mean 'in0'?)"))
     << unknown;
 }
