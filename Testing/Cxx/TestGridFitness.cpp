@@ -42,7 +42,7 @@ using test::Pi;
  */
 double maxNeighbourRatio(const std::string& templateName)
 {
-  return templateName == "axial_passage_h" ? 1.8 : 600.0;
+  return templateName == "axial_passage_h" ? 1.5 : 600.0;
 }
 
 struct Machine
