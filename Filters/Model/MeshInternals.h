@@ -132,10 +132,6 @@ struct MeshTopology
   std::vector<std::pair<int, int>> matchCopies;
 };
 
-/// Node counts of a block at a density multiplier (max(1, round(cells * m)) cells per
-/// direction, at most `cap` when cap > 0), plus one.
-std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int cap);
-
 MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedCurve>& curves,
   const std::vector<std::array<int, 3>>& nodes, bool allowFallback);
 /// Node parameters of unique edge `e` from the laws of the blocks that use it (checked to
