@@ -498,8 +498,14 @@ int BSplineCurve::span(double t) const
   {
     return bspline::findSpan(Degree, Knots, count, t); // ends, NaN
   }
-  // Inside, exactly one span k has Knots[k] <= t < Knots[k + 1]: walk to it from the
-  // table (a step or two), the same span the bisection finds.
+  // Inside, exactly one span k has Knots[k] <= t < Knots[k + 1]: the last one found if
+  // it still holds, else a walk from the table (a step or two), the same span the
+  // bisection finds.
+  const int last = LastSpan.Span.load(std::memory_order_relaxed);
+  if (last >= Degree && last <= n && Knots[last] <= t && t < Knots[last + 1])
+  {
+    return last;
+  }
   const int bins = static_cast<int>(SpanTable.size()) - 1;
   const double place = (t - Knots[Degree]) / (Knots[n + 1] - Knots[Degree]) * bins;
   int k = SpanTable[std::max(0, std::min(bins - 1, static_cast<int>(place)))];
@@ -511,6 +517,7 @@ int BSplineCurve::span(double t) const
   {
     ++k;
   }
+  LastSpan.Span.store(k, std::memory_order_relaxed);
   return k;
 }
 

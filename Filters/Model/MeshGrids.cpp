@@ -80,6 +80,7 @@ MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedC
   }
   if (!topology.matchGroups.empty())
   {
+    computeMatchFloors(model, curves, topology);
     matchEdgeEnds(model, topology);
   }
   for (std::size_t e = 0; e < topology.edges.size(); ++e)
@@ -615,19 +616,27 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
     loop.push_back(node(left, b));
   const int loopSize = static_cast<int>(loop.size());
   std::vector<Eigen::Vector2d> st(loopSize);
-  for (int k = 0; k < loopSize; ++k)
-  {
-    double s = 0.0, t = 0.0, distance = 0.0;
-    if (cache)
+  // Each node is projected, and below each interior node placed, on its own: in chunks
+  // on threads when a runner is installed (a face computed inside another chunked loop
+  // runs in that loop's thread), the same bits.
+  const long loopChunks = std::min<long>(loopSize, 16);
+  forEachChunk(loopChunks, [&](long chunk) {
+    const int first = static_cast<int>(chunk * loopSize / loopChunks);
+    const int last = static_cast<int>((chunk + 1) * loopSize / loopChunks);
+    for (int k = first; k < last; ++k)
     {
-      cache->project(geometry, carrier, loop[k], s, t);
+      double s = 0.0, t = 0.0, distance = 0.0;
+      if (cache)
+      {
+        cache->project(geometry, carrier, loop[k], s, t);
+      }
+      else
+      {
+        geometry.project(carrier, loop[k], s, t, distance);
+      }
+      st[k] = Eigen::Vector2d(s, t);
     }
-    else
-    {
-      geometry.project(carrier, loop[k], s, t, distance);
-    }
-    st[k] = Eigen::Vector2d(s, t);
-  }
+  });
   // Unwrap across the seam of closed directions.
   const bool closed[2] = { geometry.closedS(carrier), geometry.closedT(carrier) };
   for (int k = 1; k < loopSize; ++k)
@@ -665,8 +674,8 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
   std::vector<double> targets(parameters.size());
   transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), targets.data());
   out.resize(parameters.size());
-  for (int b = 1; b + 1 < nb; ++b)
-  {
+  forEachChunk(std::max(0, nb - 2), [&](long row) {
+    const int b = static_cast<int>(row) + 1;
     for (int a = 1; a + 1 < na; ++a)
     {
       const std::size_t i = static_cast<std::size_t>(b) * na + a;
@@ -682,7 +691,7 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
       }
       std::copy_n(p.data(), 3, &out[3 * i]);
     }
-  }
+  });
   copyFaceBoundary(model, topology, block, face, na, nb, out);
 }
 

@@ -323,6 +323,7 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
   // matched edges follow the graded edges and the lengths at their ends
   if (!Topo.matchGroups.empty())
   {
+    computeMatchFloors(model, Curves, Topo);
     for (const int u : matchEdgeEnds(model, Topo))
     {
       changedEdge[u] = 1;
@@ -389,19 +390,15 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
       changedFace[onSurface.first] = 1;
     }
   }
-  std::vector<int> gridFaces;
+  // The nodes of a face on a surface are placed on threads inside (surfaceFace), which
+  // balances better than whole faces of unequal cost.
   for (std::size_t f = 0; f < Topo.faces.size(); ++f)
   {
     if (changedFace[f] && !IsImage[f])
     {
-      gridFaces.push_back(static_cast<int>(f));
+      computeFaceGrid(model, Geometry, OnSurface, Topo, static_cast<int>(f), &Projections);
     }
   }
-  // Each face grid is made from its own edges into its own storage (as in
-  // computeAllBoundaries): on threads when a runner is installed, the same bits.
-  forEachChunk(static_cast<long>(gridFaces.size()), [&](long n) {
-    computeFaceGrid(model, Geometry, OnSurface, Topo, gridFaces[n], &Projections);
-  });
   for (const PeriodicPair& pair : Topo.connectivity.periodic)
   {
     if (changedFace[pair.source] || changedFace[pair.image])

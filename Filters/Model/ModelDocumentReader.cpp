@@ -258,15 +258,24 @@ private:
     return *found;
   }
 
-  int vertexRef(const YAML::Node& node, int line, const std::string& entityText) const
+  /// The index `find` gives the name in `node` (a `kind`: vertex, carrier), or an error.
+  template <typename Find>
+  int namedRef(const YAML::Node& node, int line, const std::string& entityText,
+    const std::string& kind, const Find& find) const
   {
-    const std::string name = text(node, line, entityText, "vertex");
-    const int index = Model.findVertex(name);
+    const std::string name = text(node, line, entityText, kind);
+    const int index = find(name);
     if (index < 0)
     {
-      fail(here(node, line), entityText, "unknown vertex '" + name + "'");
+      fail(here(node, line), entityText, "unknown " + kind + " '" + name + "'");
     }
     return index;
+  }
+
+  int vertexRef(const YAML::Node& node, int line, const std::string& entityText) const
+  {
+    return namedRef(node, line, entityText, "vertex",
+      [this](const std::string& name) { return Model.findVertex(name); });
   }
 
   void readVertex(const YAML::Node& node)
@@ -761,13 +770,8 @@ private:
 
   int carrierRef(const YAML::Node& node, int line, const std::string& entityText) const
   {
-    const std::string name = text(node, line, entityText, "carrier");
-    const int index = Model.findCarrier(name);
-    if (index < 0)
-    {
-      fail(here(node, line), entityText, "unknown carrier '" + name + "'");
-    }
-    return index;
+    return namedRef(node, line, entityText, "carrier",
+      [this](const std::string& name) { return Model.findCarrier(name); });
   }
 
   /// The items of list `key` (empty when absent), each read by `item(node, line)`.
