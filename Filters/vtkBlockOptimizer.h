@@ -68,7 +68,8 @@ public:
   ///@}
 
   ///@{
-  /// Largest number of grid evaluations of the automatic run (default 400).
+  /// Largest number of grid evaluations of the automatic run (default 400); the compass
+  /// search counts the trials it leaves out because they cannot gain as evaluations.
   vtkSetClampMacro(MaximumEvaluations, int, 1, 1000000);
   vtkGetMacro(MaximumEvaluations, int);
   ///@}

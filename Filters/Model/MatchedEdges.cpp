@@ -270,10 +270,15 @@ std::vector<int> matchEdgeEnds(const BlockModel& model, MeshTopology& topology)
   return changed;
 }
 void computeMatchFloors(const BlockModel& model, const std::vector<NamedCurve>& curves,
-  MeshTopology& topology)
+  MeshTopology& topology, const std::vector<char>* changed)
 {
-  for (UniqueEdge& edge : topology.edges)
+  for (std::size_t e = 0; e < topology.edges.size(); ++e)
   {
+    UniqueEdge& edge = topology.edges[e];
+    if (changed && !(*changed)[e])
+    {
+      continue;
+    }
     edge.matchFloor = { { 0.0, 0.0 } };
     if (!edge.matched || !(edge.matchLean > 0.0) || edge.named < 0)
     {
@@ -305,7 +310,9 @@ void computeMatchFloors(const BlockModel& model, const std::vector<NamedCurve>& 
         const double n = chord.norm();
         return n > 0.0 && chord.dot(course) >= cosLimit * n;
       };
-      double low = 1.0 / 65536.0;
+      // a cell of 1/4096 of the edge that complies needs no floor (the cells the limit is
+      // for are a fraction of an edge's radius of curvature long, far more)
+      double low = 1.0 / 4096.0;
       if (complies(low))
       {
         continue;
@@ -320,7 +327,7 @@ void computeMatchFloors(const BlockModel& model, const std::vector<NamedCurve>& 
       {
         continue; // leans across its whole first half: not an edge this limit is for
       }
-      for (int iteration = 0; iteration < 30; ++iteration)
+      for (int iteration = 0; iteration < 24; ++iteration) // to 6e-8 of the bracket
       {
         const double mid = 0.5 * (low + high);
         (complies(mid) ? high : low) = mid;

@@ -193,10 +193,10 @@ void computeEdgeGrading(const BlockModel& model, const std::vector<NamedCurve>& 
  * leans no more than the limit from the edge's chord (bisection on the curve, the same
  * bits every time). Straight edges and ends that already comply get 0. Run again when the
  * edges' vertices moved, before matchEdgeEnds, which makes every group's cell at least
- * its members' floors.
+ * its members' floors. With `changed`, only the edges flagged there (their curves moved).
  */
 void computeMatchFloors(const BlockModel& model, const std::vector<NamedCurve>& curves,
-  MeshTopology& topology);
+  MeshTopology& topology, const std::vector<char>* changed = nullptr);
 /// Parameters of the collapsed edges of block `b`.
 void computeCollapsedParameters(const BlockModel& model, MeshTopology& topology, int b);
 

@@ -248,7 +248,7 @@ void computeEdgeGrading(const BlockModel& model, const std::vector<NamedCurve>& 
   project(false);
   if (!topology.matchGroups.empty())
   {
-    computeMatchFloors(model, curves, topology);
+    computeMatchFloors(model, curves, topology, changed); // the floors of moved curves
     for (const int u : matchEdgeEnds(model, topology))
     {
       if (changed)

@@ -47,9 +47,10 @@ CASES = [("cylinder_in_box", "cylinder_in_box", None, False),
 ALLOWED_FAILURES = {
     # 20 of the 60 prisms on the axis are slivers (aspect ratio 32).
     "wedge_sector": {"determinant"},
-    # The turbine's inlet is 10 % of a chord from its thick round leading edge: graded to
-    # match the short upstream blocks (law match), the blade-side cells at the leading and
-    # trailing edges are thin across the blade (62 cells below 0.001).
+    # The turbine's blade turns the flow by 70 degrees and more: its trailing edge meets the
+    # axial trailing-edge plane at an acute angle, and the last two cells along side b there
+    # are sheared flat (4 cells below 0.001, aspect ratio 11-13; 62 before the template put
+    # fewer cells into its short inlet and outlet gaps).
     "axial_passage_h_turbine": {"determinant"},
     # Thin cells on the blade (O-grid expansion k_o towards the wall, aspect ratio up to
     # 37); and where the O-grid's leading/trailing-edge blocks meet its side blocks the cell
@@ -68,15 +69,11 @@ ALLOWED_FAILURES = {
     "axial_passage_oh_turbine_optimized": {"determinant"},
     "axial_passage_oh_compressor_optimized": {"determinant", "interpolation weight", "concave",
                                               "volume ratio"},
-    # The optimizer (which maximises the smallest angle, blind to cell size) shifts how the
-    # H-grid splits the pitch and squeezes some blocks' hub cells across it (measured on
-    # Rotor 37 before issue 7's merge: BR, AR, DR down to 0.65-0.71 degrees of the 10 degree
-    # pitch, cells 0.2-0.3 mm across it against 4-6 mm along chord and span): a few cells
-    # with a cell determinant below 0.001 (distributor 4, Rotor 37 2, compressor 1). On the
-    # turbine the thin blade-side cells of the template's grid (above).
-    "axial_passage_h_distributor_optimized": {"determinant"},
-    "axial_passage_h_rotor37_optimized": {"determinant"},
-    "axial_passage_h_compressor_optimized": {"determinant"},
+    # Optimized H grids pass but on the turbine: the optimizer (which maximises the smallest
+    # angle, blind to cell size) squeezes the downstream blocks' last cells at the outlet by
+    # the shroud across the pitch (3 cells below 0.001, aspect ratio 15-31). The distributor,
+    # Rotor 37 and the compressor failed with 4, 2 and 1 cells before the H template's lean
+    # limit; now they must pass.
     "axial_passage_h_turbine_optimized": {"determinant"},
 }
 

@@ -32,6 +32,7 @@ struct SearchSettings
   /// Compass by default: on the passage templates it reached 1-4 degrees more than
   /// BOBYQA, with evaluations about 5 times cheaper (README, "The optimizer").
   SearchAlgorithm algorithm = SearchAlgorithm::Compass;
+  /// Evaluations at most (compass: trials, evaluated or left out by a TrialFilter).
   int maxEvaluations = 400;
   /// Stop when a step changes the objective by less than this (degrees for the angle
   /// objectives) or moves every variable by less than 1e-9 of its range.
