@@ -51,6 +51,7 @@
 #include <functional>
 #include <iostream>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -278,18 +279,45 @@ const Applied& appliedWithoutChains()
   return result;
 }
 
+/**
+ * The control point the entries move: the O-grid corner `oa_f_h` when the template has
+ * one (the figures of earlier builds), else the vertex with a free parameter that most
+ * vertices follow (the template is redesigned from time to time; the entry must keep
+ * measuring a move with followers).
+ */
+model::FreeParameter movedParameter(const model::BlockModel& model, const model::CarrierGeometry& carriers)
+{
+  const std::vector<model::FreeParameter> parameters = model::freeParameters(model, carriers);
+  const std::vector<std::vector<int>> dependents = model::vertexDependents(model);
+  const int corner = model.findVertex("oa_f_h");
+  const model::FreeParameter* best = nullptr;
+  for (const model::FreeParameter& p : parameters)
+  {
+    if (p.component != 0)
+    {
+      continue;
+    }
+    if (p.vertex == corner)
+    {
+      return p;
+    }
+    if (!best || dependents[p.vertex].size() > dependents[best->vertex].size())
+    {
+      best = &p;
+    }
+  }
+  if (!best)
+  {
+    throw std::runtime_error("the template has no vertex with a free parameter to move");
+  }
+  return *best;
+}
+
 void moveOneControlPoint(benchmark::State& state, const Applied& a)
 {
   model::MeshPlan plan(a.model, a.carriers);
-  const int vertex = plan.model().findVertex("oa_f_h");
-  model::FreeParameter parameter;
-  for (const model::FreeParameter& p : model::freeParameters(plan.model(), plan.carriers()))
-  {
-    if (p.vertex == vertex && p.component == 0)
-    {
-      parameter = p;
-    }
-  }
+  const model::FreeParameter parameter = movedParameter(plan.model(), plan.carriers());
+  const int vertex = parameter.vertex;
   const double original = plan.model().vertices[vertex].constraint.s;
   long long step = 0, cells = 0, blocks = 0, infeasible = 0;
   for (auto _ : state)
@@ -364,6 +392,8 @@ int main(int argc, char** argv)
   {
     benchmark::AddCustomContext("template", templatePath());
     benchmark::AddCustomContext("threads", std::to_string(threads));
+    benchmark::AddCustomContext("moved vertex",
+      applied().model.vertices[movedParameter(applied().model, applied().carriers).vertex].name);
     benchmark::AddCustomContext("blocks", std::to_string(applied().model.blocks.size()));
   }
   catch (const std::exception& error)
