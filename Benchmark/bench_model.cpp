@@ -69,8 +69,10 @@ const std::string Source = BLOCKFORGE_SOURCE_DIR;
 /**
  * A pool of threads kept for the whole run (starting threads for every chunked loop
  * would cost more than the small loops of one evaluation): the caller and the workers
- * take chunks in turn. A loop started from inside a chunk runs in the thread that
- * started it, as vtkSMPTools runs nested loops.
+ * take chunks in turn, and the caller waits only for chunks a worker has taken, never
+ * for a worker to wake up (on a loaded machine that can take a time slice). A loop
+ * started from inside a chunk runs in the thread that started it, as vtkSMPTools runs
+ * nested loops.
  */
 class ThreadPool
 {
@@ -99,32 +101,47 @@ public:
 
   void run(long count, const std::function<void(long, long)>& body)
   {
-    if (InChunk || Workers.empty())
+    if (InChunk || Workers.empty() || count <= 1)
     {
       body(0, count);
       return;
     }
+    const auto job = std::make_shared<Job>();
+    job->body = &body;
+    job->count = count;
     {
       std::lock_guard<std::mutex> lock(Mutex);
-      Body = &body;
-      Count = count;
-      Next = 0;
-      Active = static_cast<int>(Workers.size());
+      Current = job;
       ++Generation;
     }
     Wake.notify_all();
-    drain();
+    drain(*job);
     std::unique_lock<std::mutex> lock(Mutex);
-    Done.wait(lock, [this] { return Active == 0; });
+    Done.wait(lock, [&] { return job->finished.load() == job->count; });
   }
 
 private:
-  void drain()
+  /// One loop: chunks are taken by counting up `next`; a worker that wakes after all
+  /// are taken finds none (the job outlives the loop while a worker holds it).
+  struct Job
+  {
+    const std::function<void(long, long)>* body = nullptr;
+    long count = 0;
+    std::atomic<long> next{ 0 };
+    std::atomic<long> finished{ 0 };
+  };
+
+  void drain(Job& job)
   {
     InChunk = true;
-    for (long chunk = Next++; chunk < Count; chunk = Next++)
+    for (long chunk = job.next++; chunk < job.count; chunk = job.next++)
     {
-      (*Body)(chunk, chunk + 1);
+      (*job.body)(chunk, chunk + 1);
+      if (++job.finished == job.count)
+      {
+        std::lock_guard<std::mutex> lock(Mutex);
+        Done.notify_all();
+      }
     }
     InChunk = false;
   }
@@ -133,6 +150,7 @@ private:
     unsigned long seen = 0;
     for (;;)
     {
+      std::shared_ptr<Job> job;
       {
         std::unique_lock<std::mutex> lock(Mutex);
         Wake.wait(lock, [&] { return Stop || Generation != seen; });
@@ -141,13 +159,9 @@ private:
           return;
         }
         seen = Generation;
+        job = Current;
       }
-      drain();
-      std::lock_guard<std::mutex> lock(Mutex);
-      if (--Active == 0)
-      {
-        Done.notify_one();
-      }
+      drain(*job);
     }
   }
 
@@ -155,10 +169,7 @@ private:
   std::vector<std::thread> Workers;
   std::mutex Mutex;
   std::condition_variable Wake, Done;
-  const std::function<void(long, long)>* Body = nullptr;
-  long Count = 0;
-  std::atomic<long> Next{ 0 };
-  int Active = 0;
+  std::shared_ptr<Job> Current;
   unsigned long Generation = 0;
   bool Stop = false;
 };
