@@ -9,9 +9,11 @@
 // Not a test (nothing asserts a time). Prints a Markdown table.
 // Usage: bench_optimizer [--repetitions N] [--evaluations N] [--sharpness K] [--step F]
 //          [--algorithm bobyqa|cobyla|subplex] [--blocks] [--timing] [--csv FILE]
-//          template.yaml input.inf [...]
+//          [--history FILE] [--no-baselines] template.yaml input.inf [...]
 // --blocks: where the smallest angles are (block, cell, grid plane) and which variables end
-// on their bounds; --csv: the table's numbers for Benchmark/optimizer_figure.py.
+// on their bounds; --csv: the table's numbers for Benchmark/optimizer_figure.py; --history:
+// every evaluation of every case (objective, smallest angle, the best so far); --no-baselines:
+// the optimizer alone.
 #include "Optimizer.h"
 
 #include "../Testing/Cxx/TestTurboInputs.h"
@@ -255,7 +257,9 @@ int main(int argc, char** argv)
   int repetitions = 5;
   bool blocks = false;
   bool timing = false;
-  std::string csvFile;
+  bool baselines = true;
+  std::string csvFile, historyFile;
+  FILE* history = nullptr;
   OptimizerSettings settings;
   std::vector<std::pair<std::string, std::string>> cases;
   for (int a = 1; a < argc; ++a)
@@ -293,6 +297,14 @@ int main(int argc, char** argv)
     {
       timing = true;
     }
+    else if (arg == "--history" && a + 1 < argc)
+    {
+      historyFile = argv[++a];
+    }
+    else if (arg == "--no-baselines")
+    {
+      baselines = false;
+    }
     else if (arg == "--csv" && a + 1 < argc)
     {
       csvFile = argv[++a];
@@ -302,6 +314,17 @@ int main(int argc, char** argv)
       cases.emplace_back(argv[a], argv[a + 1]);
       ++a;
     }
+  }
+  if (!historyFile.empty())
+  {
+    history = std::fopen(historyFile.c_str(), "w");
+    if (!history)
+    {
+      std::fprintf(stderr, "cannot write %s\n", historyFile.c_str());
+      return 1;
+    }
+    std::fprintf(history, "template,input,evaluation,objective,min_angle,feasible,seconds,"
+                          "best_objective,best_min_angle\n");
   }
   std::vector<Row> rows;
   for (const auto& [templateFile, inputFile] : cases)
@@ -362,6 +385,27 @@ int main(int argc, char** argv)
     row.searchSeconds = result.search.seconds;
     row.evaluations = result.search.evaluations;
     row.stop = result.search.stopReason;
+    if (history)
+    {
+      // The best so far is what a run limited to that many evaluations returns (the
+      // search is deterministic): the smallest objective no worse than the start.
+      double bestObjective = 0.0, bestAngle = 0.0;
+      for (const HistoryEntry& entry : result.search.history)
+      {
+        const HistoryEntry& start = result.search.history.front();
+        if (entry.evaluation == 1 ||
+          (entry.feasible && entry.objective < bestObjective &&
+            (!start.feasible || entry.minAngle >= start.minAngle)))
+        {
+          bestObjective = entry.objective;
+          bestAngle = entry.minAngle;
+        }
+        std::fprintf(history, "%s,%s,%d,%.9g,%.9g,%d,%.4f,%.9g,%.9g\n", row.templateName.c_str(),
+          row.input.c_str(), entry.evaluation, entry.objective, entry.minAngle,
+          entry.feasible ? 1 : 0, entry.seconds, bestObjective, bestAngle);
+      }
+    }
+    if (baselines)
     {
       const auto begin = std::chrono::steady_clock::now();
       ControlProblem problem(model, geometry, 1.0, settings.objective, {});
@@ -369,6 +413,7 @@ int main(int argc, char** argv)
       row.laplace = problem.evaluate(x);
       row.laplaceSeconds = seconds(begin);
     }
+    if (baselines)
     {
       const auto begin = std::chrono::steady_clock::now();
       ControlProblem problem(model, geometry, 1.0, settings.objective, {});
@@ -382,9 +427,11 @@ int main(int argc, char** argv)
       row.classySeconds = seconds(begin);
     }
     std::fprintf(stderr,
-      "%s: %zu variables, %.2f -> %.2f deg, %d evaluations, %.3f s (CPU %.3f s) (%s)\n",
+      "%s: %zu variables, %.2f -> %.2f deg, %d evaluations (%d trials left out), %.3f s "
+      "(CPU %.3f s, search %.3f s) (%s)\n",
       row.name.c_str(), row.variables, row.before.minAngle, row.after.minAngle,
-      row.evaluations, row.seconds, row.cpuSeconds, row.stop.c_str());
+      row.evaluations, result.search.skipped, row.seconds, row.cpuSeconds, row.searchSeconds,
+      row.stop.c_str());
     if (blocks)
     {
       for (std::size_t i = 0; i < result.variables.size(); ++i)
@@ -424,6 +471,10 @@ int main(int argc, char** argv)
       row.evaluations,
       row.evaluations / row.searchSeconds, angleText(row.laplace).c_str(), row.laplaceSeconds,
       angleText(row.classy).c_str(), row.classySeconds);
+  }
+  if (history)
+  {
+    std::fclose(history);
   }
   if (!csvFile.empty())
   {

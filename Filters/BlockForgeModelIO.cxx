@@ -376,7 +376,7 @@ private:
 };
 } // namespace
 
-void meshModel(const model::BlockModel& blockModel, const std::string& document,
+std::string meshModel(const model::BlockModel& blockModel, const std::string& document,
   double densityMultiplier, int cellCap, int piece, int pieceCount,
   vtkMultiBlockDataSet* output, const std::function<void(double)>& progress,
   const model::CarrierGeometry* carriers, InvertedCellPolicy policy,
@@ -410,11 +410,36 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
   {
     nodes.push_back(mesher.nodeCounts(b));
   }
+  const bool preview = cellCap > 0 || policy == InvertedCellPolicy::Skip;
   model::checkGridMemory(nodes, maximumMemoryGigabytes,
-    cellCap > 0 || policy == InvertedCellPolicy::Skip // the template's preview
-      ? "lower PreviewCells or the cell counts"
-                : "lower the density multiplier or the cell counts");
-  mesher.computeBoundaries(share);
+    preview ? "lower PreviewCells or the cell counts"
+            : "lower the density multiplier or the cell counts");
+  try
+  {
+    mesher.computeBoundaries(share);
+  }
+  catch (const model::FoldError& fold)
+  {
+    if (!preview)
+    {
+      throw;
+    }
+    // The preview's capped cell counts have other first cells than the grid: pass the
+    // model on without a drawing (the blocks named and empty, the structure every rank has).
+    vtkNew<vtkMultiBlockDataSet> modelOnly;
+    modelOnly->SetNumberOfBlocks(static_cast<unsigned int>(mesher.blockCount()));
+    for (int b = 0; b < mesher.blockCount(); ++b)
+    {
+      modelOnly->GetMetaData(static_cast<unsigned int>(b))
+        ->Set(vtkCompositeDataSet::NAME(), blockModel.blocks[b].name.c_str());
+    }
+    attachModel(modelOnly->GetFieldData(), document);
+    output->ShallowCopy(modelOnly);
+    return "the preview (at most " + std::to_string(cellCap) +
+      " cells per edge) folds and is not drawn; the model is passed on (BlockMesher checks "
+      "the grid at the density it meshes): " +
+      printable(fold.what());
+  }
   if (progress)
   {
     progress(0.05);
@@ -431,6 +456,7 @@ void meshModel(const model::BlockModel& blockModel, const std::string& document,
     policy, reports);
   attachModel(grid->GetFieldData(), document);
   output->ShallowCopy(grid);
+  return {};
 }
 
 std::string printable(const char* text)

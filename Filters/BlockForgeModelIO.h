@@ -90,10 +90,16 @@ void fillMultiBlock(const model::BlockModel& model, const model::MultiBlockMeshe
  * available memory and `maximumMemoryGigabytes` (<= 0: no user limit). Throws
  * (TemplateError, GeometryError, ResourceError) on any problem, inverted cells included
  * unless `policy` says otherwise (then each block's message goes to `reports`); `output`
- * is only touched
- * on success.
+ * is only touched on success.
+ *
+ * A preview (`cellCap` > 0 or policy Skip) whose capped grid folds at a block corner
+ * (model::FoldError) is no error: its cell counts are not the grid's, which BlockMesher
+ * checks at the density it meshes. Then `output` holds the model document without
+ * blocks, so the model is passed on, and the returned text (for a warning) says why the
+ * preview is not drawn. Model errors and memory refusals stay errors. Returns "" when the
+ * grid was drawn.
  */
-void meshModel(const model::BlockModel& model, const std::string& document,
+std::string meshModel(const model::BlockModel& model, const std::string& document,
   double densityMultiplier, int cellCap, int piece, int pieceCount,
   vtkMultiBlockDataSet* output, const std::function<void(double)>& progress,
   const model::CarrierGeometry* carriers = nullptr,

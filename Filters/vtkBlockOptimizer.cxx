@@ -259,24 +259,13 @@ int vtkBlockOptimizer::RequestData(
     }
     this->LocatedControlPoint = handle >= 0 ? this->HandleControlPoint : "";
     const std::string moved = blockforge::model::writeModelDocument(result.model);
-    try
+    const std::string previewWarning = blockforge::vtkglue::meshModel(result.model, moved, 1.0,
+      this->PreviewCells, piece, pieceCount, output,
+      [this](double fraction) { this->UpdateProgress(0.9 + 0.1 * fraction); }, &geometry,
+      blockforge::vtkglue::InvertedCellPolicy::Skip, nullptr, this->MaximumMemory);
+    if (!previewWarning.empty())
     {
-      blockforge::vtkglue::meshModel(result.model, moved, 1.0, this->PreviewCells, piece,
-        pieceCount, output,
-        [this](double fraction) { this->UpdateProgress(0.9 + 0.1 * fraction); }, &geometry,
-        blockforge::vtkglue::InvertedCellPolicy::Skip);
-    }
-    catch (const std::exception& previewError)
-    {
-      // The model was optimized (and is feasible) at DensityMultiplier; the coarse preview
-      // has other first cells and may fold where the real grid does not. The model still
-      // goes downstream: the mesher checks it at the density it meshes.
-      vtkWarningMacro(<< "The preview of the optimized model (at most " << this->PreviewCells
-                      << " cells per edge) cannot be drawn, the model is passed on without it: "
-                      << blockforge::vtkglue::printable(previewError.what()));
-      vtkNew<vtkMultiBlockDataSet> modelOnly;
-      blockforge::vtkglue::attachModel(modelOnly->GetFieldData(), moved);
-      output->ShallowCopy(modelOnly);
+      vtkWarningMacro(<< "The optimized model: " << previewWarning);
     }
     vtkFieldData* fields = output->GetFieldData();
     fields->AddArray(classArray("MinAngleClassCountsBefore", result.before));

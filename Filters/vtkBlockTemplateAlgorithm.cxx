@@ -263,11 +263,15 @@ int vtkBlockTemplateAlgorithm::ApplyTemplate(
       this->TemplateFile, this->Parameters, hasInput ? &inputs : nullptr, &geometry);
     this->UpdateProgress(0.4);
     const std::string document = blockforge::model::writeModelDocument(blockModel);
-    blockforge::vtkglue::meshModel(blockModel, document, 1.0, this->PreviewCells, piece,
-      pieceCount, output, [this](double fraction) { this->UpdateProgress(0.4 + 0.55 * fraction); },
-      &geometry,
+    const std::string previewWarning = blockforge::vtkglue::meshModel(blockModel, document,
+      1.0, this->PreviewCells, piece, pieceCount, output,
+      [this](double fraction) { this->UpdateProgress(0.4 + 0.55 * fraction); }, &geometry,
       // The preview's capped cell counts are not the grid: BlockMesher checks the cells.
       blockforge::vtkglue::InvertedCellPolicy::Skip, nullptr, this->MaximumMemory);
+    if (!previewWarning.empty())
+    {
+      vtkWarningMacro(<< this->TemplateFile << ": " << previewWarning);
+    }
     if (carriers && piece == 0)
     {
       fillCarriers(blockModel, geometry, carriers);

@@ -44,11 +44,18 @@ struct DistributionLaw
   /// cells match at one density match at all.
   /// Match: length of the last cell (0: free).
   double lastCellSize = 0.0;
+  /// Match only: the largest angle [rad] between an end cell (the chord from the end to
+  /// the next node) and the edge's chord from end to end; 0: none. A curved edge leaving
+  /// its end across its course (a blade side leaving a round leading edge across the
+  /// pitch) gets its end cell lengthened until it leans no more, and the edges continuing
+  /// it across the interface take that cell too (Filters/Model/MatchedEdges.cpp).
+  double leanLimit = 0.0;
 
   bool operator==(const DistributionLaw& o) const
   {
     return kind == o.kind && expansionRatio == o.expansionRatio &&
-      firstCellSize == o.firstCellSize && lastCellSize == o.lastCellSize;
+      firstCellSize == o.firstCellSize && lastCellSize == o.lastCellSize &&
+      leanLimit == o.leanLimit;
   }
   bool operator!=(const DistributionLaw& o) const { return !(*this == o); }
 };

@@ -30,5 +30,17 @@ private:
   std::string File, Entity;
   int Line;
 };
+
+/**
+ * @class FoldError
+ * @brief A block whose grid folds at the node counts meshed: the first cells at one of
+ * its corners are inverted (the mesher's corner check). Unlike other TemplateErrors it
+ * may depend on the cell counts alone: a coarse preview can fold where the grid does not.
+ */
+class FoldError : public TemplateError
+{
+public:
+  using TemplateError::TemplateError;
+};
 } // namespace model
 } // namespace blockforge

@@ -120,6 +120,7 @@ void buildMatchGroups(const BlockModel& model, MeshTopology& topology)
   for (UniqueEdge& edge : topology.edges)
   {
     edge.matched = false;
+    edge.matchLean = 0.0;
     for (const EdgeUse& use : edge.uses)
     {
       const DistributionLaw& law = model.blocks[use.block].laws[use.localEdge];
@@ -127,6 +128,7 @@ void buildMatchGroups(const BlockModel& model, MeshTopology& topology)
       {
         edge.matched = true;
         edge.matchRatio = law.expansionRatio;
+        edge.matchLean = std::max(edge.matchLean, law.leanLimit);
       }
     }
     any = any || edge.matched;
@@ -227,8 +229,16 @@ std::vector<int> matchEdgeEnds(const BlockModel& model, MeshTopology& topology)
         ++matched;
       }
     }
-    const double target =
-      graded > 0 ? std::exp(gradedLogs / graded) : std::exp(meanLogs / matched);
+    double target = graded > 0 ? std::exp(gradedLogs / graded) : std::exp(meanLogs / matched);
+    for (const int key : group)
+    {
+      // a member leaving its end across its course asks for a longer cell: all follow
+      const UniqueEdge& edge = topology.edges[key / 2];
+      if (edge.matched && edge.matchFloor[key % 2] > target)
+      {
+        target = edge.matchFloor[key % 2];
+      }
+    }
     for (const int key : group)
     {
       if (topology.edges[key / 2].matched)
@@ -254,6 +264,66 @@ std::vector<int> matchEdgeEnds(const BlockModel& model, MeshTopology& topology)
     }
   }
   return changed;
+}
+void computeMatchFloors(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  MeshTopology& topology)
+{
+  for (UniqueEdge& edge : topology.edges)
+  {
+    edge.matchFloor = { { 0.0, 0.0 } };
+    if (!edge.matched || !(edge.matchLean > 0.0) || edge.named < 0)
+    {
+      continue;
+    }
+    const Edge& named = model.edges[edge.named];
+    if (named.kind == Edge::Kind::Line || named.kind == Edge::Kind::Project ||
+      named.kind == Edge::Kind::Periodic)
+    {
+      continue; // straight (no lean), or a rotated copy whose ends follow its source's
+    }
+    const NamedCurve& curve = curves[edge.named];
+    const bool reversed = named.from != edge.a;
+    // the point at arc-length fraction f from end a, as computeEdgeNodes places nodes
+    auto at = [&](double f) {
+      const double fraction = reversed ? 1.0 - f : f;
+      return curve.curve->point(
+        curve.lengthTable ? curve.lengthTable->parameterAtFraction(fraction) : fraction);
+    };
+    const Vec3 a = at(0.0), b = at(1.0);
+    const double cosLimit = std::cos(edge.matchLean);
+    for (int end = 0; end < 2; ++end)
+    {
+      const Vec3 origin = end == 0 ? a : b;
+      const Vec3 course = ((end == 0 ? b : a) - origin).normalized();
+      // does the cell of fraction f from this end lean no more than the limit?
+      auto complies = [&](double f) {
+        const Vec3 chord = at(end == 0 ? f : 1.0 - f) - origin;
+        const double n = chord.norm();
+        return n > 0.0 && chord.dot(course) >= cosLimit * n;
+      };
+      double low = 1.0 / 65536.0;
+      if (complies(low))
+      {
+        continue;
+      }
+      double high = low;
+      while (high < 0.5 && !complies(high))
+      {
+        low = high;
+        high *= 2.0;
+      }
+      if (high >= 0.5 && !complies(high))
+      {
+        continue; // leans across its whole first half: not an edge this limit is for
+      }
+      for (int iteration = 0; iteration < 30; ++iteration)
+      {
+        const double mid = 0.5 * (low + high);
+        (complies(mid) ? high : low) = mid;
+      }
+      edge.matchFloor[end] = high * edge.length;
+    }
+  }
 }
 } // namespace model
 } // namespace blockforge

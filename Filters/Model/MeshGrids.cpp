@@ -80,6 +80,7 @@ MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedC
   }
   if (!topology.matchGroups.empty())
   {
+    computeMatchFloors(model, curves, topology);
     matchEdgeEnds(model, topology);
   }
   for (std::size_t e = 0; e < topology.edges.size(); ++e)
@@ -285,7 +286,7 @@ void checkCornerCells(const BlockModel& model, const MeshTopology& topology, int
       if (ds.dot(dt.cross(du)) < -1e-10 * scale)
       {
         const Block& block = model.blocks[b];
-        fail(block.where, blockEntity(model, b),
+        throw FoldError(block.where.file, block.where.line, blockEntity(model, b),
           "the block folds at V" + std::to_string(v) + " (vertex '" +
             model.vertices[block.vertices[v]].name +
             "'): the edges leaving it form a left-handed frame, so its corner cells are "

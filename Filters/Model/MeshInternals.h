@@ -99,6 +99,10 @@ struct UniqueEdge : TopologyEdge
   bool matched = false;
   double matchRatio = DefaultMatchRatio;
   double matchFirst = 0.0, matchLast = 0.0;
+  /// Match with a lean limit (DistributionLaw::leanLimit, 0: none): the shortest end
+  /// cells at a and b that lean no more than that from the edge's chord (0: any).
+  double matchLean = 0.0;
+  std::array<double, 2> matchFloor{ { 0.0, 0.0 } };
   std::vector<double> params;
   std::vector<double> xyz;
 };
@@ -128,10 +132,6 @@ struct MeshTopology
   std::vector<std::pair<int, int>> matchCopies;
 };
 
-/// Node counts of a block at a density multiplier (max(1, round(cells * m)) cells per
-/// direction, at most `cap` when cap > 0), plus one.
-std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int cap);
-
 MeshTopology buildMeshTopology(const BlockModel& model, const std::vector<NamedCurve>& curves,
   const std::vector<std::array<int, 3>>& nodes, bool allowFallback);
 /// Node parameters of unique edge `e` from the laws of the blocks that use it (checked to
@@ -154,6 +154,16 @@ void buildMatchGroups(const BlockModel& model, MeshTopology& topology);
  * edges whose end lengths changed.
  */
 std::vector<int> matchEdgeEnds(const BlockModel& model, MeshTopology& topology);
+/**
+ * The end-cell floors of the matched edges with a lean limit (UniqueEdge::matchFloor): at
+ * each end, the arc length along the edge's curve at which the chord from the end first
+ * leans no more than the limit from the edge's chord (bisection on the curve, the same
+ * bits every time). Straight edges and ends that already comply get 0. Run again when the
+ * edges' vertices moved, before matchEdgeEnds, which makes every group's cell at least
+ * its members' floors.
+ */
+void computeMatchFloors(const BlockModel& model, const std::vector<NamedCurve>& curves,
+  MeshTopology& topology);
 /// Parameters of the collapsed edges of block `b`.
 void computeCollapsedParameters(const BlockModel& model, MeshTopology& topology, int b);
 

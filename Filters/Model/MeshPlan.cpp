@@ -323,6 +323,7 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
   // matched edges follow the graded edges and the lengths at their ends
   if (!Topo.matchGroups.empty())
   {
+    computeMatchFloors(model, Curves, Topo);
     for (const int u : matchEdgeEnds(model, Topo))
     {
       changedEdge[u] = 1;

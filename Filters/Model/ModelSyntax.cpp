@@ -265,7 +265,7 @@ namespace
 {
 const char* const LawSyntax =
   "uniform, {geometric: k}, {two_sided: k}, {first_cell: h, ratio: r}, "
-  "{ends: [a, b]}, match or {match: r}";
+  "{ends: [a, b]}, match, {match: r} or {match: r, lean: angle}";
 }
 
 DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entityText,
@@ -293,14 +293,25 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
     reporter.fail(here, entityText, what + ": expected " + LawSyntax);
   }
   const std::vector<MapEntry> entries = mapEntries(node, here, entityText, what, reporter);
-  checkKeys(
-    entries, { "geometric", "two_sided", "first_cell", "ratio", "ends", "match" }, entityText,
-    reporter);
+  checkKeys(entries, { "geometric", "two_sided", "first_cell", "ratio", "ends", "match", "lean" },
+    entityText, reporter);
+  const MapEntry* lean = findEntry(entries, "lean");
   if (const MapEntry* match = findEntry(entries, "match"))
   {
-    if (entries.size() != 1)
+    if (entries.size() != (lean ? 2u : 1u))
     {
-      reporter.fail(match->line, entityText, what + ": expected {match: r} alone");
+      reporter.fail(match->line, entityText,
+        what + ": expected {match: r} or {match: r, lean: angle} alone");
+    }
+    if (lean)
+    {
+      law.leanLimit = number(lean->value, lean->line, what + " lean");
+      if (!(law.leanLimit > 0.0) || !(law.leanLimit < 3.14159265358979))
+      {
+        reporter.fail(lean->line, entityText,
+          what + ": the lean of a matched edge's end cells must be an angle between 0 and "
+                 "180deg, got " + formatNumber(law.leanLimit) + " rad");
+      }
     }
     law.kind = DistributionLaw::Kind::Match;
     law.expansionRatio = number(match->value, match->line, what + " match");
@@ -311,6 +322,10 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
           formatNumber(law.expansionRatio));
     }
     return law;
+  }
+  if (lean)
+  {
+    reporter.fail(lean->line, entityText, what + ": 'lean' belongs to the law match");
   }
   if (const MapEntry* ends = findEntry(entries, "ends"))
   {
@@ -405,7 +420,12 @@ void emitLaw(YAML::Emitter& out, const DistributionLaw& law)
     case DistributionLaw::Kind::Match:
       // the end cells are the mesher's, from the neighbour edges: only the ratio is the law's
       out << YAML::Flow << YAML::BeginMap << YAML::Key << "match" << YAML::Value
-          << formatNumber(law.expansionRatio) << YAML::EndMap;
+          << formatNumber(law.expansionRatio);
+      if (law.leanLimit > 0.0)
+      {
+        out << YAML::Key << "lean" << YAML::Value << formatNumber(law.leanLimit);
+      }
+      out << YAML::EndMap;
       return;
   }
 }

@@ -116,6 +116,11 @@ struct Topology
 /// Node counts (cells + 1) of every block as the model gives them (density 1, no cap).
 std::vector<std::array<int, 3>> baseNodeCounts(const BlockModel& model);
 
+/// Node counts of a block at a density multiplier, as the mesher makes them:
+/// max(1, round(cells * m)) cells per direction, at most `cap` when cap > 0, plus one.
+/// The multiplier must be valid (checkDensityMultiplier), so every count fits an int.
+std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int cap = 0);
+
 /**
  * Shared edges and faces for the given node counts, with every consistency check that
  * depends on them alone: node counts on shared edges, faces shared by more than two

@@ -46,7 +46,12 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 # - O corners: on the offset curve, where its normal leans o_corner from the camber
 #   direction at the leading (trailing) edge towards each side; a_f/b_f/a_r/b_r are their
 #   feet on the blade. The leading-edge O block O_le thus wraps the nose symmetrically
-#   about the camber line, however staggered the blade.
+#   about the camber line, however staggered the blade. At a thin or sharp edge every point
+#   of the offset's arc round the tip has its foot on the tip: there the feet are moved o_tip
+#   along the blade from the edge and the corners become their normal offsets (radial
+#   lines normal to blade and O-grid), unless the edge block would still be a fan more than
+#   o_fan times wider outside than on the blade (a sharp wedge, whose edge block is left a
+#   fan on the tip: arc-length nodes on a short blade arc under a wide fan fold it).
 # - H blocks: the periodic_low line runs mid-passage (between side a and the side b of the
 #   blade one pitch below) through the front, middle and rear O corners. Upstream and
 #   downstream the H lines leave the O-grid along the camber direction at the edges
@@ -68,6 +73,8 @@ parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
+  o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
+  o_fan: 30               # ... where the edge block's outer chord is at most this many times its blade chord (sharper edges keep corners and feet on the tip: a fan)
   probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
   follow_le: 0.7          # upstream H lines follow this fraction of the blade's leading-edge angle (0: axial)
   follow_te: 0.7          # downstream H lines follow this fraction of the trailing-edge angle
@@ -151,6 +158,12 @@ def template_text():
             w(f'  {e}_vy0_{l}: "rm_{l}*(pa_{e}_{l}.theta - pb_{e}_{l}.theta) - ((pa_{e}_{l}.axial - pb_{e}_{l}.axial)*{e}_ux_{l} + rm_{l}*(pa_{e}_{l}.theta - pb_{e}_{l}.theta)*{e}_uy_{l})*{e}_uy_{l}"')
             w(f'  {e}_vx_{l}: "{e}_vx0_{l}/sqrt({e}_vx0_{l}^2 + {e}_vy0_{l}^2)"      # unit normal of the camber towards side a')
             w(f'  {e}_vy_{l}: "{e}_vy0_{l}/sqrt({e}_vx0_{l}^2 + {e}_vy0_{l}^2)"')
+        # the corners moved off the tip are taken where the edge block's outer chord is at most
+        # o_fan times its blade chord; sharper edges keep their corners on the tip (a fan)
+        for e, (a, b) in (('le', ('a_f', 'b_f')), ('te', ('a_r', 'b_r'))):
+            outer = f'sqrt((r{a}_{l}.axial - r{b}_{l}.axial)^2 + (rm_{l}*(r{a}_{l}.theta - r{b}_{l}.theta))^2)'
+            inner = f'sqrt((k{a}_{l}.axial - k{b}_{l}.axial)^2 + (rm_{l}*(k{a}_{l}.theta - k{b}_{l}.theta))^2)'
+            w(f'  off_{e}_{l}: "{outer} <= o_fan*{inner}"')
         # H lines upstream / downstream: slope d(r theta)/d(axial distance from the O-grid)
         w(f'  slope_in_{l}: "tan(follow_le*atan2(le_uy_{l}, -le_ux_{l}))"')
         w(f'  slope_out_{l}: "tan(follow_te*atan2(te_uy_{l}, te_ux_{l}))"')
@@ -197,9 +210,23 @@ def template_text():
             dx = f'(cos({c})*{e}_ux_{l} {side} sin({c})*{e}_vx_{l})'
             dy = f'(cos({c})*{e}_uy_{l} {side} sin({c})*{e}_vy_{l})'
             far = f'o{e}_{l}.s {towards} dir_{l}*o_window'
-            w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}}}')
-        for v in ('a_f', 'b_f', 'a_r', 'b_r'):
-            w(f'  {v}_{l}: {{project: o{v}_{l}, onto: blade_{l}}}')
+            b = v[1:]  # the corner's foot on the blade
+            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+            # (nearest points by a search, not `project`: a search only places a helper once,
+            # a projection would be redone at every step of the optimizer)
+            near = lambda P: f'"(x - {P}.x)^2 + (y - {P}.y)^2 + (z - {P}.z)^2"'
+            w(f'  f{b}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"c{b}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
+            # the foot kept o_tip (fraction of the loop) from the edge: at a sharp edge every
+            # point of the O curve's arc round the tip projects onto the tip itself
+            x = f'dir_{l}*(f{b}_{l}.s - {e}_{l}.s)'
+            off = f'({x} - rint({x}))'
+            lim = f'max({off}, o_tip)' if towards == '+' else f'min({off}, -o_tip)'
+            w(f'  k{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{lim}", fixed: true}}')
+            w(f'  r{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"k{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
+            dr = f'(x - r{b}_{l}.x)^2 + (y - r{b}_{l}.y)^2 + (z - r{b}_{l}.z)^2'
+            dc = f'(x - c{b}_{l}.x)^2 + (y - c{b}_{l}.y)^2 + (z - c{b}_{l}.z)^2'
+            w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {dr} : {dc}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
+            w(f'  {b}_{l}: {{project: {v}_{l}, onto: blade_{l}}}')
         w(f'  a_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s + dir_{l}*side_a_{l}/2"}}')
         w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
         w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')

@@ -585,3 +585,58 @@ TEST(Mesher, MatchedEdgesTakeTheirEndCellsFromTheirNeighbours)
       << error.what();
   }
 }
+
+TEST(Mesher, MatchedEdgesLeanNoMoreThanTheirLimit)
+{
+  // The right block's bottom edge is a half circle of radius 0.5 leaving the shared face
+  // along it (Testing/Data/match_lean.yaml). The chord of its first cell, of angle a at the
+  // centre, leans 90deg - a/2 from the edge's chord (+x): with a lean limit L the first
+  // cell is the arc of a = 180deg - 2L, 0.5 (pi - 2L) long, and the left block's straight
+  // edge ending there takes that cell too, at every density. Without the limit both take
+  // the geometric mean of the mean cells, sqrt(0.25 * (pi/2) / 16).
+  const std::string path = test::sourcePath("Testing/Data/match_lean.yaml");
+  for (const double leanDegrees : { 75.0, 80.0, 179.0 })
+  {
+    SCOPED_TRACE(leanDegrees);
+    const BlockModel model =
+      loadTemplate(path, { { "lean", std::to_string(leanDegrees) + "deg" } });
+    const double lean = leanDegrees * test::Pi / 180.0;
+    EXPECT_NEAR(model.blocks[1].laws[0].leanLimit, lean, 1e-15);
+    for (const double density : { 1.0, 2.0 })
+    {
+      const auto grids = meshBlocks(model, density);
+      const BlockGrid& left = grids[0];
+      const BlockGrid& right = grids[1];
+      const double chord = (right.node(1, 0, 0) - right.node(0, 0, 0)).norm();
+      const double arc = 2.0 * 0.5 * std::asin(chord / (2.0 * 0.5));
+      const double expected = leanDegrees < 90.0
+        ? 0.5 * (test::Pi - 2.0 * lean)
+        : std::sqrt(0.25 / density * (test::Pi / 2.0) / (16.0 * density));
+      EXPECT_NEAR(arc, expected, 1e-8);
+      EXPECT_NEAR((left.node(left.ni - 1, 0, 0) - left.node(left.ni - 2, 0, 0)).norm(), expected,
+        1e-8);
+      // the straight edges at y = 1 keep the geometric mean (their ends lean nowhere)
+      EXPECT_NEAR((right.node(1, right.nj - 1, 0) - right.node(0, right.nj - 1, 0)).norm(),
+        std::sqrt(0.25 * (1.0 / 16.0)) / density, 1e-12);
+    }
+    // the limit travels in the model document: the same grid after a round trip
+    const BlockModel reread = readModelDocument(writeModelDocument(model));
+    EXPECT_EQ(reread.blocks[1].laws, model.blocks[1].laws);
+    EXPECT_EQ(meshBlocks(reread)[1].xyz, meshBlocks(model)[1].xyz);
+  }
+  // a lean limit belongs to the law match only
+  std::string text = test::readText(path);
+  text.replace(text.find("grading: {i: {match: 1.2, lean: lean}}"),
+    std::string("grading: {i: {match: 1.2, lean: lean}}").size(),
+    "grading: {i: {geometric: 1.2, lean: lean}}");
+  try
+  {
+    parseTemplate(text, "match_lean.yaml");
+    ADD_FAILURE() << "no error for a lean limit on a geometric law";
+  }
+  catch (const TemplateError& error)
+  {
+    EXPECT_NE(std::string(error.what()).find("'lean' belongs to the law match"), std::string::npos)
+      << error.what();
+  }
+}

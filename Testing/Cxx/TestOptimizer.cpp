@@ -181,6 +181,32 @@ TEST(Optimizer, ManualMoveIsHeld)
   EXPECT_EQ(reread.vertices[m0].constraint.s, 0.42);
 }
 
+TEST(Optimizer, ManualMovesOnlyFillTheHistory)
+{
+  // Automatic off: the history holds the input and the moved model (the result).
+  Loaded loaded = loadSymmetric("0.3");
+  OptimizerSettings settings;
+  settings.automatic = false;
+  settings.moves = { { "m0", { 0.42 } } };
+  const OptimizerResult moved = optimizeModel(loaded.model, loaded.geometry, settings);
+  ASSERT_EQ(moved.search.history.size(), 2u);
+  EXPECT_EQ(moved.search.evaluations, 2);
+  EXPECT_EQ(moved.search.history[0].evaluation, 1);
+  EXPECT_EQ(moved.search.history[1].evaluation, 2);
+  EXPECT_NEAR(moved.search.history[0].minAngle, std::atan2(1.0, 0.4) * 180.0 / M_PI, 1e-9);
+  EXPECT_EQ(moved.search.history[1].minAngle, moved.after.minAngle);
+  EXPECT_NEAR(moved.after.minAngle, std::atan2(1.0, 0.16) * 180.0 / M_PI, 1e-9);
+  EXPECT_EQ(moved.search.history[1].objective, moved.after.objective);
+  EXPECT_LT(moved.search.history[1].objective, moved.search.history[0].objective);
+  EXPECT_LE(moved.search.history[0].seconds, moved.search.history[1].seconds);
+  // Nothing moved: one row, the input as it is.
+  settings.moves.clear();
+  const OptimizerResult unchanged = optimizeModel(loaded.model, loaded.geometry, settings);
+  ASSERT_EQ(unchanged.search.history.size(), 1u);
+  EXPECT_EQ(unchanged.search.history[0].minAngle, unchanged.before.minAngle);
+  EXPECT_EQ(unchanged.before.minAngle, unchanged.after.minAngle);
+}
+
 TEST(Optimizer, FixedControlPointStays)
 {
   Loaded loaded = loadSymmetric("0.3");
@@ -400,4 +426,29 @@ TEST(OptimizerPassage, RefusesAGridTheMesherWouldRefuse)
   // A density within MaximumMeasuredNodes is measured as it is.
   EXPECT_EQ(measuredDensity(loaded.model, 2.0), 2.0);
   EXPECT_LT(measuredDensity(loaded.model, 3.0), 3.0);
+}
+
+TEST(OptimizerPassage, TrialsLeftOutChangeNoStep)
+{
+  // The control problem's TrialFilter leaves out trials that cannot gain (inert helper
+  // points, moves of blocks outside the smooth minimum's window): the same steps and
+  // result bit for bit as evaluating every trial, with fewer evaluations.
+  Loaded loaded = loadPassage("axial_passage_oh", "rotor37/turbogrid");
+  SearchSettings settings;
+  settings.maxEvaluations = 120;
+  auto run = [&](bool filtered) {
+    ControlProblem problem(loaded.model, loaded.geometry, 1.0, ObjectiveSettings{}, {});
+    return search(problem.start(), problem.low(), problem.high(), ObjectiveKind::MinAngle,
+      [&](const std::vector<double>& x) { return problem.evaluate(x); }, settings, {},
+      filtered ? TrialFilter([&](std::size_t variable, const GridMeasures& current) {
+        return problem.mayGain(variable, current);
+      })
+               : TrialFilter());
+  };
+  const SearchResult all = run(false), filtered = run(true);
+  EXPECT_GT(filtered.skipped, 5);
+  EXPECT_EQ(filtered.evaluations + filtered.skipped, all.evaluations);
+  EXPECT_EQ(filtered.best, all.best);
+  EXPECT_TRUE(test::sameBits(filtered.bestMeasures.objective, all.bestMeasures.objective));
+  EXPECT_EQ(filtered.bestMeasures.minAngle, all.bestMeasures.minAngle);
 }

@@ -276,3 +276,62 @@ TEST(Search, RejectsAStartOutsideItsBounds)
                  [](const std::vector<double>& x) { return peak(x, { 0.5 }); }, SearchSettings{}),
     std::invalid_argument);
 }
+
+TEST(Search, TrialsRuledOutAreCountedNotEvaluated)
+{
+  // Variable 1 does not enter the objective: ruling its trials out gives the same steps
+  // (the same evaluations of variable 0, the same best) with fewer evaluations, the
+  // trials left out counted against the limit.
+  const std::vector<double> optimum = { 0.62 };
+  auto evaluate = [&](const std::vector<double>& x) { return peak({ x[0] }, optimum); };
+  SearchSettings settings;
+  settings.maxEvaluations = 40;
+  settings.tolerance = 0.0;
+  const SearchResult all = search({ 0.3, 0.5 }, { 0.0, 0.0 }, { 1.0, 1.0 },
+    ObjectiveKind::MinAngle, evaluate, settings);
+  int asked = 0;
+  const SearchResult filtered = search({ 0.3, 0.5 }, { 0.0, 0.0 }, { 1.0, 1.0 },
+    ObjectiveKind::MinAngle, evaluate, settings, {},
+    [&](std::size_t variable, const GridMeasures& current) {
+      ++asked;
+      EXPECT_TRUE(current.feasible);
+      return variable != 1;
+    });
+  EXPECT_EQ(all.evaluations, 40);
+  EXPECT_EQ(all.skipped, 0);
+  EXPECT_GT(filtered.skipped, 5);
+  EXPECT_EQ(filtered.evaluations + filtered.skipped, 40);
+  EXPECT_EQ(asked, filtered.evaluations - 1 + filtered.skipped);
+  EXPECT_EQ(filtered.best[0], all.best[0]);
+  EXPECT_EQ(filtered.bestMeasures.objective, all.bestMeasures.objective);
+  // The evaluations made are those of the unfiltered run, in order, less the left out.
+  std::vector<double> kept;
+  for (const HistoryEntry& entry : all.history)
+  {
+    kept.push_back(entry.objective);
+  }
+  std::size_t next = 0;
+  for (const HistoryEntry& entry : filtered.history)
+  {
+    while (next < kept.size() && kept[next] != entry.objective)
+    {
+      ++next;
+    }
+    ASSERT_LT(next, kept.size());
+    ++next;
+  }
+}
+
+TEST(GridObjective, ActiveBlocksAreThoseInTheSmoothMinimumsWindow)
+{
+  // Block 0 sheared by 50 degrees (smallest angle 40), block 1 by 25 (65, more than 20
+  // above the minimum: outside the window), block 2 by 35 (55).
+  const Grid a = shearedBlock(3, 50.0 / degrees), b = shearedBlock(3, 25.0 / degrees),
+             c = shearedBlock(3, 35.0 / degrees);
+  const GridMeasures m = measureGrid({ a.block(), b.block(), c.block() }, {}, ObjectiveSettings{});
+  EXPECT_NEAR(m.minAngle, 40.0, 1e-9);
+  EXPECT_EQ(m.activeBlocks, (std::vector<char>{ 1, 0, 1 }));
+  // without block 1 the smooth minimum is the same bit for bit
+  const GridMeasures without = measureGrid({ a.block(), c.block() }, {}, ObjectiveSettings{});
+  EXPECT_EQ(without.objective, m.objective);
+}

@@ -13,6 +13,9 @@ import blockforge
 import blockforge.output
 from blockforge.__main__ import main as blockforge_main
 from vtkmodules.numpy_interface import dataset_adapter as dsa
+from vtkmodules.util.misc import calldata_type
+from vtkmodules.vtkCommonCore import VTK_STRING, vtkCommand
+from vtkmodules.vtkCommonDataModel import vtkCompositeDataSet
 from vtkmodules.vtkFiltersVerdict import vtkMeshQuality
 from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataReader, vtkXMLMultiBlockDataWriter
 import numpy as np
@@ -452,6 +455,96 @@ class BadInputTest(unittest.TestCase):
         self.assertIn("inside-out", str(context.exception))
 
 
+def observe(algorithm):
+    """(errors, warnings): the messages `algorithm` reports from now on."""
+    found = {vtkCommand.ErrorEvent: [], vtkCommand.WarningEvent: []}
+    for event, messages in found.items():
+        collect = calldata_type(VTK_STRING)(lambda _caller, _event, message, into=messages:
+                                            into.append(message))
+        algorithm.AddObserver(event, collect)
+    return found[vtkCommand.ErrorEvent], found[vtkCommand.WarningEvent]
+
+
+class PreviewFoldTest(unittest.TestCase):
+    """A coarse preview that folds at its capped cell counts where the grid does not is a
+    warning: the model is passed on (BlockTemplate and BlockOptimizer share the preview
+    path); errors of the model and memory refusals stay errors."""
+
+    FOLD = os.path.join(DATA, "preview_fold.yaml")
+    SYMMETRIC = os.path.join(DATA, "optimizer_symmetric.yaml")
+
+    def check_model_passed_on(self, output, folded):
+        self.assertEqual(output.GetNumberOfBlocks(), 1)
+        self.assertEqual(output.GetMetaData(0).Get(vtkCompositeDataSet.NAME()), "swung")
+        self.assertEqual(output.GetBlock(0) is None, folded)
+        self.assertIsNotNone(output.GetFieldData().GetAbstractArray("BlockForgeModel"))
+
+    def test_template_preview(self):
+        for cells, folds in ((2, True), (4, True), (8, False)):
+            source = blockforge.vtkBlockTemplateSource()
+            source.SetTemplateFile(self.FOLD)
+            source.SetPreviewCells(cells)
+            errors, warnings = observe(source)
+            source.Update()
+            self.assertEqual(errors, [])
+            self.check_model_passed_on(source.GetOutputDataObject(0), folds)
+            if folds:
+                self.assertEqual(len(warnings), 1, warnings)
+                self.assertIn("the preview (at most %d cells per edge) folds and is not drawn; "
+                              "the model is passed on" % cells, warnings[0])
+                self.assertIn("preview_fold.yaml:23: block 'swung': the block folds at V0",
+                              warnings[0])
+            else:
+                self.assertEqual(warnings, [])
+            # the mesher judges the grid at the density it meshes (here: inverted cells)
+            mesher = blockforge.vtkBlockMesher()
+            mesher.SetInputConnection(source.GetOutputPort())
+            mesher_errors, _ = observe(mesher)
+            mesher.Update()
+            self.assertEqual(len(mesher_errors), 1)
+            self.assertIn("block 'swung': 662 inverted cells of 4096", mesher_errors[0])
+
+    def test_optimizer_preview(self):
+        source = blockforge.vtkBlockTemplateSource()
+        source.SetTemplateFile(self.FOLD)
+        optimizer = blockforge.vtkBlockOptimizer()
+        optimizer.SetInputConnection(source.GetOutputPort())
+        optimizer.SetAutomatic(False)
+        optimizer.SetPreviewCells(2)
+        errors, warnings = observe(optimizer)
+        optimizer.Update()
+        self.assertEqual(errors, [])
+        self.check_model_passed_on(optimizer.GetOutputDataObject(0), True)
+        self.assertTrue(any("The optimized model: the preview (at most 2 cells per edge) "
+                            "folds" in w for w in warnings), warnings)
+
+    def test_memory_refusals_stay_errors(self):
+        # The template's preview (uncapped: 8192 cells) and the optimizer's: the optimizer
+        # works at density 0.5 (54 nodes, 6.39 kB) but draws its uncapped preview at
+        # density 1 (250 nodes, 20.4 kB), more than MaximumMemory allows.
+        source = blockforge.vtkBlockTemplateSource()
+        source.SetTemplateFile(CYLINDER)
+        source.SetPreviewCells(0)
+        source.SetMaximumMemory(1e-6)
+        errors, _ = observe(source)
+        source.Update()
+        self.assertEqual(len(errors), 1)
+        self.assertIn("lower PreviewCells or the cell counts", errors[0])
+        source = blockforge.vtkBlockTemplateSource()
+        source.SetTemplateFile(self.SYMMETRIC)
+        optimizer = blockforge.vtkBlockOptimizer()
+        optimizer.SetInputConnection(source.GetOutputPort())
+        optimizer.SetDensityMultiplier(0.5)
+        optimizer.SetPreviewCells(0)
+        optimizer.SetMaximumMemory(1e-5)
+        errors, _ = observe(optimizer)
+        optimizer.Update()
+        self.assertEqual(len(errors), 1)
+        self.assertIn("the grid would need 20.4 kB for 2.5e+02 nodes, more than MaximumMemory "
+                      "(10.5 kB); lower PreviewCells or the cell counts", errors[0])
+        self.assertEqual(optimizer.GetOutputDataObject(0).GetNumberOfBlocks(), 0)
+
+
 class OptimizerTest(unittest.TestCase):
     """vtkBlockOptimizer through `import blockforge`, and the optimizer in mesh_template and
     the command line (on by default, --no-optimize / optimize=False to skip it)."""
@@ -492,14 +585,19 @@ class OptimizerTest(unittest.TestCase):
         # The optimized model meshes at every density asked for: at 0.5 its coarse preview
         # (PreviewCells per edge) folds where the real grid does not, which must not stop
         # the pipeline; at 4 the optimizer measures a coarsened copy (above 1e5 nodes) and
-        # steps back towards the start until the real grid is valid and no worse.
+        # steps back towards the start until the real grid is valid and no worse. The
+        # template's lean limit is lifted (179deg): its blade-side cells then leave the
+        # round leading edge across the pitch as before issue 8's limit, which is what
+        # folds the coarse preview (with the limit, no preview of the four machines folds).
         template = os.path.join(SOURCE, "Templates", "axial_passage_h.yaml")
+        lifted = {"lean": "179deg"}
         for density in (0.5, 4.0):
             warnings = []
             placed = self.min_angle(blockforge.mesh_template(
-                template, density_multiplier=density, input_file=ROTOR37_INF, optimize=False))
+                template, lifted, density_multiplier=density, input_file=ROTOR37_INF,
+                optimize=False))
             optimized = self.min_angle(blockforge._run_pipeline(
-                template, density_multiplier=density, input_file=ROTOR37_INF,
+                template, lifted, density_multiplier=density, input_file=ROTOR37_INF,
                 warnings=warnings))
             self.assertGreaterEqual(optimized, placed, density)
             if density == 0.5:

@@ -81,6 +81,15 @@ class OptimizerProxyTest(unittest.TestCase):
         model = servermanager.Fetch(optimizer)
         self.assertAlmostEqual(field_values(model, "MinAngleAfter")[0], corner_angle(0.16),
                                places=9)
+        # the history holds the start and the moved model
+        history = servermanager.Fetch(optimizer, idx=1)
+        self.assertEqual(history.GetNumberOfRows(), 2)
+        self.assertEqual(field_values(model, "OptimizerEvaluations"), [2])
+        self.assertEqual([history.GetValue(r, 0).ToInt() for r in range(2)], [1, 2])
+        self.assertAlmostEqual(history.GetValue(0, 2).ToDouble(), corner_angle(0.4), places=9)
+        self.assertAlmostEqual(history.GetValue(1, 2).ToDouble(), corner_angle(0.16), places=9)
+        self.assertEqual([history.GetValue(r, 4).ToInt() for r in range(2)], [1, 1])
+        self.assertLess(history.GetValue(1, 1).ToDouble(), history.GetValue(0, 1).ToDouble())
         # held by the automatic run
         optimizer.Automatic = 1
         optimizer.UpdatePipeline()

@@ -216,6 +216,30 @@ struct ControlProblem::Impl
   }
   std::vector<ThroughPoint> Through;
   std::vector<ControlVariable> Variables;
+  /// Per variable, the blocks a feasible update recomputed when it moved (a superset of
+  /// what it changes: the update may have moved other variables too); empty: not known.
+  std::vector<std::vector<char>> VariableBlocks;
+  std::vector<std::size_t> LastMoved; ///< variables the last place() changed
+
+  /// Notes the blocks the last (feasible) update recomputed against the variable it moved,
+  /// when it moved one (a step that also moved back the last trial's variable recomputes
+  /// that one's blocks too).
+  void learnBlocks()
+  {
+    if (LastMoved.size() != 1)
+    {
+      return;
+    }
+    for (std::size_t i : LastMoved)
+    {
+      std::vector<char>& blocks = VariableBlocks[i];
+      blocks.resize(Plan->blockCount(), 0);
+      for (int b : Plan->updatedBlocks())
+      {
+        blocks[b] = 1;
+      }
+    }
+  }
   /// The grid kept alive between evaluations, and the configuration it holds.
   std::unique_ptr<model::MeshPlan> Plan;
   std::vector<double> Current;
@@ -235,12 +259,14 @@ struct ControlProblem::Impl
     }
     BlockModel& work = Plan->model();
     std::vector<int> moved;
+    LastMoved.clear();
     for (std::size_t i = 0; i < Variables.size(); ++i)
     {
       if (x[i] != Current[i])
       {
         setVariable(work, Plan->carriers(), Variables[i], x[i]);
         moved.push_back(Variables[i].vertex);
+        LastMoved.push_back(i);
       }
     }
     Current = x;
@@ -441,6 +467,15 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
   };
   // The boundary test: a small step must keep every moved vertex on its boundary faces.
   std::set<std::string> locked;
+  std::set<std::pair<int, int>> inert; // (vertex, component) whose step changes nothing
+  std::vector<char> carrierEdgeEnd(vertexCount, 0);
+  for (const model::Edge& edge : base.edges)
+  {
+    if (edge.carrier >= 0)
+    {
+      carrierEdgeEnd[edge.from] = carrierEdgeEnd[edge.to] = 1;
+    }
+  }
   std::vector<model::FreeParameter> kept;
   std::vector<char> moves(vertexCount, 0); // vertex moves with some kept parameter
   for (const model::FreeParameter& parameter : candidates)
@@ -457,7 +492,8 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
     const double step = value + probeStep <= parameter.high || parameter.wraps ? probeStep : -probeStep;
     setParameter(probe, P->Geometry, v, parameter.component, value + step);
     bool keeps = true;
-    for (int w : model::applyPlacement(probe, probeGeometry, { v }))
+    const std::vector<int> placed = model::applyPlacement(probe, probeGeometry, { v });
+    for (int w : placed)
     {
       keeps = keeps && staysOnBoundary(probe, w);
     }
@@ -465,6 +501,27 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
     {
       locked.insert(base.vertices[v].name + (parameter.component == 0 ? ".s" : ".t"));
       continue;
+    }
+    // A parameter whose step moves no block vertex, no carrier edge end and no curve (a
+    // helper vertex outside the blocks, or a vertex its rule places whatever the
+    // parameter) changes no grid.
+    bool changesNothing = std::all_of(placed.begin(), placed.end(), [&](int w) {
+      const model::Vertex &before = base.vertices[w], &after = probe.vertices[w];
+      const bool same = after.position == before.position &&
+        after.constraint.s == before.constraint.s && after.constraint.t == before.constraint.t;
+      return same || (!inBlock[w] && !carrierEdgeEnd[w]);
+    });
+    for (std::size_t c = 0; changesNothing && c < base.carriers.size(); ++c)
+    {
+      changesNothing = probe.carriers[c].parameterPoints == base.carriers[c].parameterPoints;
+    }
+    for (std::size_t e = 0; changesNothing && e < base.edges.size(); ++e)
+    {
+      changesNothing = probe.edges[e].at == base.edges[e].at;
+    }
+    if (changesNothing)
+    {
+      inert.insert({ v, parameter.component });
     }
     kept.push_back(parameter);
     for (int w : followers(dependents, v))
@@ -559,6 +616,7 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
       variable.high = std::min(variable.high, parameter.high);
     }
     variable.name = vertex.name + (component == 0 ? ".s" : ".t");
+    variable.inert = inert.count({ v, component }) > 0;
     if (variable.low < variable.high)
     {
       Variables.push_back(variable);
@@ -629,6 +687,7 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
     Variables.end());
   Locked.assign(locked.begin(), locked.end());
   P->Variables = Variables;
+  P->VariableBlocks.resize(Variables.size());
 }
 
 ControlProblem::~ControlProblem() = default;
@@ -669,6 +728,10 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
   {
     const model::Feasibility feasibility = P->place(x);
     P->forgetUpdated();
+    if (feasibility.feasible())
+    {
+      P->learnBlocks();
+    }
     if (P->Objective.kind != ObjectiveKind::NonOrthogonality && feasibility.feasible())
     {
       return P->measureChanged();
@@ -704,6 +767,28 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
     failed.failure = error.what();
     return failed;
   }
+}
+
+bool ControlProblem::mayGain(std::size_t variable, const GridMeasures& current) const
+{
+  if (Variables.at(variable).inert)
+  {
+    return false;
+  }
+  const std::vector<char>& blocks = P->VariableBlocks.at(variable);
+  if (P->Objective.kind != ObjectiveKind::MinAngle || !current.feasible || blocks.empty() ||
+    current.activeBlocks.size() != blocks.size())
+  {
+    return true;
+  }
+  for (std::size_t b = 0; b < blocks.size(); ++b)
+  {
+    if (blocks[b] && current.activeBlocks[b])
+    {
+      return true;
+    }
+  }
+  return false;
 }
 
 BlockModel ControlProblem::modelAt(const std::vector<double>& x)

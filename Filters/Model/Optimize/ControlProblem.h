@@ -47,6 +47,9 @@ struct ControlVariable
   int component = 0;
   double start = 0.0, low = 0.0, high = 1.0;
   std::string name; ///< "vertex.s", "vertex.t", or "vertex.x", "vertex.y", "vertex.z"
+  /// A small step of it moved no vertex, carrier edge end or curve (its vertex follows a
+  /// rule that places it whatever the parameter): its trials cannot change the grid.
+  bool inert = false;
 };
 
 /// A manual move: the control point's new parameters (s on a curve, s and t on a surface).
@@ -91,6 +94,17 @@ public:
   /// Places the configuration, meshes it and measures its final cells. Never throws: a
   /// configuration the mesher refuses is infeasible, with the reason in `failure`.
   GridMeasures evaluate(const std::vector<double>& x);
+  /**
+   * Whether moving variable `variable` alone from the configuration measured as `current`
+   * may raise the smooth minimum angle (a TrialFilter for the search). False only when
+   * every block such a move recomputed in the evaluations so far lies outside the smooth
+   * minimum's window (GridMeasures::activeBlocks): the other blocks keep their angles, so
+   * the move can only add terms to the smooth minimum's sum (or lower the minimum itself,
+   * the objective gaining then at most through corners near the window's far edge, whose
+   * terms are below e^-14 of the worst corner's). False for an inert variable. Otherwise
+   * true for other objectives and for a variable not yet moved in a feasible evaluation.
+   */
+  bool mayGain(std::size_t variable, const GridMeasures& current) const;
   /// The model at configuration x (vertices, carrier edges and surface curves moved).
   model::BlockModel modelAt(const std::vector<double>& x);
   /// The vertices placed at configuration x (placement rules only: no edge, curve or

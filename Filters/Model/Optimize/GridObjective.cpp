@@ -162,6 +162,10 @@ BlockAngles::BlockAngles(const BlockGrid& grid)
       }
     }
   }
+  for (double angle : CellMin)
+  {
+    Lowest = std::min(Lowest, angle);
+  }
 }
 
 bool BlockAngles::touchesCollapsedEdge(std::size_t n) const
@@ -331,9 +335,12 @@ GridMeasures measureAngles(const std::vector<const BlockAngles*>& blocks, double
   }
   measures.minAngle = angles.empty() ? 0.0 : *std::min_element(angles.begin(), angles.end());
   double sum = 0.0;
+  // cornerSum leaves out the cells above this (as it computes it)
+  const double cutoff = measures.minAngle + softRange / settings.angleSharpness;
   for (const BlockAngles* block : blocks) // block order: the same sum bit for bit
   {
     sum += block->cornerSum(measures.minAngle, settings.angleSharpness);
+    measures.activeBlocks.push_back(block->lowest() <= cutoff ? 1 : 0);
   }
   measures.softMinAngle =
     sum > 0.0 ? measures.minAngle - std::log(sum) / settings.angleSharpness : measures.minAngle;

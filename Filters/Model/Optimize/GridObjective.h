@@ -59,6 +59,8 @@ class BlockAngles
 public:
   explicit BlockAngles(const BlockGrid& grid);
   const std::vector<double>& cellMinimum() const { return CellMin; }
+  /// The smallest of cellMinimum() (180 for a block without cells).
+  double lowest() const { return Lowest; }
   /**
    * Sum of exp(-sharpness (angle - lowest)) over the 24 face corner angles of every cell
    * (the terms of the smooth minimum); corners more than 20 / sharpness degrees above
@@ -76,6 +78,7 @@ private:
   std::array<std::size_t, 3> Steps{};
   double Collapsed = 0.0;
   std::vector<double> CellMin;
+  double Lowest = 180.0;
   std::vector<char> Exact;
 };
 
@@ -104,6 +107,10 @@ struct GridMeasures
   double maxSizeRatio = 1.0;      ///< largest neighbour size ratio (MinAngleAndSizeRatio)
   double maxNonOrthogonality = 0.0; ///< NonOrthogonality objective only, degrees
   std::array<long long, 5> classes{}; ///< MinAngle classes 0-20, 20-40, ... 80-90
+  /// Angle objectives: per block, whether any of its corners lies within the smooth
+  /// minimum's window (cornerSum counts it); a step that changes only blocks outside the
+  /// window cannot raise the smooth minimum. Empty for other objectives.
+  std::vector<char> activeBlocks;
   double objective = 0.0;         ///< the value minimised (lower is better)
   std::string failure;            ///< why it is not feasible
 };

@@ -1,8 +1,10 @@
 #include "Optimizer.h"
 
 #include "MemoryBudget.h"
+#include "Topology.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 namespace blockforge
@@ -11,37 +13,40 @@ namespace optimize
 {
 namespace
 {
-/// Nodes of the grid of `model` at density multiplier `density` (as the mesher rounds).
-double nodeCount(const model::BlockModel& model, double density)
-{
-  double nodes = 0.0;
-  for (const model::Block& block : model.blocks)
-  {
-    double product = 1.0;
-    for (int cells : block.cells)
-    {
-      product *= std::max(1.0, std::round(cells * density)) + 1.0;
-    }
-    nodes += product;
-  }
-  return nodes;
-}
-
-/// Node counts of every block at density multiplier `density` (for the memory check; the
-/// density is valid, checkDensityMultiplier, so every count fits an int).
+/// Node counts of every block at density multiplier `density` (as the mesher makes them).
 model::BlockNodeCounts nodeCounts(const model::BlockModel& model, double density)
 {
   model::BlockNodeCounts counts;
   for (const model::Block& block : model.blocks)
   {
-    std::array<int, 3> n{};
-    for (int d = 0; d < 3; ++d)
-    {
-      n[d] = static_cast<int>(std::max(1.0, std::round(block.cells[d] * density))) + 1;
-    }
-    counts.push_back(n);
+    counts.push_back(model::scaledNodeCounts(block, density));
   }
   return counts;
+}
+
+/// Nodes of the grid of `model` at density multiplier `density`.
+double nodeCount(const model::BlockModel& model, double density)
+{
+  double nodes = 0.0;
+  for (const std::array<int, 3>& n : nodeCounts(model, density))
+  {
+    nodes += static_cast<double>(n[0]) * n[1] * n[2];
+  }
+  return nodes;
+}
+
+/// A history row for an evaluation made outside the search (manual moves only).
+HistoryEntry historyEntry(
+  int evaluation, const GridMeasures& measures, std::chrono::steady_clock::time_point begin)
+{
+  HistoryEntry entry;
+  entry.evaluation = evaluation;
+  entry.objective = measures.objective;
+  entry.minAngle = measures.feasible ? measures.minAngle : 0.0;
+  entry.feasible = measures.feasible;
+  entry.seconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  return entry;
 }
 } // namespace
 
@@ -63,6 +68,7 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
   model::checkDensityMultiplier(model, requested.densityMultiplier);
   model::checkGridMemory(nodeCounts(model, requested.densityMultiplier),
     requested.maximumMemory, "lower the density multiplier or the cell counts");
+  const std::chrono::steady_clock::time_point begin = std::chrono::steady_clock::now();
   OptimizerSettings settings = requested;
   settings.densityMultiplier = measuredDensity(model, requested.densityMultiplier);
   OptimizerResult result;
@@ -87,17 +93,34 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
   result.boundaryLocked = problem.boundaryLocked();
   if (!settings.automatic)
   {
+    // Manual moves only: the history holds the input (evaluation 1) and, when points
+    // were moved, the moved model (evaluation 2), which is the result.
     result.after = problem.evaluate(problem.start());
     if (settings.moves.empty())
     {
       result.before = result.after;
     }
+    SearchResult& record = result.search;
+    record.start = result.before;
+    record.bestMeasures = result.after;
+    record.best = problem.start();
+    record.history.push_back(historyEntry(1, result.before, begin));
+    if (!settings.moves.empty())
+    {
+      record.history.push_back(historyEntry(2, result.after, begin));
+    }
+    record.evaluations = static_cast<int>(record.history.size());
+    record.seconds = record.history.back().seconds;
+    record.stopReason = "manual moves only";
     return result;
   }
   result.search = search(problem.start(), problem.low(), problem.high(),
     settings.objective.kind,
     [&](const std::vector<double>& x) { return problem.evaluate(x); }, settings.search,
-    progress);
+    progress,
+    [&](std::size_t variable, const GridMeasures& current) {
+      return problem.mayGain(variable, current);
+    });
   result.after = result.search.bestMeasures;
   if (settings.moves.empty())
   {

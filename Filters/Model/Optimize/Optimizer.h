@@ -48,7 +48,9 @@ struct OptimizerResult
   model::BlockModel model;           ///< the model with moved vertices
   GridMeasures before;               ///< the input model's grid
   GridMeasures after;                ///< the output model's grid
-  SearchResult search;               ///< history of the automatic run (empty without one)
+  /// History of the automatic run; without one (manual moves only), the input's evaluation
+  /// and, when points were moved, the moved model's.
+  SearchResult search;
   std::vector<ControlVariable> variables;
   std::vector<std::string> boundaryLocked;
   double densityMultiplier = 1.0;    ///< the density the objective was measured at

@@ -58,6 +58,7 @@ struct SearchState
   const ProgressFunction* progress = nullptr;
   ObjectiveKind kind = ObjectiveKind::MinAngle;
   int maxEvaluations = 1;
+  int trials = 0; ///< evaluations and skipped trials, against maxEvaluations
   std::chrono::steady_clock::time_point begin;
   SearchResult* result = nullptr;
   double bestObjective = 0.0;
@@ -76,6 +77,7 @@ struct SearchState
   {
     GridMeasures measures = (*evaluate)(x);
     SearchResult& out = *result;
+    ++trials;
     HistoryEntry entry;
     entry.evaluation = ++out.evaluations;
     entry.objective = measures.objective;
@@ -100,7 +102,7 @@ struct SearchState
     }
     if (*progress)
     {
-      (*progress)(std::min(1.0, static_cast<double>(out.evaluations) / maxEvaluations));
+      (*progress)(std::min(1.0, static_cast<double>(trials) / maxEvaluations));
     }
     return measures;
   }
@@ -111,10 +113,11 @@ struct SearchState
  * up and down (the direction that last succeeded first); a step that lowers the objective
  * is taken and grows by half, one that does not halves. Stops when every step is below
  * 1e-7 of its range, or when a pass that took steps gained less than `tolerance`.
+ * A trial `mayGain` rules out is counted as a failed one without being evaluated.
  */
 void compassSearch(SearchState& state, const std::vector<double>& start,
   const std::vector<double>& low, const std::vector<double>& high,
-  const SearchSettings& settings, SearchResult& result)
+  const SearchSettings& settings, const TrialFilter& mayGain, SearchResult& result)
 {
   const std::size_t n = start.size();
   std::vector<double> x = start, step(n), direction(n, 1.0);
@@ -123,6 +126,7 @@ void compassSearch(SearchState& state, const std::vector<double>& start,
     step[i] = settings.initialStep * (high[i] - low[i]);
   }
   double value = result.history.front().objective;
+  GridMeasures current = result.start; // the measures of x
   auto largestStep = [&] {
     double largest = 0.0;
     for (std::size_t i = 0; i < n; ++i)
@@ -147,7 +151,7 @@ void compassSearch(SearchState& state, const std::vector<double>& start,
       bool improved = false;
       for (double sign : { direction[i], -direction[i] })
       {
-        if (result.evaluations >= state.maxEvaluations)
+        if (state.trials >= state.maxEvaluations)
         {
           result.stopReason = "evaluation limit reached";
           return;
@@ -158,11 +162,19 @@ void compassSearch(SearchState& state, const std::vector<double>& start,
         {
           continue;
         }
-        const double trial = state.record(y).objective;
+        if (mayGain && !mayGain(i, current))
+        {
+          ++state.trials;
+          ++result.skipped;
+          continue;
+        }
+        GridMeasures measures = state.record(y);
+        const double trial = measures.objective;
         if (trial < value)
         {
           x = y;
           value = trial;
+          current = std::move(measures);
           direction[i] = sign;
           step[i] *= 1.5;
           improved = true;
@@ -199,7 +211,7 @@ double nloptObjective(unsigned n, const double* u, double* gradient, void* data)
 
 SearchResult search(const std::vector<double>& start, const std::vector<double>& low,
   const std::vector<double>& high, ObjectiveKind kind, const EvaluateFunction& evaluate,
-  const SearchSettings& settings, const ProgressFunction& progress)
+  const SearchSettings& settings, const ProgressFunction& progress, const TrialFilter& mayGain)
 {
   const std::size_t n = start.size();
   if (low.size() != n || high.size() != n)
@@ -248,7 +260,7 @@ SearchResult search(const std::vector<double>& start, const std::vector<double>&
   }
   if (settings.algorithm == SearchAlgorithm::Compass)
   {
-    compassSearch(state, start, low, high, settings, result);
+    compassSearch(state, start, low, high, settings, mayGain, result);
     result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - state.begin).count();
     return result;

@@ -58,6 +58,9 @@ struct SearchResult
   GridMeasures start, bestMeasures;
   std::vector<HistoryEntry> history;
   int evaluations = 0;
+  /// Compass trials left out because they could not gain (TrialFilter); they count
+  /// against maxEvaluations, so the search takes the steps it takes when evaluating them.
+  int skipped = 0;
   double seconds = 0.0;
   std::string stopReason;         ///< NLopt's reason, for the log
 };
@@ -66,6 +69,10 @@ struct SearchResult
 using EvaluateFunction = std::function<GridMeasures(const std::vector<double>& x)>;
 /// Progress in [0, 1] after each evaluation.
 using ProgressFunction = std::function<void(double)>;
+/// Whether a compass trial of variable `variable` from the configuration measured as
+/// `current` may lower the objective; false only when it certainly cannot (the trial
+/// is then counted as failed without evaluating it).
+using TrialFilter = std::function<bool(std::size_t variable, const GridMeasures& current)>;
 
 /**
  * Minimises the objective of `evaluate` over low <= x <= high from `start` (inside the
@@ -75,6 +82,7 @@ using ProgressFunction = std::function<void(double)>;
  */
 SearchResult search(const std::vector<double>& start, const std::vector<double>& low,
   const std::vector<double>& high, ObjectiveKind kind, const EvaluateFunction& evaluate,
-  const SearchSettings& settings, const ProgressFunction& progress = {});
+  const SearchSettings& settings, const ProgressFunction& progress = {},
+  const TrialFilter& mayGain = {});
 } // namespace optimize
 } // namespace blockforge
