@@ -51,6 +51,7 @@
 #include <functional>
 #include <iostream>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -68,8 +69,10 @@ const std::string Source = BLOCKFORGE_SOURCE_DIR;
 /**
  * A pool of threads kept for the whole run (starting threads for every chunked loop
  * would cost more than the small loops of one evaluation): the caller and the workers
- * take chunks in turn. A loop started from inside a chunk runs in the thread that
- * started it, as vtkSMPTools runs nested loops.
+ * take chunks in turn, and the caller waits only for chunks a worker has taken, never
+ * for a worker to wake up (on a loaded machine that can take a time slice). A loop
+ * started from inside a chunk runs in the thread that started it, as vtkSMPTools runs
+ * nested loops.
  */
 class ThreadPool
 {
@@ -98,32 +101,47 @@ public:
 
   void run(long count, const std::function<void(long, long)>& body)
   {
-    if (InChunk || Workers.empty())
+    if (InChunk || Workers.empty() || count <= 1)
     {
       body(0, count);
       return;
     }
+    const auto job = std::make_shared<Job>();
+    job->body = &body;
+    job->count = count;
     {
       std::lock_guard<std::mutex> lock(Mutex);
-      Body = &body;
-      Count = count;
-      Next = 0;
-      Active = static_cast<int>(Workers.size());
+      Current = job;
       ++Generation;
     }
     Wake.notify_all();
-    drain();
+    drain(*job);
     std::unique_lock<std::mutex> lock(Mutex);
-    Done.wait(lock, [this] { return Active == 0; });
+    Done.wait(lock, [&] { return job->finished.load() == job->count; });
   }
 
 private:
-  void drain()
+  /// One loop: chunks are taken by counting up `next`; a worker that wakes after all
+  /// are taken finds none (the job outlives the loop while a worker holds it).
+  struct Job
+  {
+    const std::function<void(long, long)>* body = nullptr;
+    long count = 0;
+    std::atomic<long> next{ 0 };
+    std::atomic<long> finished{ 0 };
+  };
+
+  void drain(Job& job)
   {
     InChunk = true;
-    for (long chunk = Next++; chunk < Count; chunk = Next++)
+    for (long chunk = job.next++; chunk < job.count; chunk = job.next++)
     {
-      (*Body)(chunk, chunk + 1);
+      (*job.body)(chunk, chunk + 1);
+      if (++job.finished == job.count)
+      {
+        std::lock_guard<std::mutex> lock(Mutex);
+        Done.notify_all();
+      }
     }
     InChunk = false;
   }
@@ -132,6 +150,7 @@ private:
     unsigned long seen = 0;
     for (;;)
     {
+      std::shared_ptr<Job> job;
       {
         std::unique_lock<std::mutex> lock(Mutex);
         Wake.wait(lock, [&] { return Stop || Generation != seen; });
@@ -140,13 +159,9 @@ private:
           return;
         }
         seen = Generation;
+        job = Current;
       }
-      drain();
-      std::lock_guard<std::mutex> lock(Mutex);
-      if (--Active == 0)
-      {
-        Done.notify_one();
-      }
+      drain(*job);
     }
   }
 
@@ -154,10 +169,7 @@ private:
   std::vector<std::thread> Workers;
   std::mutex Mutex;
   std::condition_variable Wake, Done;
-  const std::function<void(long, long)>* Body = nullptr;
-  long Count = 0;
-  std::atomic<long> Next{ 0 };
-  int Active = 0;
+  std::shared_ptr<Job> Current;
   unsigned long Generation = 0;
   bool Stop = false;
 };
@@ -278,18 +290,45 @@ const Applied& appliedWithoutChains()
   return result;
 }
 
+/**
+ * The control point the entries move: the O-grid corner `oa_f_h` when the template has
+ * one (the figures of earlier builds), else the vertex with a free parameter that most
+ * vertices follow (the template is redesigned from time to time; the entry must keep
+ * measuring a move with followers).
+ */
+model::FreeParameter movedParameter(const model::BlockModel& model, const model::CarrierGeometry& carriers)
+{
+  const std::vector<model::FreeParameter> parameters = model::freeParameters(model, carriers);
+  const std::vector<std::vector<int>> dependents = model::vertexDependents(model);
+  const int corner = model.findVertex("oa_f_h");
+  const model::FreeParameter* best = nullptr;
+  for (const model::FreeParameter& p : parameters)
+  {
+    if (p.component != 0)
+    {
+      continue;
+    }
+    if (p.vertex == corner)
+    {
+      return p;
+    }
+    if (!best || dependents[p.vertex].size() > dependents[best->vertex].size())
+    {
+      best = &p;
+    }
+  }
+  if (!best)
+  {
+    throw std::runtime_error("the template has no vertex with a free parameter to move");
+  }
+  return *best;
+}
+
 void moveOneControlPoint(benchmark::State& state, const Applied& a)
 {
   model::MeshPlan plan(a.model, a.carriers);
-  const int vertex = plan.model().findVertex("oa_f_h");
-  model::FreeParameter parameter;
-  for (const model::FreeParameter& p : model::freeParameters(plan.model(), plan.carriers()))
-  {
-    if (p.vertex == vertex && p.component == 0)
-    {
-      parameter = p;
-    }
-  }
+  const model::FreeParameter parameter = movedParameter(plan.model(), plan.carriers());
+  const int vertex = parameter.vertex;
   const double original = plan.model().vertices[vertex].constraint.s;
   long long step = 0, cells = 0, blocks = 0, infeasible = 0;
   for (auto _ : state)
@@ -364,6 +403,8 @@ int main(int argc, char** argv)
   {
     benchmark::AddCustomContext("template", templatePath());
     benchmark::AddCustomContext("threads", std::to_string(threads));
+    benchmark::AddCustomContext("moved vertex",
+      applied().model.vertices[movedParameter(applied().model, applied().carriers).vertex].name);
     benchmark::AddCustomContext("blocks", std::to_string(applied().model.blocks.size()));
   }
   catch (const std::exception& error)

@@ -686,19 +686,7 @@ private:
     }
     for (const YAML::Node& face : faces.value)
     {
-      const std::string name = text(face, faces.line, entityText, "face");
-      const std::size_t dot = name.rfind('.');
-      BlockFace blockFace;
-      if (dot != std::string::npos)
-      {
-        blockFace.block = Model.findBlock(name.substr(0, dot));
-        blockFace.face = faceFromName(name.substr(dot + 1));
-      }
-      if (blockFace.block < 0 || blockFace.face < 0)
-      {
-        fail(here(face, faces.line), entityText, "unknown face '" + name + "'");
-      }
-      patch.faces.push_back(blockFace);
+      patch.faces.push_back(blockFaceRef(face, faces.line, entityText));
     }
     if (const MapEntry* partner = syntax::findEntry(keys, "partner"))
     {
