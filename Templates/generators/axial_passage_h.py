@@ -12,6 +12,8 @@ Usage: /usr/bin/python3 Templates/generators/axial_passage_h.py [--check]
 import os
 import sys
 
+from template_file import write_or_check
+
 TEMPLATE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "axial_passage_h.yaml")
 
 HEADER = """# Written by Templates/generators/axial_passage_h.py: edit that, then run it.
@@ -180,17 +182,7 @@ def template_text():
 
 
 def main(argv):
-    text = template_text()
-    if "--check" in argv:
-        with open(TEMPLATE, encoding="utf-8") as stream:
-            if stream.read() != text:
-                print(f"{TEMPLATE} differs from what {__file__} writes; run it to update")
-                return 1
-        print("up to date")
-        return 0
-    with open(TEMPLATE, "w", encoding="utf-8") as stream:
-        stream.write(text)
-    return 0
+    return write_or_check(TEMPLATE, template_text(), __file__, argv)
 
 
 if __name__ == "__main__":
