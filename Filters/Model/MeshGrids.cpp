@@ -639,6 +639,30 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
         st[k][d] += 1.0;
     }
   }
+  // The closest point of the whole surface can lie on the far side of a thin edge (a
+  // blade's leading or trailing edge, where both sides are closer than the projector's
+  // sample spacing): follow the loop from each node's neighbour as well, and keep the
+  // nearer of the two.
+  const double onSurface = 1e-9 * geometry.size(carrier);
+  auto follow = [&](int k, int from) {
+    double s = st[from][0], t = st[from][1];
+    Vec3 start;
+    closestNear(geometry, carrier, loop[k], s, t, start);
+    const double near = (geometry.point(carrier, s, t) - loop[k]).norm();
+    const double global = (geometry.point(carrier, st[k][0], st[k][1]) - loop[k]).norm();
+    if (near + onSurface < global)
+    {
+      st[k] = Eigen::Vector2d(s, t);
+    }
+  };
+  for (int k = 1; k < loopSize; ++k)
+  {
+    follow(k, k - 1);
+  }
+  follow(0, 1);
+  if (std::getenv("BF_DEBUG_LOOP") && block == std::atoi(std::getenv("BF_DEBUG_LOOP")) && face == 2)
+    for (int k = 0; k < loopSize; ++k)
+      std::fprintf(stderr, "loop %d %.6f %.6f  xyz %.6f %.6f %.6f\n", k, st[k][0], st[k][1], loop[k][0], loop[k][1], loop[k][2]);
   auto fill = [&](int count, auto index) {
     std::vector<double> xyz(3 * count);
     for (int i = 0; i < count; ++i)
@@ -677,6 +701,8 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
       {
         p = p0; // no better than the (s, t) node: keep that
       }
+      if (std::getenv("BF_DEBUG_FACE"))
+        std::fprintf(stderr, "face b%d f%d a%d b%d st0 %.6f %.6f st %.6f %.6f d0 %.3e d %.3e fell %d\n", block, face, a, b, s0, t0, s, t, (p0 - target).norm(), (geometry.point(carrier, s, t) - target).norm(), int(p == p0));
       std::copy_n(p.data(), 3, &out[3 * i]);
     }
   });
