@@ -626,13 +626,17 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
       st[k] = Eigen::Vector2d(s, t);
     }
   };
+  // Both ways round: from a sharp edge's tip the way on is ambiguous, from the other
+  // neighbour it is not.
   for (int k = 1; k < loopSize; ++k)
   {
     unwrap(k, k - 1);
     follow(k, k - 1);
   }
-  follow(0, 1);
-  unwrap(0, 1);
+  for (int k = loopSize - 2; k >= 0; --k)
+  {
+    follow(k, k + 1);
+  }
   out.resize(3 * static_cast<std::size_t>(na) * nb);
   surfaceFaceGrid(surface, st, bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data());
 }
