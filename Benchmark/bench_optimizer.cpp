@@ -417,6 +417,10 @@ int main(int argc, char** argv)
     {
       settings.objective.kind = objectiveFromName(argv[++a]);
     }
+    else if (arg == "--size-limit" && a + 1 < argc)
+    {
+      settings.objective.sizeRatioLimit = std::atof(argv[++a]);
+    }
     else if (arg == "--size-weight" && a + 1 < argc)
     {
       settings.objective.sizeRatioWeight = std::atof(argv[++a]);
@@ -581,7 +585,7 @@ int main(int argc, char** argv)
         ControlProblem problem(m, built, 1.0, settings.objective, {});
         const std::vector<std::vector<double>> grids = problem.gridAt(problem.start());
         model::MeshPlan plan(m, built);
-        double largest = 1.0;
+        std::pair<double, std::string> largest(1.0, "");
         for (std::size_t b = 0; b < grids.size(); ++b)
         {
           const std::array<int, 3> n = plan.nodeCounts(static_cast<int>(b));
@@ -590,14 +594,15 @@ int main(int argc, char** argv)
           grid.nj = n[1];
           grid.nk = n[2];
           grid.xyz = grids[b].data();
-          largest = std::max(largest, maxNeighbourSizeRatio(grid));
+          largest = std::max(largest, std::make_pair(maxNeighbourSizeRatio(grid), m.blocks[b].name));
         }
         return largest;
       };
       try
       {
-        std::fprintf(stderr, "  size ratio within blocks: %.2f -> %.2f\n", largestRatio(model),
-          largestRatio(result.model));
+        const auto before = largestRatio(model), after = largestRatio(result.model);
+        std::fprintf(stderr, "  size ratio within blocks: %.2f (%s) -> %.2f (%s)\n", before.first,
+          before.second.c_str(), after.first, after.second.c_str());
       }
       catch (const std::exception& error)
       {
