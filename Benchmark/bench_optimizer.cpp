@@ -10,14 +10,15 @@
 // Usage: bench_optimizer [--repetitions N] [--evaluations N] [--sharpness K] [--step F]
 //          [--algorithm bobyqa|cobyla|subplex] [--blocks] [--timing] [--csv FILE]
 //          [--history FILE] [--no-baselines] [--objective NAME] [--size-weight W]
-//          [--scan name:weight,... T] [--probe] template.yaml input.inf [...]
+//          [--scan name:weight,... T] [--probe] [--max-skew S] template.yaml input.inf [...]
 // --blocks: where the smallest angles are (block, cell, grid plane) and which variables end
 // on their bounds; --csv: the table's numbers for Benchmark/optimizer_figure.py; --history:
 // every evaluation of every case (objective, smallest angle, the best so far); --no-baselines:
 // the optimizer alone; --objective, --size-weight: ObjectiveSettings; --scan: the smallest
 // angle along a direction from the optimizer's result (weights in units of each
 // variable's range, steps up to T times the direction each way), with the lowest blocks;
-// --probe: the smallest angle after moving each variable alone a little from the result.
+// --probe: the smallest angle after moving each variable alone a little from the result;
+// --max-skew: OptimizerSettings::maximumSkew (1: no distribution skews).
 #include "Optimizer.h"
 
 #include "../Testing/Cxx/TestTurboInputs.h"
@@ -280,7 +281,8 @@ void scanDirection(const model::BlockModel& model, const model::CarrierGeometry&
   const OptimizerSettings& settings, const std::vector<double>& best, const std::string& spec,
   double scale)
 {
-  ControlProblem problem(model, geometry, 1.0, settings.objective, {});
+  ControlProblem problem(model, geometry, 1.0, settings.objective, {},
+    settings.skewDistributions ? settings.maximumSkew : 0.0);
   const std::vector<ControlVariable>& variables = problem.variables();
   std::vector<double> direction(variables.size(), 0.0);
   std::size_t from = 0;
@@ -340,7 +342,8 @@ void scanDirection(const model::BlockModel& model, const model::CarrierGeometry&
 void probeVariables(const model::BlockModel& model, const model::CarrierGeometry& geometry,
   const OptimizerSettings& settings, const std::vector<double>& best)
 {
-  ControlProblem problem(model, geometry, 1.0, settings.objective, {});
+  ControlProblem problem(model, geometry, 1.0, settings.objective, {},
+    settings.skewDistributions ? settings.maximumSkew : 0.0);
   const std::vector<ControlVariable>& variables = problem.variables();
   const GridMeasures here = problem.evaluate(best);
   std::fprintf(stderr, "  probe from %.2f deg (moves of -5, -1, +1, +5 %% of the range):\n",
@@ -441,6 +444,11 @@ int main(int argc, char** argv)
     {
       scan = argv[++a];
       scanScale = std::atof(argv[++a]);
+    }
+    else if (arg == "--max-skew" && a + 1 < argc)
+    {
+      settings.maximumSkew = std::atof(argv[++a]);
+      settings.skewDistributions = settings.maximumSkew > 1.0;
     }
     else if (arg == "--probe")
     {
@@ -634,13 +642,15 @@ int main(int argc, char** argv)
     if (probe)
     {
       probeVariables(model, geometry, settings,
-        result.search.best.empty() ? ControlProblem(model, geometry, 1.0, settings.objective, {}).start()
+        result.search.best.empty() ? ControlProblem(model, geometry, 1.0, settings.objective, {},
+            settings.skewDistributions ? settings.maximumSkew : 0.0).start()
                                    : result.search.best);
     }
     if (!scan.empty())
     {
       scanDirection(model, geometry, settings,
-        result.search.best.empty() ? ControlProblem(model, geometry, 1.0, settings.objective, {}).start()
+        result.search.best.empty() ? ControlProblem(model, geometry, 1.0, settings.objective, {},
+            settings.skewDistributions ? settings.maximumSkew : 0.0).start()
                                    : result.search.best,
         scan, scanScale);
     }

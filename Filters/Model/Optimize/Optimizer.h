@@ -41,6 +41,11 @@ struct OptimizerSettings
   std::vector<ControlPointMove> moves;
   /// false: only the manual moves are applied (no automatic run).
   bool automatic = true;
+  /// The automatic run also skews the node distributions of block directions graded
+  /// `ends` (ControlProblem): the passage templates' blade sides.
+  bool skewDistributions = true;
+  /// A skewed distribution's end cells change at most this many times either way.
+  double maximumSkew = 3.0;
 };
 
 struct OptimizerResult
