@@ -18,7 +18,8 @@
 // angle along a direction from the optimizer's result (weights in units of each
 // variable's range, steps up to T times the direction each way), with the lowest blocks;
 // --probe: the smallest angle after moving each variable alone a little from the result;
-// --max-skew: OptimizerSettings::maximumSkew (1: no distribution skews).
+// --max-skew: skew distributions (OptimizerSettings::skewDistributions) by at most this
+// (1: none, the default).
 #include "Optimizer.h"
 
 #include "../Testing/Cxx/TestTurboInputs.h"

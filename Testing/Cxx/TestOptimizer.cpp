@@ -109,6 +109,7 @@ TEST(Optimizer, SkewFindsTheMatchingDistribution)
   OptimizerSettings settings;
   settings.search.tolerance = 1e-12;
   settings.search.maxEvaluations = 300;
+  settings.skewDistributions = true;
   const OptimizerResult result = optimizeModel(loaded.model, loaded.geometry, settings);
   // The lower block's i-direction is the only one graded `ends` on all four edges.
   ASSERT_EQ(result.variables.size(), 1u);
