@@ -246,6 +246,14 @@ void printWorstCells(const std::string& block, const std::vector<double>& xyz,
   std::fprintf(stderr, "\n");
 }
 
+/// Block b of `grids` (nodes as ControlProblem::gridAt gives them, counts from `plan`).
+BlockGrid blockGrid(const model::MeshPlan& plan, const std::vector<std::vector<double>>& grids,
+  std::size_t b)
+{
+  const std::array<int, 3> n = plan.nodeCounts(static_cast<int>(b));
+  return BlockGrid{ grids[b].data(), n[0], n[1], n[2] };
+}
+
 /// Per-block smallest angle of a grid, as "name angle" of the `count` lowest blocks.
 std::string blockMinima(const model::BlockModel& model, const std::vector<std::vector<double>>& grids,
   model::MeshPlan& plan, std::size_t count)
@@ -253,13 +261,7 @@ std::string blockMinima(const model::BlockModel& model, const std::vector<std::v
   std::vector<std::pair<double, std::string>> minima;
   for (std::size_t b = 0; b < grids.size(); ++b)
   {
-    const std::array<int, 3> n = plan.nodeCounts(static_cast<int>(b));
-    BlockGrid grid;
-    grid.ni = n[0];
-    grid.nj = n[1];
-    grid.nk = n[2];
-    grid.xyz = grids[b].data();
-    minima.emplace_back(BlockAngles(grid).lowest(), model.blocks[b].name);
+    minima.emplace_back(BlockAngles(blockGrid(plan, grids, b)).lowest(), model.blocks[b].name);
   }
   std::sort(minima.begin(), minima.end());
   std::string text;
@@ -597,13 +599,8 @@ int main(int argc, char** argv)
         std::pair<double, std::string> largest(1.0, "");
         for (std::size_t b = 0; b < grids.size(); ++b)
         {
-          const std::array<int, 3> n = plan.nodeCounts(static_cast<int>(b));
-          BlockGrid grid;
-          grid.ni = n[0];
-          grid.nj = n[1];
-          grid.nk = n[2];
-          grid.xyz = grids[b].data();
-          largest = std::max(largest, std::make_pair(maxNeighbourSizeRatio(grid), m.blocks[b].name));
+          largest = std::max(largest,
+            std::make_pair(maxNeighbourSizeRatio(blockGrid(plan, grids, b)), m.blocks[b].name));
         }
         return largest;
       };
