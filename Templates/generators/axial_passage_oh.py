@@ -93,22 +93,23 @@ parameters:
   n_span: 12              # cells from hub to shroud
   k_o: 1.15               # expansion ratio away from the blade in the O-grid
   k_span: 1.05            # expansion ratio away from hub and shroud (two-sided)
-  grade: 0                # blade sides: end cells (edge cell size / side mean cell)^grade; 1 matches the edge blocks' cells, 0 uniform (above 0.3 some machines fold at density 2 and more)
+  grade: 0.5              # blade sides: end cells (edge block's mean cell / side's mean cell)^grade times the side's mean cell
+  o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
 """
 
 FOOTER = """blocks:
-  O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}}}
-  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [fle_a_h, fte_a_h]}, E3: {ends: [ofle_a_h, ofte_a_h]}, E5: {ends: [fle_a_s, fte_a_s]}, E7: {ends: [ofle_a_s, ofte_a_s]}}}}
-  O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}}}
-  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [fte_b_h, fle_b_h]}, E3: {ends: [ofte_b_h, ofle_b_h]}, E5: {ends: [fte_b_s, fle_b_s]}, E7: {ends: [ofte_b_s, ofle_b_s]}}}}
-  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {k: {two_sided: k_span}}}
-  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], grading: {k: {two_sided: k_span}}}
-  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {k: {two_sided: k_span}}}
-  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {k: {two_sided: k_span}, edges: {E2: {ends: [ofle_a_h, ofte_a_h]}, E4: {ends: [ofle_a_h, ofte_a_h]}, E6: {ends: [ofle_a_s, ofte_a_s]}, E8: {ends: [ofle_a_s, ofte_a_s]}}}}
-  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {k: {two_sided: k_span}, edges: {E2: {ends: [ofle_a_h, ofte_a_h]}, E4: {ends: [ofle_b_h, ofte_b_h]}, E6: {ends: [ofle_a_s, ofte_a_s]}, E8: {ends: [ofle_b_s, ofte_b_s]}}}}
-  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], grading: {k: {two_sided: k_span}}}
-  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], grading: {k: {two_sided: k_span}}}
-  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], grading: {k: {two_sided: k_span}}}
+  O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_le_h}, E5: {project_from: ol_le_s}}}}
+  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [fle_a_h, fte_a_h]}, E3: {project_from: bl_a_h}, E5: {ends: [fle_a_s, fte_a_s]}, E7: {project_from: bl_a_s}}}}
+  O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
+  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [fte_b_h, fle_b_h]}, E3: {project_from: bl_b_h}, E5: {ends: [fte_b_s, fle_b_s]}, E7: {project_from: bl_b_s}}}}
+  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {project_from: bl_a_h}, E4: {ends: [ofle_a_h, ofte_a_h]}, E6: {project_from: bl_a_s}, E8: {ends: [ofle_a_s, ofte_a_s]}}}}
+  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {ends: [ofle_a_h, ofte_a_h]}, E4: {project_from: bl_b_h}, E6: {ends: [ofle_a_s, ofte_a_s]}, E8: {project_from: bl_b_s}}}}
+  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
 
 faces:
   hub_faces: {on_surface: hub, faces: [O_le.k0, O_a.k0, O_te.k0, O_b.k0, U_L.k0, U_M.k0, U_R.k0, M_L.k0, M_R.k0, D_L.k0, D_M.k0, D_R.k0]}
