@@ -406,6 +406,39 @@ double grownLength(double first, double last, double r, int cells)
 }
 } // namespace
 
+namespace
+{
+/// Whether cells grown from both given ends by at most `ratio` (raised when too few to
+/// fill the edge) and capped by a uniform middle keep both end cells: the cap that makes
+/// them fill the edge is at least as large as either end.
+bool grownKeepsEnds(double first, double last, double length, int cells, double ratio)
+{
+  double r = ratio;
+  if (grownLength(first, last, r, cells) < length)
+  {
+    return true; // the ratio is raised until they fill it: the cap is then the largest cell
+  }
+  std::vector<double> sorted(cells);
+  for (int i = 0; i < cells; ++i)
+  {
+    sorted[i] = grownCell(first, last, r, i, cells);
+  }
+  std::sort(sorted.begin(), sorted.end());
+  double below = 0.0, cap = sorted.back();
+  for (int k = 0; k < cells; ++k)
+  {
+    const double candidate = (length - below) / (cells - k);
+    if (candidate <= sorted[k])
+    {
+      cap = candidate;
+      break;
+    }
+    below += sorted[k];
+  }
+  return cap >= std::max(first, last);
+}
+} // namespace
+
 std::vector<double> matchedNodes(double first, double last, double length, int nodeCount,
   double ratio)
 {
@@ -432,9 +465,14 @@ std::vector<double> matchedNodes(double first, double last, double length, int n
     return uniform(nodeCount);
   }
   // An end cell larger than the mean cell: cells shrink from it towards the other end or
-  // the middle, with both ends exact (log-linear sizes plus a bump, as the Ends law).
+  // the middle, with both ends exact (log-linear sizes plus a bump, as the Ends law) --
+  // unless both ends are given and cells grown from them to a uniform middle keep them
+  // (the other end small enough): then those, so that the nodes do not jump when an end
+  // cell passes the mean cell (two edges across a periodic pair of nearly equal means
+  // sharing one end cell, one of them always a little above its mean).
   const double mean = length / cells;
-  if (first > mean || last > mean)
+  if ((first > mean || last > mean) &&
+    !(first > 0.0 && last > 0.0 && grownKeepsEnds(first, last, length, cells, ratio)))
   {
     if (first <= 0.0 || last <= 0.0)
     {

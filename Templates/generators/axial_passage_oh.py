@@ -64,6 +64,18 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
 #   from hub to shroud; H blocks run i with theta, j with the axis.
 # - theta is measured from the blade (machine: theta_zero), wherever the export puts it.
+# Grading (Templates/README.md, laws `match`, `ends`, `project_from`), so that neighbour cells
+# across the block interfaces differ little at every density:
+# - the O-grid: geometric k_o away from the blade (its outer cell is what the H blocks start
+#   with); the blade sides `ends`, their end cells (edge block's mean cell / side's mean
+#   cell, both on the O-grid's outer curve)^grade times the side's mean cell; the O-grid's
+#   outer sides the normal offsets of the blade sides' nodes (project_from); the edge blocks'
+#   outer arcs `match` (cells of their neighbours at both ends, growing by o_match towards
+#   the middle), their blade arcs the normal feet of the outer arcs' nodes (project_from:
+#   on a thin or sharp edge a fan, the nose resolved by the feet);
+# - every H edge `match`: the H blocks start from the O-grid's outer cells and the edge
+#   blocks' and sides' cells and grow towards the inlet, outlet and periodic lines; the
+#   periodic lines beside the sides take the sides' relative end cells (`ends`).
 blockforge: 2
 name: axial_passage_oh
 description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.
