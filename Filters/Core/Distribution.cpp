@@ -408,23 +408,21 @@ double grownLength(double first, double last, double r, int cells)
 
 namespace
 {
-/// Whether cells grown from both given ends by at most `ratio` (raised when too few to
-/// fill the edge) and capped by a uniform middle keep both end cells: the cap that makes
-/// them fill the edge is at least as large as either end.
-bool grownKeepsEnds(double first, double last, double length, int cells, double ratio)
+/// Cells grown from the given ends by `r` (grownCell) and the uniform cap c with
+/// sum(min(grown_i, c)) = length: the total is piecewise linear and increasing in c, found
+/// exactly from the sorted cells (c is the largest cell when even that total falls short).
+std::vector<double> grownCells(double first, double last, double r, double length, int cells,
+  double& cap)
 {
-  double r = ratio;
-  if (grownLength(first, last, r, cells) < length)
-  {
-    return true; // the ratio is raised until they fill it: the cap is then the largest cell
-  }
-  std::vector<double> sorted(cells);
+  std::vector<double> grown(cells);
   for (int i = 0; i < cells; ++i)
   {
-    sorted[i] = grownCell(first, last, r, i, cells);
+    grown[i] = grownCell(first, last, r, i, cells);
   }
+  std::vector<double> sorted = grown;
   std::sort(sorted.begin(), sorted.end());
-  double below = 0.0, cap = sorted.back();
+  double below = 0.0;
+  cap = sorted.back();
   for (int k = 0; k < cells; ++k)
   {
     const double candidate = (length - below) / (cells - k);
@@ -435,6 +433,20 @@ bool grownKeepsEnds(double first, double last, double length, int cells, double 
     }
     below += sorted[k];
   }
+  return grown;
+}
+
+/// Whether cells grown from both given ends by at most `ratio` (raised when too few to
+/// fill the edge) and capped by a uniform middle keep both end cells: the cap that makes
+/// them fill the edge is at least as large as either end.
+bool grownKeepsEnds(double first, double last, double length, int cells, double ratio)
+{
+  if (grownLength(first, last, ratio, cells) < length)
+  {
+    return true; // the ratio is raised until they fill it: the cap is then the largest cell
+  }
+  double cap = 0.0;
+  grownCells(first, last, ratio, length, cells, cap);
   return cap >= std::max(first, last);
 }
 } // namespace
@@ -513,26 +525,8 @@ std::vector<double> matchedNodes(double first, double last, double length, int n
     bisect([&](double x) { return grownLength(first, last, x, cells) < length; }, low, high, 0.0, 200);
     r = high;
   }
-  std::vector<double> grown(cells);
-  for (int i = 0; i < cells; ++i)
-  {
-    grown[i] = grownCell(first, last, r, i, cells);
-  }
-  // The uniform cap c with sum(min(grown_i, c)) = length: the total is piecewise linear
-  // and increasing in c, found exactly from the sorted cells.
-  std::vector<double> sorted = grown;
-  std::sort(sorted.begin(), sorted.end());
-  double below = 0.0, cap = sorted.back();
-  for (int k = 0; k < cells; ++k)
-  {
-    const double candidate = (length - below) / (cells - k);
-    if (candidate <= sorted[k])
-    {
-      cap = candidate;
-      break;
-    }
-    below += sorted[k];
-  }
+  double cap = 0.0;
+  const std::vector<double> grown = grownCells(first, last, r, length, cells, cap);
   std::vector<double> sizes(cells);
   for (int i = 0; i < cells; ++i)
   {
