@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 
 namespace blockforge
@@ -490,6 +491,32 @@ BSplineCurve::BSplineCurve(int degree, std::vector<double> knots,
   }
 }
 
+namespace
+{
+/**
+ * The span of the last evaluation of a curve in this thread, tried first: evaluations
+ * come in runs along a curve (arc-length tables, projections). Kept per thread, in a
+ * small table by the curve's address, because a hint in the curve itself, written by
+ * every thread that evaluates the curve, made the threads of a chunked loop take the
+ * cache line of the curve's data from each other. Only a hint: a stale entry (another
+ * curve at the same place, a destroyed curve's address reused) fails the knot test and
+ * the span is looked up; the span found is the same either way.
+ */
+struct SpanHint
+{
+  const void* curve = nullptr;
+  int span = -1;
+};
+
+SpanHint& spanHint(const void* curve)
+{
+  constexpr std::size_t Entries = 64; // a Gordon surface's sections fit without collisions
+  thread_local SpanHint hints[Entries];
+  const auto address = reinterpret_cast<std::uintptr_t>(curve);
+  return hints[(address >> 4 ^ address >> 10) % Entries];
+}
+} // namespace
+
 int BSplineCurve::span(double t) const
 {
   const int count = static_cast<int>(ControlPoints.size());
@@ -501,10 +528,14 @@ int BSplineCurve::span(double t) const
   // Inside, exactly one span k has Knots[k] <= t < Knots[k + 1]: the last one found if
   // it still holds, else a walk from the table (a step or two), the same span the
   // bisection finds.
-  const int last = LastSpan.Span.load(std::memory_order_relaxed);
-  if (last >= Degree && last <= n && Knots[last] <= t && t < Knots[last + 1])
+  SpanHint& hint = spanHint(this);
+  if (hint.curve == this)
   {
-    return last;
+    const int last = hint.span;
+    if (last >= Degree && last <= n && Knots[last] <= t && t < Knots[last + 1])
+    {
+      return last;
+    }
   }
   const int bins = static_cast<int>(SpanTable.size()) - 1;
   const double place = (t - Knots[Degree]) / (Knots[n + 1] - Knots[Degree]) * bins;
@@ -517,7 +548,8 @@ int BSplineCurve::span(double t) const
   {
     ++k;
   }
-  LastSpan.Span.store(k, std::memory_order_relaxed);
+  hint.curve = this;
+  hint.span = k;
   return k;
 }
 

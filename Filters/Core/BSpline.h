@@ -12,8 +12,6 @@
 #include "Curve.h"
 #include "Surface.h"
 
-#include <atomic>
-
 namespace blockforge
 {
 /// How interpolation parameters are assigned to the data points.
@@ -93,23 +91,6 @@ private:
   std::vector<int> SpanTable;
   std::vector<Vec3> ControlPoints;
   std::vector<double> DataParameters;
-  /**
-   * The span of the last evaluation, tried first: evaluations come in runs along the
-   * curve (arc-length tables, projections). Only a hint, shared by threads without
-   * order (relaxed atomic): the span found is the same either way.
-   */
-  struct SpanHint
-  {
-    SpanHint() = default;
-    SpanHint(const SpanHint& other) : Span(other.Span.load(std::memory_order_relaxed)) {}
-    SpanHint& operator=(const SpanHint& other)
-    {
-      Span.store(other.Span.load(std::memory_order_relaxed), std::memory_order_relaxed);
-      return *this;
-    }
-    mutable std::atomic<int> Span{ -1 };
-  };
-  SpanHint LastSpan;
 };
 
 /**
