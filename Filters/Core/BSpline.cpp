@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <sstream>
 
 namespace blockforge
@@ -292,12 +291,17 @@ static bool exactEndBasis(int span, double t, int degree, const std::vector<doub
   return false;
 }
 
-void basisFunctions(int span, double t, int degree, const std::vector<double>& knots,
+namespace
+{
+/// Piegl & Tiller's algorithm A2.2; FixedDegree > 0 makes the degree a compile-time
+/// constant (unrolled loops, the same operations in the same order, the same bits).
+template <int FixedDegree>
+void basisFunctionsOf(int span, double t, int degree, const std::vector<double>& knots,
   double* values)
 {
-  if (exactEndBasis(span, t, degree, knots, values))
+  if (FixedDegree > 0)
   {
-    return;
+    degree = FixedDegree;
   }
   double left[MaxBasis], right[MaxBasis];
   values[0] = 1.0;
@@ -313,6 +317,24 @@ void basisFunctions(int span, double t, int degree, const std::vector<double>& k
       saved = left[j - r] * temp;
     }
     values[j] = saved;
+  }
+}
+} // namespace
+
+void basisFunctions(int span, double t, int degree, const std::vector<double>& knots,
+  double* values)
+{
+  if (exactEndBasis(span, t, degree, knots, values))
+  {
+    return;
+  }
+  if (degree == 3)
+  {
+    basisFunctionsOf<3>(span, t, degree, knots, values);
+  }
+  else
+  {
+    basisFunctionsOf<0>(span, t, degree, knots, values);
   }
 }
 
@@ -485,37 +507,12 @@ BSplineCurve::BSplineCurve(int degree, std::vector<double> knots,
   const int bins = 4 * count;
   const double first = Knots[Degree], range = Knots[count] - first;
   SpanTable.resize(bins + 1);
+  BinScale = bins / range;
   for (int bin = 0; bin <= bins; ++bin)
   {
     SpanTable[bin] = bspline::findSpan(Degree, Knots, count, first + range * bin / bins);
   }
 }
-
-namespace
-{
-/**
- * The span of the last evaluation of a curve in this thread, tried first: evaluations
- * come in runs along a curve (arc-length tables, projections). Kept per thread, in a
- * small table by the curve's address, because a hint in the curve itself, written by
- * every thread that evaluates the curve, made the threads of a chunked loop take the
- * cache line of the curve's data from each other. Only a hint: a stale entry (another
- * curve at the same place, a destroyed curve's address reused) fails the knot test and
- * the span is looked up; the span found is the same either way.
- */
-struct SpanHint
-{
-  const void* curve = nullptr;
-  int span = -1;
-};
-
-SpanHint& spanHint(const void* curve)
-{
-  constexpr std::size_t Entries = 64; // a Gordon surface's sections fit without collisions
-  thread_local SpanHint hints[Entries];
-  const auto address = reinterpret_cast<std::uintptr_t>(curve);
-  return hints[(address >> 4 ^ address >> 10) % Entries];
-}
-} // namespace
 
 int BSplineCurve::span(double t) const
 {
@@ -525,32 +522,35 @@ int BSplineCurve::span(double t) const
   {
     return bspline::findSpan(Degree, Knots, count, t); // ends, NaN
   }
-  // Inside, exactly one span k has Knots[k] <= t < Knots[k + 1]: the last one found if
-  // it still holds, else a walk from the table (a step or two), the same span the
-  // bisection finds.
-  SpanHint& hint = spanHint(this);
-  if (hint.curve == this)
+  // Inside, exactly one span k has Knots[k] <= t < Knots[k + 1], the one the bisection
+  // finds: between the spans at the start of t's bin and of the next bin (a step outside
+  // them only when rounding put t in a neighbouring bin), by bisection between them
+  // (usually one or two spans). Nothing is written: threads evaluating one curve share
+  // only what they read.
+  const int bins = static_cast<int>(SpanTable.size()) - 1;
+  const int bin = std::max(0, std::min(bins - 1, static_cast<int>((t - Knots[Degree]) * BinScale)));
+  int low = SpanTable[bin], high = SpanTable[bin + 1];
+  while (t < Knots[low])
   {
-    const int last = hint.span;
-    if (last >= Degree && last <= n && Knots[last] <= t && t < Knots[last + 1])
+    --low;
+  }
+  while (t >= Knots[high + 1])
+  {
+    ++high;
+  }
+  while (low < high)
+  {
+    const int middle = (low + high + 1) / 2;
+    if (Knots[middle] <= t)
     {
-      return last;
+      low = middle;
+    }
+    else
+    {
+      high = middle - 1;
     }
   }
-  const int bins = static_cast<int>(SpanTable.size()) - 1;
-  const double place = (t - Knots[Degree]) / (Knots[n + 1] - Knots[Degree]) * bins;
-  int k = SpanTable[std::max(0, std::min(bins - 1, static_cast<int>(place)))];
-  while (t < Knots[k])
-  {
-    --k;
-  }
-  while (t >= Knots[k + 1])
-  {
-    ++k;
-  }
-  hint.curve = this;
-  hint.span = k;
-  return k;
+  return low;
 }
 
 namespace
@@ -642,18 +642,34 @@ BSplineCurve BSplineCurve::interpolateAt(const std::vector<Vec3>& points,
   return curve;
 }
 
+namespace
+{
+/// sum_j weights[j] * points[j], j = 0 .. degree, in that order (FixedDegree > 0: unrolled,
+/// the same operations, the same bits).
+template <int FixedDegree>
+inline Vec3 weightedSum(const double* weights, const Vec3* points, int degree)
+{
+  if (FixedDegree > 0)
+  {
+    degree = FixedDegree;
+  }
+  Vec3 sum = Vec3::Zero();
+  for (int j = 0; j <= degree; ++j)
+  {
+    sum += weights[j] * points[j];
+  }
+  return sum;
+}
+} // namespace
+
 Vec3 BSplineCurve::point(double t) const
 {
   t = clampUnit(t);
   const int span = this->span(t);
   double basis[MaxBasis];
   bspline::basisFunctions(span, t, Degree, Knots, basis);
-  Vec3 result = Vec3::Zero();
-  for (int j = 0; j <= Degree; ++j)
-  {
-    result += basis[j] * ControlPoints[span - Degree + j];
-  }
-  return result;
+  const Vec3* points = &ControlPoints[span - Degree];
+  return Degree == 3 ? weightedSum<3>(basis, points, Degree) : weightedSum<0>(basis, points, Degree);
 }
 
 Vec3 BSplineCurve::derivative(double t, int order) const
@@ -679,14 +695,11 @@ void BSplineCurve::derivatives(double t, int order, Vec3* out) const
   double ders[MaxBasis * MaxBasis];
   bspline::basisDerivatives(span, t, Degree, computed, Knots, ders);
   const int width = Degree + 1;
+  const Vec3* points = &ControlPoints[span - Degree];
   for (int k = 0; k <= computed; ++k)
   {
-    Vec3 sum = Vec3::Zero();
-    for (int j = 0; j <= Degree; ++j)
-    {
-      sum += ders[k * width + j] * ControlPoints[span - Degree + j];
-    }
-    out[k] = sum;
+    out[k] = Degree == 3 ? weightedSum<3>(ders + k * width, points, Degree)
+                         : weightedSum<0>(ders + k * width, points, Degree);
   }
   for (int k = computed + 1; k <= order; ++k)
   {

@@ -82,13 +82,14 @@ public:
   const std::vector<double>& dataParameters() const { return DataParameters; }
 
 private:
-  /// findSpan(Degree, Knots, count, t), from SpanTable: same result, no bisection.
+  /// findSpan(Degree, Knots, count, t), from SpanTable: the same result, faster.
   int span(double t) const;
   int Degree;
   std::vector<double> Knots;
   /// The span at the start of each of SpanTable.size() - 1 equal bins of
   /// [Knots[Degree], Knots[count]] (spans of curves on blades are uneven: crowded at the edges).
   std::vector<int> SpanTable;
+  double BinScale = 0.0; ///< bins per unit of t
   std::vector<Vec3> ControlPoints;
   std::vector<double> DataParameters;
 };

@@ -258,6 +258,9 @@ public:
   void project(const CarrierGeometry& geometry, int carrier, const Vec3& p, double& s, double& t);
   /// Forgets every projection (the carriers' shapes changed).
   void clear();
+  /// Forgets the projections onto the carriers c with changed[c] set (their shapes
+  /// changed); those onto other carriers stay good.
+  void clear(const std::vector<char>& changed);
 
 private:
   struct Key

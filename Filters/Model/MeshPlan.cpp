@@ -292,7 +292,7 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
   }
   if (std::find(changedCarrier.begin(), changedCarrier.end(), 1) != changedCarrier.end())
   {
-    Projections.clear(); // it remembers projections onto the old shapes
+    Projections.clear(changedCarrier); // it remembers projections onto the old shapes
   }
 
   // Named edge curves: those ending at a moved vertex, those on a carrier drawn again,
@@ -577,7 +577,11 @@ bool MeshPlan::undo()
   }
   saved.valid = false;
   // The projections cache remembers projections onto the shapes the update drew
-  bool clearProjections = !saved.carriers.empty();
+  std::vector<char> redrawn(P->Model.carriers.size(), 0);
+  for (const auto& carrier : saved.carriers)
+  {
+    redrawn[carrier.first] = 1;
+  }
   for (auto& vertex : saved.vertices)
   {
     P->CommittedVertices[vertex.first] = vertex.second;
@@ -592,11 +596,11 @@ bool MeshPlan::undo()
   P->Geometry = std::move(saved.geometry);
   for (std::size_t c = 0; c < P->Model.carriers.size(); ++c)
   {
-    clearProjections = clearProjections || P->shape(static_cast<int>(c)) != P->CarrierShapes[c];
+    redrawn[c] = redrawn[c] || P->shape(static_cast<int>(c)) != P->CarrierShapes[c] ? 1 : 0;
   }
-  if (clearProjections)
+  if (std::find(redrawn.begin(), redrawn.end(), 1) != redrawn.end())
   {
-    P->Projections.clear();
+    P->Projections.clear(redrawn);
   }
   for (std::size_t e = 0; e < P->Model.edges.size(); ++e)
   {
