@@ -523,10 +523,14 @@ int BSplineCurve::span(double t) const
     return bspline::findSpan(Degree, Knots, count, t); // ends, NaN
   }
   // Inside, exactly one span k has Knots[k] <= t < Knots[k + 1], the one the bisection
-  // finds: between the spans at the start of t's bin and of the next bin (a step outside
-  // them only when rounding put t in a neighbouring bin), by bisection between them
-  // (usually one or two spans). Nothing is written: threads evaluating one curve share
-  // only what they read.
+  // finds: the last one found if it still holds, else between the spans at the start of
+  // t's bin and of the next bin (a step outside them only when rounding put t in a
+  // neighbouring bin), by bisection between them (usually one or two spans).
+  const int last = LastSpan.Span.load(std::memory_order_relaxed);
+  if (last >= Degree && last <= n && Knots[last] <= t && t < Knots[last + 1])
+  {
+    return last;
+  }
   const int bins = static_cast<int>(SpanTable.size()) - 1;
   const int bin = std::max(0, std::min(bins - 1, static_cast<int>((t - Knots[Degree]) * BinScale)));
   int low = SpanTable[bin], high = SpanTable[bin + 1];
@@ -550,6 +554,7 @@ int BSplineCurve::span(double t) const
       high = middle - 1;
     }
   }
+  LastSpan.Span.store(low, std::memory_order_relaxed);
   return low;
 }
 

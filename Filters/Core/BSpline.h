@@ -12,6 +12,8 @@
 #include "Curve.h"
 #include "Surface.h"
 
+#include <atomic>
+
 namespace blockforge
 {
 /// How interpolation parameters are assigned to the data points.
@@ -92,6 +94,26 @@ private:
   double BinScale = 0.0; ///< bins per unit of t
   std::vector<Vec3> ControlPoints;
   std::vector<double> DataParameters;
+  /**
+   * The span of the last evaluation, tried first: evaluations come in runs along the
+   * curve (arc-length tables, projections). Only a hint, shared by threads without order
+   * (relaxed atomic), written only when it changes: the span found is the same either
+   * way. On a cache line of its own: threads of a chunked loop evaluating different parts
+   * of one curve write it in turn, and with the curve's data on the same line every
+   * such write made the other threads fetch the data again.
+   */
+  struct alignas(64) SpanHint
+  {
+    SpanHint() = default;
+    SpanHint(const SpanHint& other) : Span(other.Span.load(std::memory_order_relaxed)) {}
+    SpanHint& operator=(const SpanHint& other)
+    {
+      Span.store(other.Span.load(std::memory_order_relaxed), std::memory_order_relaxed);
+      return *this;
+    }
+    mutable std::atomic<int> Span{ -1 };
+  };
+  SpanHint LastSpan;
 };
 
 /**
