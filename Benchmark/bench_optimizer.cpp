@@ -9,11 +9,17 @@
 // Not a test (nothing asserts a time). Prints a Markdown table.
 // Usage: bench_optimizer [--repetitions N] [--evaluations N] [--sharpness K] [--step F]
 //          [--algorithm bobyqa|cobyla|subplex] [--blocks] [--timing] [--csv FILE]
-//          [--history FILE] [--no-baselines] template.yaml input.inf [...]
+//          [--history FILE] [--no-baselines] [--objective NAME] [--size-weight W]
+//          [--scan name:weight,... T] [--probe] [--max-skew S] template.yaml input.inf [...]
 // --blocks: where the smallest angles are (block, cell, grid plane) and which variables end
 // on their bounds; --csv: the table's numbers for Benchmark/optimizer_figure.py; --history:
 // every evaluation of every case (objective, smallest angle, the best so far); --no-baselines:
-// the optimizer alone.
+// the optimizer alone; --objective, --size-weight: ObjectiveSettings; --scan: the smallest
+// angle along a direction from the optimizer's result (weights in units of each
+// variable's range, steps up to T times the direction each way), with the lowest blocks;
+// --probe: the smallest angle after moving each variable alone a little from the result;
+// --max-skew: skew distributions (OptimizerSettings::skewDistributions) by at most this
+// (1: none, the default).
 #include "Optimizer.h"
 
 #include "../Testing/Cxx/TestTurboInputs.h"
@@ -240,6 +246,128 @@ void printWorstCells(const std::string& block, const std::vector<double>& xyz,
   std::fprintf(stderr, "\n");
 }
 
+/// Block b of `grids` (nodes as ControlProblem::gridAt gives them, counts from `plan`).
+BlockGrid blockGrid(const model::MeshPlan& plan, const std::vector<std::vector<double>>& grids,
+  std::size_t b)
+{
+  const std::array<int, 3> n = plan.nodeCounts(static_cast<int>(b));
+  return BlockGrid{ grids[b].data(), n[0], n[1], n[2] };
+}
+
+/// Per-block smallest angle of a grid, as "name angle" of the `count` lowest blocks.
+std::string blockMinima(const model::BlockModel& model, const std::vector<std::vector<double>>& grids,
+  model::MeshPlan& plan, std::size_t count)
+{
+  std::vector<std::pair<double, std::string>> minima;
+  for (std::size_t b = 0; b < grids.size(); ++b)
+  {
+    minima.emplace_back(BlockAngles(blockGrid(plan, grids, b)).lowest(), model.blocks[b].name);
+  }
+  std::sort(minima.begin(), minima.end());
+  std::string text;
+  for (std::size_t b = 0; b < std::min(count, minima.size()); ++b)
+  {
+    char item[64];
+    std::snprintf(item, sizeof item, " %s %.1f", minima[b].second.c_str(), minima[b].first);
+    text += item;
+  }
+  return text;
+}
+
+/**
+ * The objective along a direction from the optimizer's result: `spec` is
+ * "name:weight,name:weight,..." (weights in units of each variable's range); prints the
+ * smallest angle and the lowest blocks at steps t = -1.0 ... 1.0 of `scale` times the
+ * direction (clipped to the bounds).
+ */
+void scanDirection(const model::BlockModel& model, const model::CarrierGeometry& geometry,
+  const OptimizerSettings& settings, const std::vector<double>& best, const std::string& spec,
+  double scale)
+{
+  ControlProblem problem(model, geometry, 1.0, settings.objective, {},
+    settings.skewDistributions ? settings.maximumSkew : 0.0);
+  const std::vector<ControlVariable>& variables = problem.variables();
+  std::vector<double> direction(variables.size(), 0.0);
+  std::size_t from = 0;
+  while (from < spec.size())
+  {
+    std::size_t comma = spec.find(',', from);
+    if (comma == std::string::npos)
+    {
+      comma = spec.size();
+    }
+    const std::string item = spec.substr(from, comma - from);
+    const std::size_t colon = item.find(':');
+    const std::string name = item.substr(0, colon);
+    const double weight = colon == std::string::npos ? 1.0 : std::atof(item.c_str() + colon + 1);
+    bool found = false;
+    for (std::size_t i = 0; i < variables.size(); ++i)
+    {
+      if (variables[i].name == name)
+      {
+        direction[i] = weight * (variables[i].high - variables[i].low);
+        found = true;
+      }
+    }
+    if (!found)
+    {
+      std::fprintf(stderr, "scan: no variable %s\n", name.c_str());
+    }
+    from = comma + 1;
+  }
+  model::MeshPlan plan(model, geometry);
+  for (int step = -10; step <= 10; ++step)
+  {
+    const double t = scale * step / 10.0;
+    std::vector<double> y = best;
+    for (std::size_t i = 0; i < y.size(); ++i)
+    {
+      y[i] = std::min(variables[i].high, std::max(variables[i].low, best[i] + t * direction[i]));
+    }
+    const GridMeasures m = problem.evaluate(y);
+    std::string lowest;
+    if (m.feasible)
+    {
+      lowest = blockMinima(model, problem.gridAt(y), plan, 5);
+    }
+    if (!m.feasible)
+    {
+      lowest = " " + m.failure.substr(0, 160);
+    }
+    std::fprintf(stderr, "  t %+6.3f: %s min %.2f soft %.2f |%s\n", t,
+      m.feasible ? "ok " : "INV", m.feasible ? m.minAngle : 0.0, m.feasible ? m.softMinAngle : 0.0,
+      lowest.c_str());
+  }
+}
+
+/// For every variable, the smallest angle (or "INV" for a folded grid) after moving it
+/// alone by -5 %, -1 %, +1 % and +5 % of its range from `best`.
+void probeVariables(const model::BlockModel& model, const model::CarrierGeometry& geometry,
+  const OptimizerSettings& settings, const std::vector<double>& best)
+{
+  ControlProblem problem(model, geometry, 1.0, settings.objective, {},
+    settings.skewDistributions ? settings.maximumSkew : 0.0);
+  const std::vector<ControlVariable>& variables = problem.variables();
+  const GridMeasures here = problem.evaluate(best);
+  std::fprintf(stderr, "  probe from %.2f deg (moves of -5, -1, +1, +5 %% of the range):\n",
+    here.minAngle);
+  for (std::size_t i = 0; i < variables.size(); ++i)
+  {
+    std::string text;
+    for (double f : { -0.05, -0.01, 0.01, 0.05 })
+    {
+      std::vector<double> y = best;
+      y[i] = std::min(variables[i].high,
+        std::max(variables[i].low, best[i] + f * (variables[i].high - variables[i].low)));
+      const GridMeasures m = problem.evaluate(y);
+      char item[32];
+      std::snprintf(item, sizeof item, m.feasible ? " %6.2f" : "    INV", m.minAngle);
+      text += item;
+    }
+    std::fprintf(stderr, "  %-10s%s\n", variables[i].name.c_str(), text.c_str());
+  }
+}
+
 struct Row
 {
   std::string name, templateName, input;
@@ -258,7 +386,9 @@ int main(int argc, char** argv)
   bool blocks = false;
   bool timing = false;
   bool baselines = true;
-  std::string csvFile, historyFile;
+  bool probe = false;
+  std::string csvFile, historyFile, scan;
+  double scanScale = 0.1;
   FILE* history = nullptr;
   OptimizerSettings settings;
   std::vector<std::pair<std::string, std::string>> cases;
@@ -289,6 +419,18 @@ int main(int argc, char** argv)
         : name == "compass"                        ? SearchAlgorithm::Compass
                                                    : SearchAlgorithm::Bobyqa;
     }
+    else if (arg == "--objective" && a + 1 < argc)
+    {
+      settings.objective.kind = objectiveFromName(argv[++a]);
+    }
+    else if (arg == "--size-limit" && a + 1 < argc)
+    {
+      settings.objective.sizeRatioLimit = std::atof(argv[++a]);
+    }
+    else if (arg == "--size-weight" && a + 1 < argc)
+    {
+      settings.objective.sizeRatioWeight = std::atof(argv[++a]);
+    }
     else if (arg == "--blocks")
     {
       blocks = true;
@@ -300,6 +442,20 @@ int main(int argc, char** argv)
     else if (arg == "--history" && a + 1 < argc)
     {
       historyFile = argv[++a];
+    }
+    else if (arg == "--scan" && a + 2 < argc)
+    {
+      scan = argv[++a];
+      scanScale = std::atof(argv[++a]);
+    }
+    else if (arg == "--max-skew" && a + 1 < argc)
+    {
+      settings.maximumSkew = std::atof(argv[++a]);
+      settings.skewDistributions = settings.maximumSkew > 1.0;
+    }
+    else if (arg == "--probe")
+    {
+      probe = true;
     }
     else if (arg == "--no-baselines")
     {
@@ -432,6 +588,33 @@ int main(int argc, char** argv)
       row.name.c_str(), row.variables, row.before.minAngle, row.after.minAngle,
       row.evaluations, result.search.skipped, row.seconds, row.cpuSeconds, row.searchSeconds,
       row.stop.c_str());
+    {
+      // Largest neighbour size ratio within the blocks, before and after (what the
+      // MinAngleAndSizeRatio objective weighs).
+      auto largestRatio = [&](const model::BlockModel& m) {
+        const model::CarrierGeometry built(m);
+        ControlProblem problem(m, built, 1.0, settings.objective, {});
+        const std::vector<std::vector<double>> grids = problem.gridAt(problem.start());
+        model::MeshPlan plan(m, built);
+        std::pair<double, std::string> largest(1.0, "");
+        for (std::size_t b = 0; b < grids.size(); ++b)
+        {
+          largest = std::max(largest,
+            std::make_pair(maxNeighbourSizeRatio(blockGrid(plan, grids, b)), m.blocks[b].name));
+        }
+        return largest;
+      };
+      try
+      {
+        const auto before = largestRatio(model), after = largestRatio(result.model);
+        std::fprintf(stderr, "  size ratio within blocks: %.2f (%s) -> %.2f (%s)\n", before.first,
+          before.second.c_str(), after.first, after.second.c_str());
+      }
+      catch (const std::exception& error)
+      {
+        std::fprintf(stderr, "  size ratio: %s\n", error.what());
+      }
+    }
     if (blocks)
     {
       for (std::size_t i = 0; i < result.variables.size(); ++i)
@@ -453,6 +636,21 @@ int main(int argc, char** argv)
       {
         printWorstCells(result.model.blocks[b].name, grids[b], plan.nodeCounts(static_cast<int>(b)), 4);
       }
+    }
+    if (probe)
+    {
+      probeVariables(model, geometry, settings,
+        result.search.best.empty() ? ControlProblem(model, geometry, 1.0, settings.objective, {},
+            settings.skewDistributions ? settings.maximumSkew : 0.0).start()
+                                   : result.search.best);
+    }
+    if (!scan.empty())
+    {
+      scanDirection(model, geometry, settings,
+        result.search.best.empty() ? ControlProblem(model, geometry, 1.0, settings.objective, {},
+            settings.skewDistributions ? settings.maximumSkew : 0.0).start()
+                                   : result.search.best,
+        scan, scanScale);
     }
     rows.push_back(row);
   }

@@ -190,6 +190,7 @@ int vtkBlockOptimizer::RequestData(
     settings.densityMultiplier = this->DensityMultiplier;
     settings.maximumMemory = this->MaximumMemory;
     settings.automatic = this->Automatic;
+    settings.skewDistributions = this->SkewDistributions;
     settings.fixed = this->FixedControlPoints;
     for (const auto& move : this->ControlPointMoves)
     {
@@ -327,6 +328,7 @@ void vtkBlockOptimizer::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "DensityMultiplier: " << this->DensityMultiplier << "\n";
   os << indent << "MaximumMemory: " << this->MaximumMemory << "\n";
   os << indent << "Automatic: " << this->Automatic << "\n";
+  os << indent << "SkewDistributions: " << this->SkewDistributions << "\n";
   for (const std::string& name : this->FixedControlPoints)
   {
     os << indent << "FixedControlPoint: " << name << "\n";

@@ -3,6 +3,7 @@
 #include "../Core/Carriers.h"
 #include "../Core/Parallel.h"
 #include "../Core/Projection.h"
+#include "../Core/SurfaceFaceGrid.h"
 #include "../Core/Transfinite.h"
 
 #include <Eigen/Geometry>
@@ -481,10 +482,9 @@ void copyPeriodicEdge(const BlockModel& model, MeshTopology& topology, const Edg
 void copyFaceBoundary(const BlockModel& model, const MeshTopology& topology, int block, int face,
   int na, int nb, std::vector<double>& grid);
 
-/// Grid of a face that lies on a surface: TFI in the surface's (s, t) space, boundary
-/// nodes kept from the edges, interior nodes evaluated on the surface.
+/// The carrier's projection of p, remembered by p's bits.
 void ProjectionCache::project(
-  const CarrierGeometry& geometry, int carrier, const Vec3& p, double& s, double& t)
+  const CarrierGeometry& geometry, int carrier, const Vec3& p, double& s, double& t, double* distance)
 {
   Key key{ carrier, {} };
   std::memcpy(key.bits.data(), p.data(), sizeof(key.bits));
@@ -493,19 +493,27 @@ void ProjectionCache::project(
     const auto found = Known.find(key);
     if (found != Known.end())
     {
-      s = found->second.first;
-      t = found->second.second;
+      s = found->second[0];
+      t = found->second[1];
+      if (distance)
+      {
+        *distance = found->second[2];
+      }
       return;
     }
   }
-  double distance = 0.0;
-  geometry.project(carrier, p, s, t, distance);
+  double away = 0.0;
+  geometry.project(carrier, p, s, t, away);
+  if (distance)
+  {
+    *distance = away;
+  }
   std::lock_guard<std::mutex> guard(Lock);
   if (Known.size() > 1000000)
   {
     Known.clear(); // bounded: a long optimisation must not grow it without end
   }
-  Known.emplace(key, std::make_pair(s, t));
+  Known.emplace(key, std::array<double, 3>{ s, t, away });
 }
 
 void ProjectionCache::clear()
@@ -535,61 +543,33 @@ std::size_t ProjectionCache::KeyHash::operator()(const Key& key) const
   return static_cast<std::size_t>(h);
 }
 
-/**
- * The surface point closest to `target` near (s, t): Gauss-Newton from there on the
- * surface's own parameters (derivatives by central differences through geometry.point,
- * which wraps closed and extends Gordon carriers), steps limited so the node stays on
- * the part of the surface it started on (a thin trailing edge has another side close by).
- * `start` gets the surface point at the (s, t) it starts from.
- */
-void closestNear(const CarrierGeometry& geometry, int carrier, const Vec3& target, double& s,
-  double& t, Vec3& start)
+namespace
 {
-  const double h = 1e-6, largest = 0.02;
-  for (int iteration = 0; iteration < 8; ++iteration)
+/// A surface carrier seen through its parameters (wrapping, extending as the carrier does).
+class CarrierSurface final : public ParametricSurface
+{
+public:
+  CarrierSurface(const CarrierGeometry& geometry, int carrier)
+    : Geometry(geometry)
+    , Carrier(carrier)
   {
-    Vec3 around[5];
-    geometry.crossPoints(carrier, s, t, h, around);
-    const Vec3& p = around[0];
-    if (iteration == 0)
-    {
-      start = p;
-    }
-    const Vec3 ps = (around[1] - around[2]) / (2 * h);
-    const Vec3 pt = (around[3] - around[4]) / (2 * h);
-    const Vec3 r = target - p;
-    const double a = ps.dot(ps), b = ps.dot(pt), c = pt.dot(pt);
-    const double det = a * c - b * b;
-    if (!(det > 0.0) || !std::isfinite(det))
-    {
-      return;
-    }
-    double ds = (c * ps.dot(r) - b * pt.dot(r)) / det;
-    double dt = (a * pt.dot(r) - b * ps.dot(r)) / det;
-    const double step = std::max(std::abs(ds), std::abs(dt));
-    if (!std::isfinite(step))
-    {
-      return;
-    }
-    if (step > largest)
-    {
-      ds *= largest / step;
-      dt *= largest / step;
-    }
-    s += ds;
-    t = std::clamp(t + dt, geometry.tMin(carrier), geometry.tMax(carrier));
-    if (step < 1e-13)
-    {
-      return;
-    }
   }
-}
+  Vec3 point(double s, double t) const override { return Geometry.point(Carrier, s, t); }
+  void crossPoints(double s, double t, double h, Vec3 out[5]) const override
+  {
+    Geometry.crossPoints(Carrier, s, t, h, out);
+  }
+  double tMin() const override { return Geometry.tMin(Carrier); }
+  double tMax() const override { return Geometry.tMax(Carrier); }
 
-/// Grid of a face that lies on a surface: boundary nodes kept from the edges; each
-/// interior node is the surface point closest to the face's 3-D TFI node, searched from
-/// the TFI node in the surface's (s, t) space. TFI in (s, t) alone follows the
-/// parametrisation, which is far from even on a blade (aligned sections crowd the round
-/// edges into small s ranges): at high densities it put nodes behind their neighbours.
+private:
+  const CarrierGeometry& Geometry;
+  int Carrier;
+};
+} // namespace
+
+/// Grid of a face that lies on a surface (surfaceFaceGrid): the boundary nodes' (s, t),
+/// then the interior nodes by projected TFI guarded by the even-metric parameter TFI.
 void surfaceFace(const BlockModel& model, const MeshTopology& topology, const CarrierGeometry& geometry,
   int carrier, int block, int face, std::vector<double>& out, ProjectionCache* cache)
 {
@@ -599,6 +579,7 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
   const LocalEdge left = localEdge(model, topology, block, edges[2]);
   const LocalEdge right = localEdge(model, topology, block, edges[3]);
   const int na = bottom.count, nb = left.count;
+  const CarrierSurface surface(geometry, carrier);
   // The boundary loop: bottom (a up), right (b up), top (a down), left (b down).
   std::vector<Vec3> loop;
   auto node = [](const LocalEdge& edge, int i) {
@@ -615,6 +596,7 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
     loop.push_back(node(left, b));
   const int loopSize = static_cast<int>(loop.size());
   std::vector<Eigen::Vector2d> st(loopSize);
+  std::vector<double> away(loopSize, 0.0);
   // Each node is projected, and below each interior node placed, on its own: in chunks
   // on threads when a runner is installed (a face computed inside another chunked loop
   // runs in that loop's thread), the same bits.
@@ -624,74 +606,63 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
     const int last = static_cast<int>((chunk + 1) * loopSize / loopChunks);
     for (int k = first; k < last; ++k)
     {
-      double s = 0.0, t = 0.0, distance = 0.0;
+      double s = 0.0, t = 0.0;
       if (cache)
       {
-        cache->project(geometry, carrier, loop[k], s, t);
+        cache->project(geometry, carrier, loop[k], s, t, &away[k]);
       }
       else
       {
-        geometry.project(carrier, loop[k], s, t, distance);
+        geometry.project(carrier, loop[k], s, t, away[k]);
       }
       st[k] = Eigen::Vector2d(s, t);
     }
   });
   // Unwrap across the seam of closed directions.
   const bool closed[2] = { geometry.closedS(carrier), geometry.closedT(carrier) };
-  for (int k = 1; k < loopSize; ++k)
-  {
+  auto unwrap = [&](int k, int from) {
     for (int d = 0; d < 2; ++d)
     {
       if (!closed[d])
         continue;
-      while (st[k][d] - st[k - 1][d] > 0.5)
+      while (st[k][d] - st[from][d] > 0.5)
         st[k][d] -= 1.0;
-      while (st[k][d] - st[k - 1][d] < -0.5)
+      while (st[k][d] - st[from][d] < -0.5)
         st[k][d] += 1.0;
     }
-  }
-  auto fill = [&](int count, auto index) {
-    std::vector<double> xyz(3 * count);
-    for (int i = 0; i < count; ++i)
-    {
-      const Eigen::Vector2d& p = st[index(i) % loopSize];
-      xyz[3 * i] = p[0];
-      xyz[3 * i + 1] = p[1];
-      xyz[3 * i + 2] = 0.0;
-    }
-    return xyz;
   };
-  const std::vector<double> pb = fill(na, [&](int a) { return a; });
-  const std::vector<double> pr = fill(nb, [&](int b) { return (na - 1) + b; });
-  const std::vector<double> pt = fill(na, [&](int a) { return (na - 1) + (nb - 1) + (na - 1 - a); });
-  const std::vector<double> pl =
-    fill(nb, [&](int b) { return 2 * (na - 1) + (nb - 1) + (nb - 1 - b); });
-  std::vector<double> parameters(3 * static_cast<std::size_t>(na) * nb);
-  transfiniteFace(EdgeNodes{ pb.data(), bottom.params(), na }, EdgeNodes{ pt.data(), top.params(), na },
-    EdgeNodes{ pl.data(), left.params(), nb }, EdgeNodes{ pr.data(), right.params(), nb },
-    parameters.data());
-  std::vector<double> targets(parameters.size());
-  transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), targets.data());
-  out.resize(parameters.size());
-  forEachChunk(std::max(0, nb - 2), [&](long row) {
-    const int b = static_cast<int>(row) + 1;
-    for (int a = 1; a + 1 < na; ++a)
+  // The closest point of the whole surface can lie on the far side of a thin edge (a
+  // blade's leading or trailing edge, both sides closer than the projector's sample
+  // spacing): where a node is not on the surface at the point found, follow the loop to
+  // it from its neighbours, and keep the nearer point. Both ways round: from a sharp
+  // edge's tip the way on is ambiguous, from the other neighbour it is not.
+  const double onSurface = 1e-9 * geometry.size(carrier);
+  auto follow = [&](int k, int from) {
+    if (!(away[k] > onSurface))
     {
-      const std::size_t i = static_cast<std::size_t>(b) * na + a;
-      const double s0 = parameters[3 * i], t0 = parameters[3 * i + 1];
-      const Vec3 target(targets[3 * i], targets[3 * i + 1], targets[3 * i + 2]);
-      double s = s0, t = t0;
-      Vec3 p0;
-      closestNear(geometry, carrier, target, s, t, p0); // p0: the point at (s0, t0)
-      Vec3 p = geometry.point(carrier, s, t);
-      if (!((p - target).norm() <= (p0 - target).norm()))
-      {
-        p = p0; // no better than the (s, t) node: keep that
-      }
-      std::copy_n(p.data(), 3, &out[3 * i]);
+      return;
     }
-  });
-  copyFaceBoundary(model, topology, block, face, na, nb, out);
+    double s = st[from][0], t = st[from][1];
+    Vec3 start;
+    closestNear(surface, loop[k], s, t, start);
+    const double near = (geometry.point(carrier, s, t) - loop[k]).norm();
+    if (near + onSurface < away[k])
+    {
+      st[k] = Eigen::Vector2d(s, t);
+      away[k] = near;
+    }
+  };
+  for (int k = 1; k < loopSize; ++k)
+  {
+    unwrap(k, k - 1);
+    follow(k, k - 1);
+  }
+  for (int k = loopSize - 2; k >= 0; --k)
+  {
+    follow(k, k + 1);
+  }
+  out.resize(3 * static_cast<std::size_t>(na) * nb);
+  surfaceFaceGrid(surface, st, bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data());
 }
 
 void copyFaceBoundary(const BlockModel& model, const MeshTopology& topology, int block, int face,

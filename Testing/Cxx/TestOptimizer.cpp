@@ -99,6 +99,45 @@ TEST(Optimizer, FindsTheSymmetricOptimum)
   EXPECT_EQ(meshedMinAngle(result.model), result.after.minAngle);
 }
 
+TEST(Optimizer, SkewFindsTheMatchingDistribution)
+{
+  Loaded loaded;
+  loaded.model =
+    model::loadTemplate(dataPath("optimizer_skew.yaml"), {}, nullptr, &loaded.geometry);
+  const double r = 1.2;
+  const double a0 = 4.0 * (r - 1.0) / (std::pow(r, 4) - 1.0) * std::pow(r, 1.5);
+  OptimizerSettings settings;
+  settings.search.tolerance = 1e-12;
+  settings.search.maxEvaluations = 300;
+  settings.skewDistributions = true;
+  const OptimizerResult result = optimizeModel(loaded.model, loaded.geometry, settings);
+  // The lower block's i-direction is the only one graded `ends` on all four edges.
+  ASSERT_EQ(result.variables.size(), 1u);
+  const ControlVariable& skew = result.variables[0];
+  EXPECT_EQ(skew.name, "lower.skew_i");
+  EXPECT_EQ(skew.component, ControlVariable::SkewComponent);
+  EXPECT_NEAR(skew.low, -std::log(3.0), 1e-15);
+  EXPECT_NEAR(skew.high, std::log(3.0), 1e-15);
+  const double u = result.search.best[0];
+  EXPECT_NEAR(u, 1.5 * std::log(r), 1e-6);
+  EXPECT_LT(result.before.minAngle, 85.0);
+  EXPECT_NEAR(result.after.minAngle, 90.0, 1e-4);
+  // The output model carries the skewed laws, on every block that uses the edges, and
+  // meshes to what the optimizer measured.
+  const model::Block& lower = result.model.blocks[result.model.findBlock("lower")];
+  const model::Block& upper = result.model.blocks[result.model.findBlock("upper")];
+  EXPECT_NEAR(lower.laws[0].firstCellSize, a0 * std::exp(-u), 1e-15);
+  EXPECT_NEAR(lower.laws[0].lastCellSize, a0 * std::exp(u), 1e-15);
+  EXPECT_EQ(upper.laws[0].firstCellSize, lower.laws[2].firstCellSize);
+  EXPECT_EQ(upper.laws[2].kind, DistributionLaw::Kind::Geometric);
+  EXPECT_EQ(meshedMinAngle(result.model), result.after.minAngle);
+  // Without skews there is nothing to move.
+  settings.skewDistributions = false;
+  const OptimizerResult held = optimizeModel(loaded.model, loaded.geometry, settings);
+  EXPECT_TRUE(held.variables.empty());
+  EXPECT_EQ(held.after.minAngle, result.before.minAngle);
+}
+
 TEST(Optimizer, BoundsKeepTheVertexBetweenItsNeighbours)
 {
   Loaded loaded = loadSymmetric("0.3");

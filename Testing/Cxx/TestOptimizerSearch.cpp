@@ -136,8 +136,21 @@ TEST(GridObjective, NeighbourSizeRatio)
   ObjectiveSettings settings;
   settings.kind = ObjectiveKind::MinAngleAndSizeRatio;
   settings.sizeRatioWeight = 10.0;
-  const GridMeasures measures = measureGrid({ grid.block() }, {}, settings);
-  EXPECT_NEAR(measures.objective, -measures.softMinAngle + 5.0, 1e-12);
+  // Up to the limit (1.5 by default) a ratio costs nothing; above it, weight per unit.
+  const GridMeasures withinLimit = measureGrid({ grid.block() }, {}, settings);
+  EXPECT_NEAR(withinLimit.maxSizeRatio, 1.5, 1e-12);
+  EXPECT_NEAR(withinLimit.objective, -withinLimit.softMinAngle, 1e-12);
+  settings.sizeRatioLimit = 1.0;
+  const GridMeasures fromOne = measureGrid({ grid.block() }, {}, settings);
+  EXPECT_NEAR(fromOne.objective, -fromOne.softMinAngle + 5.0, 1e-12);
+  // Geometric spacing 2: 10 * (2 - 1.5) = 5 degrees above the limit.
+  const Grid doubling = makeGrid(5, 3, 3, [&](int i, int j, int k) {
+    return Vec3(std::pow(2.0, i) - 1.0, j, k);
+  });
+  settings.sizeRatioLimit = 1.5;
+  const GridMeasures aboveLimit = measureGrid({ doubling.block() }, {}, settings);
+  EXPECT_NEAR(aboveLimit.maxSizeRatio, 2.0, 1e-12);
+  EXPECT_NEAR(aboveLimit.objective, -aboveLimit.softMinAngle + 5.0, 1e-12);
 }
 
 TEST(GridObjective, NonOrthogonalityOfAShearedBlock)

@@ -18,6 +18,7 @@ from bftest import DATA, DISTRIBUTOR_INF, SOURCE, leaves, points
 bftest.load_plugin(globals())
 
 SYMMETRIC = os.path.join(DATA, "optimizer_symmetric.yaml")
+SKEW = os.path.join(DATA, "optimizer_skew.yaml")
 AXIAL_OH = os.path.join(SOURCE, "Templates", "axial_passage_oh.yaml")
 
 
@@ -33,6 +34,33 @@ def corner_angle(offset):
 
 
 class OptimizerProxyTest(unittest.TestCase):
+    def test_skew_distributions(self):
+        # Off by default: nothing to move in a model without control points.
+        source = BlockTemplateSource(TemplateFile=SKEW)
+        optimizer = BlockOptimizer(Input=source, Tolerance=1e-12)
+        self.assertEqual(optimizer.SkewDistributions, 0)
+        optimizer.UpdatePipeline()
+        model = servermanager.Fetch(optimizer)
+        before = field_values(model, "MinAngleBefore")[0]
+        self.assertLess(before, 85.0)
+        self.assertEqual(field_values(model, "MinAngleAfter")[0], before)
+        # On: the lower block's i-direction is skewed until the shared edge's nodes lie
+        # under the top edge's geometric ones (every element angle 90 degrees).
+        optimizer.SkewDistributions = 1
+        optimizer.UpdatePipeline()
+        model = servermanager.Fetch(optimizer)
+        names = model.GetFieldData().GetAbstractArray("ControlPointNames")
+        self.assertEqual([names.GetValue(i) for i in range(names.GetNumberOfValues())],
+                         ["lower.skew_i"])
+        self.assertGreater(field_values(model, "MinAngleAfter")[0], 90.0 - 1e-4)
+        quality = GridQuality(Input=BlockMesher(Input=optimizer))
+        quality.UpdatePipeline()
+        grid = servermanager.Fetch(quality)
+        self.assertAlmostEqual(grid.GetFieldData().GetArray("MinAngleSummary").GetTuple3(0)[0],
+                               field_values(model, "MinAngleAfter")[0], places=9)
+        for proxy in (quality, optimizer, source):
+            Delete(proxy)
+
     def test_finds_the_symmetric_optimum(self):
         source = BlockTemplateSource(TemplateFile=SYMMETRIC)
         optimizer = BlockOptimizer(Input=source, Tolerance=1e-12)

@@ -240,6 +240,60 @@ struct ControlProblem::Impl
       }
     }
   }
+  /// A topology edge whose node distribution skew variables change: its ends and every
+  /// block's use of it (laws are per block).
+  struct SkewedEdge
+  {
+    int a = -1, b = -1;
+    std::vector<model::EdgeUse> uses;
+  };
+  std::vector<SkewedEdge> SkewedEdges;
+  /// Per variable (empty for the others): the skewed edges it changes, with +1 where its
+  /// block runs the edge from a to b, -1 otherwise.
+  std::vector<std::vector<std::pair<int, int>>> SkewOf;
+
+  /// Sets the laws of the skewed edges in `work` for configuration x (each use's base law
+  /// with its end cells skewed by the sum of the variables on the edge) and adds the ends
+  /// of the edges that changed to `moved`, so the plan recomputes them.
+  void applySkews(BlockModel& work, const std::vector<double>& x,
+    const std::vector<std::size_t>& changed, std::vector<int>& moved) const
+  {
+    std::vector<char> touched(SkewedEdges.size(), 0);
+    for (std::size_t i : changed)
+    {
+      for (const auto& [edge, orientation] : SkewOf[i])
+      {
+        (void)orientation;
+        touched[edge] = 1;
+      }
+    }
+    std::vector<double> skew(SkewedEdges.size(), 0.0); // along a -> b
+    for (std::size_t i = 0; i < SkewOf.size(); ++i)
+    {
+      for (const auto& [edge, orientation] : SkewOf[i])
+      {
+        skew[edge] += orientation * x[i];
+      }
+    }
+    for (std::size_t e = 0; e < SkewedEdges.size(); ++e)
+    {
+      if (!touched[e])
+      {
+        continue;
+      }
+      for (const model::EdgeUse& use : SkewedEdges[e].uses)
+      {
+        const double along = use.reversed ? -skew[e] : skew[e];
+        const DistributionLaw& base = Base.blocks[use.block].laws[use.localEdge];
+        DistributionLaw& law = work.blocks[use.block].laws[use.localEdge];
+        law.firstCellSize = base.firstCellSize * std::exp(-along);
+        law.lastCellSize = base.lastCellSize * std::exp(along);
+      }
+      moved.push_back(SkewedEdges[e].a);
+      moved.push_back(SkewedEdges[e].b);
+    }
+  }
+
   /// The grid kept alive between evaluations, and the configuration it holds.
   std::unique_ptr<model::MeshPlan> Plan;
   std::vector<double> Current;
@@ -259,17 +313,30 @@ struct ControlProblem::Impl
     }
     BlockModel& work = Plan->model();
     std::vector<int> moved;
+    std::vector<std::size_t> skewed;
     LastMoved.clear();
     for (std::size_t i = 0; i < Variables.size(); ++i)
     {
       if (x[i] != Current[i])
       {
+        LastMoved.push_back(i);
+        if (Variables[i].component == ControlVariable::SkewComponent)
+        {
+          skewed.push_back(i);
+          continue;
+        }
         setVariable(work, Plan->carriers(), Variables[i], x[i]);
         moved.push_back(Variables[i].vertex);
-        LastMoved.push_back(i);
       }
     }
     Current = x;
+    // Skewed distributions: new laws on their edges, whose ends the update then recomputes
+    // (they do not move).
+    std::vector<int> recomputed;
+    if (!skewed.empty())
+    {
+      applySkews(work, x, skewed, recomputed);
+    }
     if (Unplaced)
     {
       // the last placement failed half-way: place every vertex again
@@ -294,13 +361,20 @@ struct ControlProblem::Impl
       failed.message = error.what();
       return failed;
     }
+    for (int v : recomputed)
+    {
+      if (std::find(applied.begin(), applied.end(), v) == applied.end())
+      {
+        applied.push_back(v);
+      }
+    }
     return Plan->update(applied);
   }
 };
 
 ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& geometry,
   double densityMultiplier, const ObjectiveSettings& objective,
-  const std::vector<std::string>& fixed)
+  const std::vector<std::string>& fixed, double maximumSkew)
   : P(new Impl)
 {
   P->Base = model;
@@ -685,9 +759,94 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
   Variables.erase(std::remove_if(Variables.begin(), Variables.end(),
                     [&](const ControlVariable& v) { return fixedVertices.count(v.vertex) > 0; }),
     Variables.end());
+  P->SkewOf.resize(Variables.size());
+  if (maximumSkew > 1.0)
+  {
+    addSkewVariables(topology, periodicFaces, maximumSkew);
+  }
   Locked.assign(locked.begin(), locked.end());
   P->Variables = Variables;
   P->VariableBlocks.resize(Variables.size());
+}
+
+void ControlProblem::addSkewVariables(
+  const model::Topology& topology, const std::set<int>& periodicFaces, double maximumSkew)
+{
+  const BlockModel& base = P->Base;
+  // Edges on periodic faces keep their laws: their images must match them.
+  std::set<int> periodicEdges;
+  for (int f : periodicFaces)
+  {
+    const model::FaceUse& use = topology.faces[f].uses.front();
+    for (int e : model::faceEdges(use.face))
+    {
+      periodicEdges.insert(topology.blocks[use.block].edge[e]);
+    }
+  }
+  std::map<int, int> skewedIndex; // topology edge -> SkewedEdges index
+  for (std::size_t b = 0; b < base.blocks.size(); ++b)
+  {
+    for (int d = 0; d < 3; ++d)
+    {
+      // The direction's edges graded `ends` (in every block using them) are skewed; edges
+      // projected from others (project_from) follow their sources; any other law, a
+      // collapsed or a periodic edge leaves the direction as it is.
+      std::vector<int> edges;
+      bool eligible = true;
+      for (int e = 0; e < 12 && eligible; ++e)
+      {
+        if (model::edgeDirection(e) != d)
+        {
+          continue;
+        }
+        const int u = topology.blocks[b].edge[e];
+        eligible = u >= 0 && !periodicEdges.count(u);
+        bool ends = true, projected = true;
+        for (std::size_t k = 0; eligible && k < topology.edges[u].uses.size(); ++k)
+        {
+          const model::EdgeUse& use = topology.edges[u].uses[k];
+          const DistributionLaw::Kind kind = base.blocks[use.block].laws[use.localEdge].kind;
+          ends = ends && kind == DistributionLaw::Kind::Ends;
+          projected = projected && kind == DistributionLaw::Kind::ProjectFrom;
+        }
+        eligible = eligible && (ends || projected);
+        if (eligible && ends)
+        {
+          edges.push_back(e);
+        }
+      }
+      if (!eligible || edges.empty())
+      {
+        continue;
+      }
+      ControlVariable variable;
+      variable.component = ControlVariable::SkewComponent;
+      variable.block = static_cast<int>(b);
+      variable.direction = d;
+      variable.start = 0.0;
+      variable.low = -std::log(maximumSkew);
+      variable.high = std::log(maximumSkew);
+      variable.name = base.blocks[b].name + ".skew_" + "ijk"[d];
+      std::vector<std::pair<int, int>> changes;
+      for (int e : edges)
+      {
+        const int u = topology.blocks[b].edge[e];
+        auto found = skewedIndex.find(u);
+        if (found == skewedIndex.end())
+        {
+          Impl::SkewedEdge skewed;
+          skewed.a = topology.edges[u].a;
+          skewed.b = topology.edges[u].b;
+          skewed.uses = topology.edges[u].uses;
+          found = skewedIndex.emplace(u, static_cast<int>(P->SkewedEdges.size())).first;
+          P->SkewedEdges.push_back(skewed);
+        }
+        changes.emplace_back(found->second, topology.blocks[b].reversed[e] ? -1 : 1);
+      }
+      Variables.push_back(variable);
+      P->SkewOf.push_back(changes);
+    }
+  }
 }
 
 ControlProblem::~ControlProblem() = default;
@@ -805,6 +964,10 @@ std::vector<Vec3> ControlProblem::verticesAt(const std::vector<double>& x) const
   std::vector<int> moved;
   for (std::size_t i = 0; i < Variables.size(); ++i)
   {
+    if (Variables[i].component == ControlVariable::SkewComponent)
+    {
+      continue; // no vertex moves
+    }
     setVariable(work, geometry, Variables[i], x[i]);
     moved.push_back(Variables[i].vertex);
   }

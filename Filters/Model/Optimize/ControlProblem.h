@@ -19,6 +19,16 @@
  * of a surface; a vertex may cover 45 % of the way to a neighbour that moves too, 90 %
  * to one that stays.
  *
+ * With `maximumSkew` above 1, a block direction whose four edges are graded `{ends: [a, b]}`
+ * in every block that uses them, or projected from another edge (`project_from`, which
+ * then follows its source), with at least one `ends` edge and none on a periodic face,
+ * gets a variable u, its skew: the `ends` edges' end cells become a e^-u and b e^u (at
+ * most maximumSkew times either way), so its nodes slide towards one end on all four
+ * edges at once, and with them the nodes of the neighbour blocks that share those edges. That is what a blade passage's O-grid side
+ * needs for the H lines beside it to cross a staggered passage at a fair angle: the
+ * nodes of side a shifted against those of side b (measured on the OH template: Rotor 37
+ * 23.6 -> 30.8 degrees with the end cells skewed 3 times, Benchmark/OPTIMIZER_LIMITS.md).
+ *
  * Everything that follows a moved vertex follows it: vertices placed from it (rules),
  * the parameters of carrier edges ending at it, and surface curves drawn through it.
  * Evaluations run on a mesh plan (MeshPlan.h) kept between them, which recomputes only
@@ -32,19 +42,28 @@
 #include "CarrierGeometry.h"
 
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
 namespace blockforge
 {
+namespace model
+{
+struct Topology;
+}
 namespace optimize
 {
 /// One free parameter: component 0 (s) or 1 (t) of control point `vertex`, or component
-/// 2, 3, 4 (x, y, z) of the position of a free interior vertex.
+/// 2, 3, 4 (x, y, z) of the position of a free interior vertex, or (component
+/// SkewComponent, vertex -1) the skew of the node distribution of direction `direction` of
+/// block `block` (see ControlProblem).
 struct ControlVariable
 {
+  static constexpr int SkewComponent = 5;
   int vertex = -1;
   int component = 0;
+  int block = -1, direction = -1; ///< a skew's block direction
   double start = 0.0, low = 0.0, high = 1.0;
   std::string name; ///< "vertex.s", "vertex.t", or "vertex.x", "vertex.y", "vertex.z"
   /// A small step of it moved no vertex, carrier edge end or curve (its vertex follows a
@@ -81,7 +100,7 @@ public:
   /// Throws model::TemplateError for unknown fixed names and for models the mesher refuses.
   ControlProblem(const model::BlockModel& model, const model::CarrierGeometry& geometry,
     double densityMultiplier, const ObjectiveSettings& objective,
-    const std::vector<std::string>& fixed);
+    const std::vector<std::string>& fixed, double maximumSkew = 0.0);
   ~ControlProblem();
 
   const std::vector<ControlVariable>& variables() const { return Variables; }
@@ -115,6 +134,9 @@ public:
   std::vector<std::vector<double>> gridAt(const std::vector<double>& x);
 
 private:
+  /// The skew variables of the block directions graded `ends` (see the class comment).
+  void addSkewVariables(
+    const model::Topology& topology, const std::set<int>& periodicFaces, double maximumSkew);
   struct Impl;
   std::unique_ptr<Impl> P;
   std::vector<ControlVariable> Variables;

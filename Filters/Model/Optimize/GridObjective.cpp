@@ -349,7 +349,8 @@ GridMeasures measureAngles(const std::vector<const BlockAngles*>& blocks, double
   if (settings.kind == ObjectiveKind::MinAngleAndSizeRatio)
   {
     measures.maxSizeRatio = maxSizeRatio;
-    measures.objective += settings.sizeRatioWeight * (maxSizeRatio - 1.0);
+    measures.objective +=
+      settings.sizeRatioWeight * std::max(0.0, maxSizeRatio - settings.sizeRatioLimit);
   }
   return measures;
 }

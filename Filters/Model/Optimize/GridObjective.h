@@ -42,8 +42,13 @@ struct ObjectiveSettings
   /// few 1/sharpness degrees above the worst hardly count.
   double angleSharpness = 1.0;
   /// MinAngleAndSizeRatio: degrees of smallest angle worth one unit of neighbour size
-  /// ratio above 1 (a ratio of 1.5 costs 0.5 * weight degrees).
+  /// ratio above sizeRatioLimit (a ratio of 2 costs 0.5 * weight degrees).
   double sizeRatioWeight = 10.0;
+  /// MinAngleAndSizeRatio: neighbour size ratios up to this cost nothing (1.5, the ratio
+  /// the templates' `match` grading keeps). A penalty from 1 traded angle for ratios the
+  /// templates' own grading sets (1.15-1.7 on the passage templates): 29.4 against 30.4
+  /// degrees on the distributor's OH grid (Benchmark/OPTIMIZER.md).
+  double sizeRatioLimit = 1.5;
 };
 
 /// One block grid: ni x nj x nk nodes, 3 doubles per node, i fastest.

@@ -87,8 +87,10 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
   {
     fixed.push_back(move.name);
   }
+  const double skew =
+    settings.automatic && settings.skewDistributions ? settings.maximumSkew : 0.0;
   ControlProblem problem(
-    result.model, geometry, settings.densityMultiplier, settings.objective, fixed);
+    result.model, geometry, settings.densityMultiplier, settings.objective, fixed, skew);
   result.variables = problem.variables();
   result.boundaryLocked = problem.boundaryLocked();
   if (!settings.automatic)
@@ -133,7 +135,7 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
     // requested density. Otherwise step back towards the start (halving the step); the
     // start itself is what the template gave.
     ControlProblem fine(
-      result.model, geometry, requested.densityMultiplier, settings.objective, fixed);
+      result.model, geometry, requested.densityMultiplier, settings.objective, fixed, skew);
     const std::vector<double> start = problem.start();
     const std::vector<double> best = result.search.best;
     const GridMeasures fineStart = fine.evaluate(start);

@@ -41,6 +41,14 @@ struct OptimizerSettings
   std::vector<ControlPointMove> moves;
   /// false: only the manual moves are applied (no automatic run).
   bool automatic = true;
+  /// The automatic run also skews the node distributions of block directions graded
+  /// `ends` (ControlProblem): axial_passage_oh's blade sides. Off by default until the
+  /// O-grid's edge blocks take the skewed end cells (issue 8's regrade): on today's OH
+  /// template the end cells next to the thin edge blocks make checkMesh fail face tets
+  /// and volume ratio on Rotor 37 (Benchmark/OPTIMIZER_LIMITS.md).
+  bool skewDistributions = false;
+  /// A skewed distribution's end cells change at most this many times either way.
+  double maximumSkew = 3.0;
 };
 
 struct OptimizerResult
