@@ -56,6 +56,16 @@ void expectSameAsFreshMesher(const MeshPlan& plan)
   }
 }
 
+/// Every block of `plan` equals the same block of `other`, bit for bit.
+void expectSameGrids(const MeshPlan& plan, const MeshPlan& other)
+{
+  ASSERT_EQ(plan.blockCount(), other.blockCount());
+  for (int b = 0; b < plan.blockCount(); ++b)
+  {
+    EXPECT_TRUE(test::sameBits(plan.blockNodes(b), other.blockNodes(b))) << "block " << b;
+  }
+}
+
 const FreeParameter& sParameter(const std::vector<FreeParameter>& parameters, int vertex)
 {
   for (const FreeParameter& parameter : parameters)
@@ -435,10 +445,7 @@ TEST(MeshPlan, ThreadsGiveTheSameBits)
     ASSERT_TRUE(move(serial, original + delta, 1).feasible());
     ASSERT_TRUE(move(threaded, original + delta, 2).feasible());
     EXPECT_EQ(threaded.updatedBlocks(), serial.updatedBlocks());
-    for (int b = 0; b < serial.blockCount(); ++b)
-    {
-      EXPECT_TRUE(test::sameBits(threaded.blockNodes(b), serial.blockNodes(b))) << "block " << b;
-    }
+    expectSameGrids(threaded, serial);
   }
   expectSameAsFreshMesher(threaded);
 }
@@ -565,16 +572,10 @@ TEST(MeshPlan, UndoPutsTheGridBackBitForBit)
   {
     ASSERT_TRUE(p->update(moveParameter(p->model(), p->carriers(), other, otherValue)).feasible());
   }
-  for (int b = 0; b < plan.blockCount(); ++b)
-  {
-    EXPECT_TRUE(test::sameBits(plan.blockNodes(b), direct.blockNodes(b))) << "block " << b;
-  }
+  expectSameGrids(plan, direct);
   ASSERT_TRUE(move(plan, original + 0.001).feasible());
   ASSERT_TRUE(move(direct, original + 0.001).feasible());
-  for (int b = 0; b < plan.blockCount(); ++b)
-  {
-    EXPECT_TRUE(test::sameBits(plan.blockNodes(b), direct.blockNodes(b))) << "block " << b;
-  }
+  expectSameGrids(plan, direct);
   expectSameAsFreshMesher(plan);
 }
 
@@ -601,8 +602,5 @@ TEST(MeshPlan, UndoAfterAnInfeasibleUpdate)
     EXPECT_TRUE(p->update({ a1 }).feasible());
   }
   EXPECT_EQ(plan.updatedBlocks(), fresh.updatedBlocks());
-  for (int b = 0; b < plan.blockCount(); ++b)
-  {
-    EXPECT_TRUE(test::sameBits(plan.blockNodes(b), fresh.blockNodes(b))) << "block " << b;
-  }
+  expectSameGrids(plan, fresh);
 }
