@@ -406,6 +406,51 @@ double grownLength(double first, double last, double r, int cells)
 }
 } // namespace
 
+namespace
+{
+/// Cells grown from the given ends by `r` (grownCell) and the uniform cap c with
+/// sum(min(grown_i, c)) = length: the total is piecewise linear and increasing in c, found
+/// exactly from the sorted cells (c is the largest cell when even that total falls short).
+std::vector<double> grownCells(double first, double last, double r, double length, int cells,
+  double& cap)
+{
+  std::vector<double> grown(cells);
+  for (int i = 0; i < cells; ++i)
+  {
+    grown[i] = grownCell(first, last, r, i, cells);
+  }
+  std::vector<double> sorted = grown;
+  std::sort(sorted.begin(), sorted.end());
+  double below = 0.0;
+  cap = sorted.back();
+  for (int k = 0; k < cells; ++k)
+  {
+    const double candidate = (length - below) / (cells - k);
+    if (candidate <= sorted[k])
+    {
+      cap = candidate;
+      break;
+    }
+    below += sorted[k];
+  }
+  return grown;
+}
+
+/// Whether cells grown from both given ends by at most `ratio` (raised when too few to
+/// fill the edge) and capped by a uniform middle keep both end cells: the cap that makes
+/// them fill the edge is at least as large as either end.
+bool grownKeepsEnds(double first, double last, double length, int cells, double ratio)
+{
+  if (grownLength(first, last, ratio, cells) < length)
+  {
+    return true; // the ratio is raised until they fill it: the cap is then the largest cell
+  }
+  double cap = 0.0;
+  grownCells(first, last, ratio, length, cells, cap);
+  return cap >= std::max(first, last);
+}
+} // namespace
+
 std::vector<double> matchedNodes(double first, double last, double length, int nodeCount,
   double ratio)
 {
@@ -432,9 +477,14 @@ std::vector<double> matchedNodes(double first, double last, double length, int n
     return uniform(nodeCount);
   }
   // An end cell larger than the mean cell: cells shrink from it towards the other end or
-  // the middle, with both ends exact (log-linear sizes plus a bump, as the Ends law).
+  // the middle, with both ends exact (log-linear sizes plus a bump, as the Ends law) --
+  // unless both ends are given and cells grown from them to a uniform middle keep them
+  // (the other end small enough): then those, so that the nodes do not jump when an end
+  // cell passes the mean cell (two edges across a periodic pair of nearly equal means
+  // sharing one end cell, one of them always a little above its mean).
   const double mean = length / cells;
-  if (first > mean || last > mean)
+  if ((first > mean || last > mean) &&
+    !(first > 0.0 && last > 0.0 && grownKeepsEnds(first, last, length, cells, ratio)))
   {
     if (first <= 0.0 || last <= 0.0)
     {
@@ -475,26 +525,8 @@ std::vector<double> matchedNodes(double first, double last, double length, int n
     bisect([&](double x) { return grownLength(first, last, x, cells) < length; }, low, high, 0.0, 200);
     r = high;
   }
-  std::vector<double> grown(cells);
-  for (int i = 0; i < cells; ++i)
-  {
-    grown[i] = grownCell(first, last, r, i, cells);
-  }
-  // The uniform cap c with sum(min(grown_i, c)) = length: the total is piecewise linear
-  // and increasing in c, found exactly from the sorted cells.
-  std::vector<double> sorted = grown;
-  std::sort(sorted.begin(), sorted.end());
-  double below = 0.0, cap = sorted.back();
-  for (int k = 0; k < cells; ++k)
-  {
-    const double candidate = (length - below) / (cells - k);
-    if (candidate <= sorted[k])
-    {
-      cap = candidate;
-      break;
-    }
-    below += sorted[k];
-  }
+  double cap = 0.0;
+  const std::vector<double> grown = grownCells(first, last, r, length, cells, cap);
   std::vector<double> sizes(cells);
   for (int i = 0; i < cells; ++i)
   {

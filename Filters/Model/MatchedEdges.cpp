@@ -111,11 +111,33 @@ double endCell(const UniqueEdge& edge, int end)
   const std::size_t n = p.size();
   return edge.length * (end == 0 ? p[1] - p[0] : p[n - 1] - p[n - 2]);
 }
+/// The groups of the ends joined in `parent` that hold a matched edge's end.
+void groupMatchedEnds(MeshTopology& topology, std::vector<int>& parent)
+{
+  std::vector<std::vector<int>> byRoot(parent.size());
+  for (int key = 0; key < static_cast<int>(parent.size()); ++key)
+  {
+    byRoot[findRoot(parent, key)].push_back(key);
+  }
+  for (std::vector<int>& group : byRoot)
+  {
+    bool hasMatched = false;
+    for (const int key : group)
+    {
+      hasMatched = hasMatched || topology.edges[key / 2].matched;
+    }
+    if (group.size() > 1 && hasMatched)
+    {
+      topology.matchGroups.push_back(std::move(group));
+    }
+  }
+}
 } // namespace
 
 void buildMatchGroups(const BlockModel& model, MeshTopology& topology)
 {
   topology.matchGroups.clear();
+  topology.matchClasses.clear();
   bool any = false;
   for (UniqueEdge& edge : topology.edges)
   {
@@ -188,22 +210,61 @@ void buildMatchGroups(const BlockModel& model, MeshTopology& topology)
       }
     }
   }
-  std::vector<std::vector<int>> byRoot(parent.size());
+  topology.matchClasses.resize(parent.size());
   for (int key = 0; key < static_cast<int>(parent.size()); ++key)
   {
-    byRoot[findRoot(parent, key)].push_back(key);
+    topology.matchClasses[key] = findRoot(parent, key);
   }
-  for (std::vector<int>& group : byRoot)
+  groupMatchedEnds(topology, parent);
+}
+
+void joinProjectedMatchEnds(const BlockModel& model, MeshTopology& topology)
+{
+  if (topology.matchClasses.empty())
   {
-    bool hasMatched = false;
-    for (const int key : group)
+    return;
+  }
+  std::vector<int> parent = topology.matchClasses; // every key points at its class's root
+  std::vector<int> classSize(parent.size(), 0);
+  for (const int root : parent)
+  {
+    ++classSize[root];
+  }
+  bool joined = false;
+  for (std::size_t u = 0; u < topology.edges.size(); ++u)
+  {
+    const UniqueEdge& edge = topology.edges[u];
+    if (!edge.projectedAfterMatch)
     {
-      hasMatched = hasMatched || topology.edges[key / 2].matched;
+      continue;
     }
-    if (group.size() > 1 && hasMatched)
+    int root = edge.projectedFrom;
+    while (topology.edges[root].projectedFrom >= 0)
     {
-      topology.matchGroups.push_back(std::move(group));
+      root = topology.edges[root].projectedFrom;
     }
+    const UniqueEdge& source = topology.edges[root];
+    // the source runs the same way or the other way round: its nearer ends decide (as
+    // projectEdgeParameters)
+    const Vec3& a = model.vertices[edge.a].position;
+    const Vec3& b = model.vertices[edge.b].position;
+    const Vec3& sa = model.vertices[source.a].position;
+    const Vec3& sb = model.vertices[source.b].position;
+    const bool crossed = (a - sb).norm() + (b - sa).norm() < (a - sa).norm() + (b - sb).norm();
+    for (int end = 0; end < 2; ++end)
+    {
+      const int key = 2 * static_cast<int>(u) + end;
+      if (classSize[topology.matchClasses[key]] > 1) // it continues into other edges
+      {
+        join(parent, key, 2 * root + (crossed ? 1 - end : end));
+        joined = true;
+      }
+    }
+  }
+  if (joined)
+  {
+    topology.matchGroups.clear();
+    groupMatchedEnds(topology, parent);
   }
 }
 

@@ -133,6 +133,9 @@ struct MeshTopology
   /// Edge ends (2 edge + 0 at vertex a, + 1 at b) that continue one another across a
   /// block interface or a periodic pair, grouped; only when the model has matched edges.
   std::vector<std::vector<int>> matchGroups;
+  /// The class (smallest key) of every edge end in those groups before projected edges
+  /// join them (joinProjectedMatchEnds); empty when the model has no matched edges.
+  std::vector<int> matchClasses;
   /// (image, source) edge ends of periodic faces: the image end takes the source's cell.
   std::vector<std::pair<int, int>> matchCopies;
   /// Projected unique edges, each after the edge it projects from.
@@ -170,6 +173,15 @@ std::vector<int> matchEdgeEnds(const BlockModel& model, MeshTopology& topology);
  * edges).
  */
 void buildProjections(const BlockModel& model, MeshTopology& topology);
+/**
+ * After buildProjections: an edge projected (through a chain) from a matched edge has its
+ * end cells from that edge's, so where its end continues into other edges (an O-grid's
+ * outer side meeting the H blocks at an O corner) the group there and the group at the
+ * matched edge's end (the blade side at the corner's foot) are one: both take one cell,
+ * from the graded edges of either. Ends of the projected edge that continue into nothing
+ * join nothing.
+ */
+void joinProjectedMatchEnds(const BlockModel& model, MeshTopology& topology);
 /**
  * Node parameters of projected edge `e`: the closest points on its curve of the interior
  * nodes of the edge it projects from (whose parameters must be current), as arc-length

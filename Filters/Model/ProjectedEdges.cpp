@@ -163,6 +163,7 @@ void buildProjections(const BlockModel& model, MeshTopology& topology)
       state[*it] = 2;
     }
   }
+  joinProjectedMatchEnds(model, topology);
 }
 
 void projectEdgeParameters(const BlockModel& model, const std::vector<NamedCurve>& curves,

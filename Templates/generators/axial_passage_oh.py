@@ -64,6 +64,19 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
 #   from hub to shroud; H blocks run i with theta, j with the axis.
 # - theta is measured from the blade (machine: theta_zero), wherever the export puts it.
+# Grading (Templates/README.md, laws `match`, `ends`, `project_from`), so that neighbour cells
+# across the block interfaces differ little at every density:
+# - the O-grid: geometric k_o away from the blade (its outer cell is what the H blocks start
+#   with); the blade sides `ends`, their end cells side_end times their mean cell (a
+#   number, not an expression of the corners: the optimizer's live model keeps laws as the
+#   template gave them); the O-grid's
+#   outer sides the normal offsets of the blade sides' nodes (project_from); the edge blocks'
+#   outer arcs `match` (cells of their neighbours at both ends, growing by o_match towards
+#   the middle), their blade arcs the normal feet of the outer arcs' nodes (project_from:
+#   on a thin or sharp edge a fan, the nose resolved by the feet);
+# - every H edge `match`: the H blocks start from the O-grid's outer cells and the edge
+#   blocks' and sides' cells and grow towards the inlet, outlet and periodic lines; the
+#   periodic lines beside the sides take the sides' relative end cells (`ends`).
 blockforge: 2
 name: axial_passage_oh
 description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.
@@ -93,22 +106,23 @@ parameters:
   n_span: 12              # cells from hub to shroud
   k_o: 1.15               # expansion ratio away from the blade in the O-grid
   k_span: 1.05            # expansion ratio away from hub and shroud (two-sided)
-  grade: 0                # blade sides: end cells (edge cell size / side mean cell)^grade; 1 matches the edge blocks' cells, 0 uniform (above 0.3 some machines fold at density 2 and more)
+  side_end: 0.35          # blade sides (and the periodic lines beside them): end cells this fraction of their mean cell, towards the edge blocks' cells
+  o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
 """
 
 FOOTER = """blocks:
-  O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}}}
-  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [fle_a_h, fte_a_h]}, E3: {ends: [ofle_a_h, ofte_a_h]}, E5: {ends: [fle_a_s, fte_a_s]}, E7: {ends: [ofle_a_s, ofte_a_s]}}}}
-  O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}}}
-  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [fte_b_h, fle_b_h]}, E3: {ends: [ofte_b_h, ofle_b_h]}, E5: {ends: [fte_b_s, fle_b_s]}, E7: {ends: [ofte_b_s, ofle_b_s]}}}}
-  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {k: {two_sided: k_span}}}
-  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], grading: {k: {two_sided: k_span}}}
-  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {k: {two_sided: k_span}}}
-  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {k: {two_sided: k_span}, edges: {E2: {ends: [ofle_a_h, ofte_a_h]}, E4: {ends: [ofle_a_h, ofte_a_h]}, E6: {ends: [ofle_a_s, ofte_a_s]}, E8: {ends: [ofle_a_s, ofte_a_s]}}}}
-  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {k: {two_sided: k_span}, edges: {E2: {ends: [ofle_a_h, ofte_a_h]}, E4: {ends: [ofle_b_h, ofte_b_h]}, E6: {ends: [ofle_a_s, ofte_a_s]}, E8: {ends: [ofle_b_s, ofte_b_s]}}}}
-  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], grading: {k: {two_sided: k_span}}}
-  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], grading: {k: {two_sided: k_span}}}
-  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], grading: {k: {two_sided: k_span}}}
+  O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_le_h}, E5: {project_from: ol_le_s}}}}
+  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [side_end, side_end]}, E3: {project_from: bl_a_h}, E5: {ends: [side_end, side_end]}, E7: {project_from: bl_a_s}}}}
+  O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
+  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [side_end, side_end]}, E3: {project_from: bl_b_h}, E5: {ends: [side_end, side_end]}, E7: {project_from: bl_b_s}}}}
+  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {project_from: bl_a_h}, E4: {ends: [side_end, side_end]}, E6: {project_from: bl_a_s}, E8: {ends: [side_end, side_end]}}}}
+  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {ends: [side_end, side_end]}, E4: {project_from: bl_b_h}, E6: {ends: [side_end, side_end]}, E8: {project_from: bl_b_s}}}}
+  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
 
 faces:
   hub_faces: {on_surface: hub, faces: [O_le.k0, O_a.k0, O_te.k0, O_b.k0, U_L.k0, U_M.k0, U_R.k0, M_L.k0, M_R.k0, D_L.k0, D_M.k0, D_R.k0]}
@@ -175,13 +189,6 @@ def template_text():
             w(f'  {name}_{l}: "{x} - rint({x} - 0.5)"')
         gap('gap_le', 'b_f', 'a_f'); gap('gap_a', 'a_f', 'a_r'); gap('gap_te', 'a_r', 'b_r'); gap('gap_b', 'b_r', 'b_f')
         gap('ogap_le', 'ob_f', 'oa_f'); gap('ogap_a', 'oa_f', 'oa_r'); gap('ogap_te', 'oa_r', 'ob_r'); gap('ogap_b', 'ob_r', 'ob_f')
-        # end cells of the blade sides (and of the O-grid's outer sides) relative to their mean
-        # cell, so they match the leading- and trailing-edge blocks' cells (curve parameters
-        # are close to arc length): `ends` laws keep these relative sizes at every density
-        for o in ('', 'o'):
-            for side in ('a', 'b'):
-                for e, n in (('le', 'n_le'), ('te', 'n_te')):
-                    w(f'  {o}f{e}_{side}_{l}: "(({o}gap_{e}_{l}/{n})/({o}gap_{side}_{l}/n_side))^grade"')
     w('')
     w('carriers:')
     w('  hub: {revolve: hub, axis: machine, extend: extend}')

@@ -421,6 +421,29 @@ TEST(Distribution, MatchGivesTheEndCellsAndGrowsByTheRatio)
   EXPECT_THROW(matchedNodes(0.01, 0.01, 1.0, 5, std::nan("")), GeometryError);
 }
 
+TEST(Distribution, MatchNodesDoNotJumpWhenAnEndCellPassesTheMeanCell)
+{
+  // Two edges across a periodic pair share one end cell, the geometric mean of their
+  // nearly equal mean cells: one of them always has an end a hair above its mean. With
+  // the other end small, cells grown from both ends to a uniform middle keep both ends,
+  // so the nodes are those of an end a hair below the mean (they used to switch to the
+  // log-linear shape and move by a tenth of a cell).
+  const double length = 2.0, mean = length / 6.0;
+  const std::vector<double> below = matchedNodes(mean * (1.0 - 1e-9), 0.1, length, 7, 1.2);
+  const std::vector<double> above = matchedNodes(mean * (1.0 + 1e-9), 0.1, length, 7, 1.2);
+  expectValidNodes(above, 7);
+  for (int i = 0; i <= 6; ++i)
+  {
+    EXPECT_NEAR(above[i], below[i], 1e-8) << i;
+  }
+  EXPECT_NEAR(cell(above, 0) * length, mean * (1.0 + 1e-9), 1e-12);
+  EXPECT_NEAR(cell(above, 5) * length, 0.1, 1e-12);
+  // Ends too large to be kept that way still shrink towards the middle (as before).
+  const std::vector<double> big = matchedNodes(0.5, 0.45, length, 7, 1.2);
+  EXPECT_NEAR(cell(big, 0) * length, 0.5, 1e-9);
+  EXPECT_LT(cell(big, 3), cell(big, 0));
+}
+
 TEST(Distribution, MatchWithAnEndCellNearTheWholeEdgeDoesNotFail)
 {
   // A neighbour's cell as long as the edge itself: the end cell is capped so the other

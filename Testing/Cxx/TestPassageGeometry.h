@@ -1,12 +1,13 @@
 /**
  * @file TestPassageGeometry.h
  * @brief What the blade-passage tests measure on a meshed grid, independently of the
- * mesher: block face nodes, cell volumes, and the size ratio of neighbour cells across
+ * mesher: distances to surface carriers, block face nodes, cell volumes, and the size ratio of neighbour cells across
  * block interfaces (periodic ones included). Header-only; for tests that link
  * BlockForgeModel.
  */
 #pragma once
 
+#include "CarrierGeometry.h"
 #include "TestHelpers.h"
 
 #include <Eigen/Geometry>
@@ -22,6 +23,45 @@ namespace blockforge
 {
 namespace test
 {
+/// Distance from p to the surface carrier: the carrier's projection, and when that lands
+/// far off (on the other side of a thin edge, from a coarse sample), local Gauss-Newton
+/// searches started around it and across the section loop.
+inline double surfaceDistance(const model::CarrierGeometry& geometry, int carrier, const Vec3& p)
+{
+  double s = 0.0, t = 0.0, d = 0.0;
+  geometry.project(carrier, p, s, t, d);
+  if (d < 1e-12 * geometry.size(carrier))
+    return d;
+  for (double start : { s - 0.05, s - 0.02, s - 0.01, s + 0.01, s + 0.02, s + 0.05, 1.5 - s, 0.5 - s })
+  {
+    double u = start, v = t;
+    for (int iteration = 0; iteration < 40; ++iteration)
+    {
+      const double h = 1e-7;
+      const Vec3 q = geometry.point(carrier, u, v);
+      const Vec3 qs = (geometry.point(carrier, u + h, v) - geometry.point(carrier, u - h, v)) / (2 * h);
+      const Vec3 qt = (geometry.point(carrier, u, v + h) - geometry.point(carrier, u, v - h)) / (2 * h);
+      const Vec3 r = p - q;
+      const double a = qs.dot(qs), b = qs.dot(qt), e = qt.dot(qt), det = a * e - b * b;
+      if (!(det > 0.0))
+        break;
+      double du = (e * qs.dot(r) - b * qt.dot(r)) / det, dv = (a * qt.dot(r) - b * qs.dot(r)) / det;
+      const double step = std::max(std::abs(du), std::abs(dv));
+      if (step > 0.01)
+      {
+        du *= 0.01 / step;
+        dv *= 0.01 / step;
+      }
+      u += du;
+      v = std::clamp(v + dv, geometry.tMin(carrier), geometry.tMax(carrier));
+      if (step < 1e-14)
+        break;
+    }
+    d = std::min(d, (geometry.point(carrier, u, v) - p).norm());
+  }
+  return d;
+}
+
 /// The nodes of one block face (0..5 = i0 i1 j0 j1 k0 k1).
 inline std::vector<Vec3> faceNodes(const Grid& grid, const model::BlockFace& face)
 {

@@ -187,9 +187,7 @@ Checked checkPassage(const std::string& templateName, const DataSet& data,
     double worst = 0.0;
     for (const Vec3& p : nodes)
     {
-      double s = 0.0, t = 0.0, d = 0.0;
-      geometry.project(carrier, p, s, t, d);
-      worst = std::max(worst, d);
+      worst = std::max(worst, test::surfaceDistance(geometry, carrier, p));
     }
     EXPECT_LT(worst, 1e-6 * chord) << surface;
   }

@@ -234,6 +234,53 @@ blocks:
   }
 }
 
+TEST(ProjectedEdges, AProjectedEdgeJoinsItsMatchedSourcesGroupWhereItContinues)
+{
+  // The matched inner arc of A continues through a0 into F's inner edge, and the outer arc
+  // projected from it continues through a3 into F's outer edge: both of F's edges are
+  // graded, with end cells 0.067 and 0.53 of their length at density 1. The projected arc's
+  // end cell follows the inner arc's, so the inner arc takes the geometric mean of the two
+  // (not the inner one alone), and neither layer jumps by the whole factor across F|A.
+  const std::string text = R"yaml(blockforge: 1
+vertices:
+  a0: [0, 1, 0]
+  m0: [sqrt(0.5), sqrt(0.5), 0]
+  a3: [0, 1.5, 0]
+  m3: [1.5*sqrt(0.5), 1.5*sqrt(0.5), 0]
+  a4: [0, 1, 1]
+  m4: [sqrt(0.5), sqrt(0.5), 1]
+  a7: [0, 1.5, 1]
+  m7: [1.5*sqrt(0.5), 1.5*sqrt(0.5), 1]
+  f0: [-1, 1, 0]
+  f3: [-1, 1.5, 0]
+  f4: [-1, 1, 1]
+  f7: [-1, 1.5, 1]
+edges:
+  ia0: {arc: [a0, m0], centre: [0, 0, 0]}
+  oa0: {arc: [a3, m3], centre: [0, 0, 0]}
+  ia1: {arc: [a4, m4], centre: [0, 0, 1]}
+  oa1: {arc: [a7, m7], centre: [0, 0, 1]}
+blocks:
+  F: {vertices: [f0, a0, a3, f3, f4, a4, a7, f7], cells: [4, 3, 1], grading: {edges: {E1: {geometric: 0.5}, E5: {geometric: 0.5}, E3: {geometric: 2}, E7: {geometric: 2}}}}
+  A: {vertices: [a0, m0, m3, a3, a4, m4, m7, a7], cells: [6, 3, 1], grading: {edges: {E1: match, E5: match, E3: {project_from: ia0}, E7: {project_from: ia1}}}}
+)yaml";
+  const BlockModel model = parseTemplate(text, "joined.yaml");
+  for (const double density : { 1.0, 2.0 })
+  {
+    SCOPED_TRACE(density);
+    const test::Grid grid = test::meshAll(model, density);
+    const int nf = grid.nodes[0][0], outerF = grid.nodes[0][1] - 1, outerA = grid.nodes[1][1] - 1;
+    const double innerF = (node(grid, 0, nf - 1, 0, 0) - node(grid, 0, nf - 2, 0, 0)).norm();
+    const double outerFCell = (node(grid, 0, nf - 1, outerF, 0) - node(grid, 0, nf - 2, outerF, 0)).norm();
+    // the inner arc's first cell (radius 1: the angle), and the outer arc's (radius 1.5)
+    const double innerA = angleOf(node(grid, 1, 0, 0, 0)) - angleOf(node(grid, 1, 1, 0, 0));
+    const double outerACell = 1.5 * (angleOf(node(grid, 1, 0, outerA, 0)) - angleOf(node(grid, 1, 1, outerA, 0)));
+    EXPECT_GT(outerFCell / innerF, 7.0); // F's ends differ by a large factor
+    EXPECT_NEAR(innerA, std::sqrt(innerF * outerFCell), 1e-9);
+    EXPECT_NEAR(outerACell / innerA, 1.5, 1e-9);
+  }
+}
+
 TEST(ProjectedEdges, TheLawTravelsInTheModelDocument)
 {
   const BlockModel model =

@@ -53,22 +53,23 @@ ALLOWED_FAILURES = {
     # fewer cells into its short inlet and outlet gaps).
     "axial_passage_h_turbine": {"determinant"},
     # Thin cells on the blade (O-grid expansion k_o towards the wall, aspect ratio up to
-    # 37); and where the O-grid's leading/trailing-edge blocks meet its side blocks the cell
-    # length along the blade jumps (uniform spacing in each block): low interpolation weights.
-    "axial_passage_oh_distributor": {"determinant", "interpolation weight"},
-    "axial_passage_oh_rotor37": {"determinant", "interpolation weight"},
-    "axial_passage_oh_turbine": {"determinant", "interpolation weight"},
-    # The same on the transonic compressor, whose sharp leading edge also leaves concave
-    # cells and cell volumes jumping by more than 100 between neighbours at the O-grid's
-    # corners (the template's grid, reported; every cell is valid: Mesh OK).
-    "axial_passage_oh_compressor": {"determinant", "interpolation weight", "concave",
-                                    "volume ratio"},
-    # Optimized: the same thin wall cells and size jumps on the O-grids.
-    "axial_passage_oh_distributor_optimized": {"determinant", "interpolation weight"},
-    "axial_passage_oh_rotor37_optimized": {"determinant", "interpolation weight"},
+    # 45). The O-grid's cells along the blade are graded (issue 8: `match`, `ends`,
+    # `project_from`), so the interpolation weights and volume ratios that failed where the
+    # edge blocks met the side blocks pass.
+    "axial_passage_oh_distributor": {"determinant"},
+    "axial_passage_oh_rotor37": {"determinant"},
+    "axial_passage_oh_turbine": {"determinant"},
+    # The transonic compressor's sharp edges keep their O corners on the tip: the edge
+    # blocks are fans whose blade cells are the feet of their outer cells on an edge of
+    # 0.8 micrometre, which leaves concave cells and faces whose decomposition tets are
+    # poor (the template's grid, reported; every cell is valid: Mesh OK).
+    "axial_passage_oh_compressor": {"determinant", "concave", "face tets"},
+    # Optimized: the same thin wall cells; on the compressor a few interpolation weights.
+    "axial_passage_oh_distributor_optimized": {"determinant"},
+    "axial_passage_oh_rotor37_optimized": {"determinant"},
     "axial_passage_oh_turbine_optimized": {"determinant"},
     "axial_passage_oh_compressor_optimized": {"determinant", "interpolation weight", "concave",
-                                              "volume ratio"},
+                                              "face tets"},
     # Optimized H grids pass but on the turbine: the optimizer (which maximises the smallest
     # angle, blind to cell size) squeezes the downstream blocks' last cells at the outlet by
     # the shroud across the pitch (3 cells below 0.001, aspect ratio 15-31). The distributor,
@@ -158,6 +159,8 @@ class CheckMeshTest(unittest.TestCase):
                         kinds.add("concave")
                     elif "small volume ratio" in line:
                         kinds.add("volume ratio")
+                    elif "face tets" in line:
+                        kinds.add("face tets")
                     else:
                         kinds.add(line)
                 self.assertLessEqual(kinds, ALLOWED_FAILURES.get(name, set()), failed)
