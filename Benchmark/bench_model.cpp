@@ -16,6 +16,9 @@
  *                       inlet vertices placed by expressions of it, the periodic line
  *                       drawn through them), update() (dependent edges, faces, checks, TFI
  *                       of the affected blocks) and MinAngle of the affected cells;
+ * - MoveOneControlPointAndUndo: the same, then MeshPlan::undo() (an optimizer's rejected
+ *                       trial move: the move and putting everything back, instead of a
+ *                       second update moving it back);
  * - MoveOneControlPointWithoutChains: the same on the model without expression and curve
  *                       chains (only a_f_h follows, as before they were kept): the same
  *                       work as before, for comparison with older builds.
@@ -324,7 +327,7 @@ model::FreeParameter movedParameter(const model::BlockModel& model, const model:
   return *best;
 }
 
-void moveOneControlPoint(benchmark::State& state, const Applied& a)
+void moveOneControlPoint(benchmark::State& state, const Applied& a, bool undo = false)
 {
   model::MeshPlan plan(a.model, a.carriers);
   const model::FreeParameter parameter = movedParameter(plan.model(), plan.carriers());
@@ -355,6 +358,10 @@ void moveOneControlPoint(benchmark::State& state, const Applied& a)
     }
     blocks = static_cast<long long>(plan.updatedBlocks().size());
     benchmark::DoNotOptimize(smallest);
+    if (undo && !plan.undo())
+    {
+      state.SkipWithError("MeshPlan::undo found nothing to undo");
+    }
   }
   state.counters["blocks"] = static_cast<double>(blocks);
   state.counters["cells"] = static_cast<double>(cells);
@@ -369,6 +376,11 @@ void BM_MoveOneControlPoint(benchmark::State& state)
 void BM_MoveOneControlPointWithoutChains(benchmark::State& state)
 {
   moveOneControlPoint(state, appliedWithoutChains());
+}
+
+void BM_MoveOneControlPointAndUndo(benchmark::State& state)
+{
+  moveOneControlPoint(state, applied(), true);
 }
 #endif
 } // namespace
@@ -422,6 +434,10 @@ int main(int argc, char** argv)
     ->Unit(benchmark::kMillisecond);
 #ifdef BLOCKFORGE_HAS_MESH_PLAN
   benchmark::RegisterBenchmark("MoveOneControlPoint", BM_MoveOneControlPoint)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("MoveOneControlPointAndUndo", BM_MoveOneControlPointAndUndo)
     ->MeasureProcessCPUTime()
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);

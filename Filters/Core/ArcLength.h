@@ -16,8 +16,8 @@ namespace blockforge
  * @brief The arc length of BlockForge's curves (edges on carriers, splines, follow edges,
  * `at: {length: f}`): a fixed composite 5-point Gauss-Legendre rule on 512 equal pieces
  * of the parameter, and its inverse by Newton inside the piece. Bounded cost whatever the
- * curve's smoothness (curves on blade surfaces are only C1 at the section knots),
- * accurate to about 1e-12 of the length for placing nodes, deterministic.
+ * curve's smoothness, deterministic; accurate to about 1e-13 of the length on smooth
+ * curves, 3e-6 on the blade-hub curve of Rotor 37 (kinks inside pieces; vs 8,192 pieces).
  */
 class ArcLength
 {

@@ -291,12 +291,17 @@ static bool exactEndBasis(int span, double t, int degree, const std::vector<doub
   return false;
 }
 
-void basisFunctions(int span, double t, int degree, const std::vector<double>& knots,
+namespace
+{
+/// Piegl & Tiller's algorithm A2.2; FixedDegree > 0 makes the degree a compile-time
+/// constant (unrolled loops, the same operations in the same order, the same bits).
+template <int FixedDegree>
+void basisFunctionsOf(int span, double t, int degree, const std::vector<double>& knots,
   double* values)
 {
-  if (exactEndBasis(span, t, degree, knots, values))
+  if (FixedDegree > 0)
   {
-    return;
+    degree = FixedDegree;
   }
   double left[MaxBasis], right[MaxBasis];
   values[0] = 1.0;
@@ -312,6 +317,24 @@ void basisFunctions(int span, double t, int degree, const std::vector<double>& k
       saved = left[j - r] * temp;
     }
     values[j] = saved;
+  }
+}
+} // namespace
+
+void basisFunctions(int span, double t, int degree, const std::vector<double>& knots,
+  double* values)
+{
+  if (exactEndBasis(span, t, degree, knots, values))
+  {
+    return;
+  }
+  if (degree == 3)
+  {
+    basisFunctionsOf<3>(span, t, degree, knots, values);
+  }
+  else
+  {
+    basisFunctionsOf<0>(span, t, degree, knots, values);
   }
 }
 
@@ -484,6 +507,7 @@ BSplineCurve::BSplineCurve(int degree, std::vector<double> knots,
   const int bins = 4 * count;
   const double first = Knots[Degree], range = Knots[count] - first;
   SpanTable.resize(bins + 1);
+  BinScale = bins / range;
   for (int bin = 0; bin <= bins; ++bin)
   {
     SpanTable[bin] = bspline::findSpan(Degree, Knots, count, first + range * bin / bins);
@@ -498,27 +522,40 @@ int BSplineCurve::span(double t) const
   {
     return bspline::findSpan(Degree, Knots, count, t); // ends, NaN
   }
-  // Inside, exactly one span k has Knots[k] <= t < Knots[k + 1]: the last one found if
-  // it still holds, else a walk from the table (a step or two), the same span the
-  // bisection finds.
+  // Inside, exactly one span k has Knots[k] <= t < Knots[k + 1], the one the bisection
+  // finds: the last one found if it still holds, else between the spans at the start of
+  // t's bin and of the next bin (a step outside them only when rounding put t in a
+  // neighbouring bin), by bisection between them (usually one or two spans).
   const int last = LastSpan.Span.load(std::memory_order_relaxed);
   if (last >= Degree && last <= n && Knots[last] <= t && t < Knots[last + 1])
   {
     return last;
   }
   const int bins = static_cast<int>(SpanTable.size()) - 1;
-  const double place = (t - Knots[Degree]) / (Knots[n + 1] - Knots[Degree]) * bins;
-  int k = SpanTable[std::max(0, std::min(bins - 1, static_cast<int>(place)))];
-  while (t < Knots[k])
+  const int bin = std::max(0, std::min(bins - 1, static_cast<int>((t - Knots[Degree]) * BinScale)));
+  int low = SpanTable[bin], high = SpanTable[bin + 1];
+  while (t < Knots[low])
   {
-    --k;
+    --low;
   }
-  while (t >= Knots[k + 1])
+  while (t >= Knots[high + 1])
   {
-    ++k;
+    ++high;
   }
-  LastSpan.Span.store(k, std::memory_order_relaxed);
-  return k;
+  while (low < high)
+  {
+    const int middle = (low + high + 1) / 2;
+    if (Knots[middle] <= t)
+    {
+      low = middle;
+    }
+    else
+    {
+      high = middle - 1;
+    }
+  }
+  LastSpan.Span.store(low, std::memory_order_relaxed);
+  return low;
 }
 
 namespace
@@ -610,18 +647,34 @@ BSplineCurve BSplineCurve::interpolateAt(const std::vector<Vec3>& points,
   return curve;
 }
 
+namespace
+{
+/// sum_j weights[j] * points[j], j = 0 .. degree, in that order (FixedDegree > 0: unrolled,
+/// the same operations, the same bits).
+template <int FixedDegree>
+inline Vec3 weightedSum(const double* weights, const Vec3* points, int degree)
+{
+  if (FixedDegree > 0)
+  {
+    degree = FixedDegree;
+  }
+  Vec3 sum = Vec3::Zero();
+  for (int j = 0; j <= degree; ++j)
+  {
+    sum += weights[j] * points[j];
+  }
+  return sum;
+}
+} // namespace
+
 Vec3 BSplineCurve::point(double t) const
 {
   t = clampUnit(t);
   const int span = this->span(t);
   double basis[MaxBasis];
   bspline::basisFunctions(span, t, Degree, Knots, basis);
-  Vec3 result = Vec3::Zero();
-  for (int j = 0; j <= Degree; ++j)
-  {
-    result += basis[j] * ControlPoints[span - Degree + j];
-  }
-  return result;
+  const Vec3* points = &ControlPoints[span - Degree];
+  return Degree == 3 ? weightedSum<3>(basis, points, Degree) : weightedSum<0>(basis, points, Degree);
 }
 
 Vec3 BSplineCurve::derivative(double t, int order) const
@@ -647,14 +700,11 @@ void BSplineCurve::derivatives(double t, int order, Vec3* out) const
   double ders[MaxBasis * MaxBasis];
   bspline::basisDerivatives(span, t, Degree, computed, Knots, ders);
   const int width = Degree + 1;
+  const Vec3* points = &ControlPoints[span - Degree];
   for (int k = 0; k <= computed; ++k)
   {
-    Vec3 sum = Vec3::Zero();
-    for (int j = 0; j <= Degree; ++j)
-    {
-      sum += ders[k * width + j] * ControlPoints[span - Degree + j];
-    }
-    out[k] = sum;
+    out[k] = Degree == 3 ? weightedSum<3>(ders + k * width, points, Degree)
+                         : weightedSum<0>(ders + k * width, points, Degree);
   }
   for (int k = computed + 1; k <= order; ++k)
   {

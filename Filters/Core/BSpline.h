@@ -84,21 +84,25 @@ public:
   const std::vector<double>& dataParameters() const { return DataParameters; }
 
 private:
-  /// findSpan(Degree, Knots, count, t), from SpanTable: same result, no bisection.
+  /// findSpan(Degree, Knots, count, t), from SpanTable: the same result, faster.
   int span(double t) const;
   int Degree;
   std::vector<double> Knots;
   /// The span at the start of each of SpanTable.size() - 1 equal bins of
   /// [Knots[Degree], Knots[count]] (spans of curves on blades are uneven: crowded at the edges).
   std::vector<int> SpanTable;
+  double BinScale = 0.0; ///< bins per unit of t
   std::vector<Vec3> ControlPoints;
   std::vector<double> DataParameters;
   /**
    * The span of the last evaluation, tried first: evaluations come in runs along the
-   * curve (arc-length tables, projections). Only a hint, shared by threads without
-   * order (relaxed atomic): the span found is the same either way.
+   * curve (arc-length tables, projections). Only a hint, shared by threads without order
+   * (relaxed atomic), written only when it changes: the span found is the same either
+   * way. On a cache line of its own: threads of a chunked loop evaluating different parts
+   * of one curve write it in turn, and with the curve's data on the same line every
+   * such write made the other threads fetch the data again.
    */
-  struct SpanHint
+  struct alignas(64) SpanHint
   {
     SpanHint() = default;
     SpanHint(const SpanHint& other) : Span(other.Span.load(std::memory_order_relaxed)) {}

@@ -522,6 +522,17 @@ void ProjectionCache::clear()
   Known.clear();
 }
 
+void ProjectionCache::clear(const std::vector<char>& changed)
+{
+  std::lock_guard<std::mutex> guard(Lock);
+  for (auto entry = Known.begin(); entry != Known.end();)
+  {
+    const int carrier = entry->first.carrier;
+    const bool stale = carrier < 0 || carrier >= static_cast<int>(changed.size()) || changed[carrier];
+    entry = stale ? Known.erase(entry) : std::next(entry);
+  }
+}
+
 std::size_t ProjectionCache::KeyHash::operator()(const Key& key) const
 {
   std::uint64_t h = static_cast<std::uint64_t>(key.carrier) * 0x9E3779B97F4A7C15ull;

@@ -272,6 +272,9 @@ public:
     double* distance = nullptr);
   /// Forgets every projection (the carriers' shapes changed).
   void clear();
+  /// Forgets the projections onto the carriers c with changed[c] set (their shapes
+  /// changed); those onto other carriers stay good.
+  void clear(const std::vector<char>& changed);
 
 private:
   struct Key

@@ -52,8 +52,48 @@ struct MeshPlan::Impl
   std::vector<std::vector<int>> FaceBlocks;        ///< unique face -> blocks
   std::vector<std::vector<int>> VertexBlocks;      ///< vertex -> blocks
 
+  /**
+   * The model's vertices, carriers and carrier shapes as of the last update (what undo()
+   * puts back in the model), and what the last update changed, as it was before it.
+   * Grids are saved just before they are overwritten, into buffers kept from update to
+   * update (no allocation once they have their sizes).
+   */
+  std::vector<Vertex> CommittedVertices;
+  std::vector<Carrier> CommittedCarriers;
+  CarrierGeometry CommittedGeometry;
+  struct Saved
+  {
+    bool valid = false;
+    std::vector<std::pair<int, Vertex>> vertices;
+    std::vector<std::pair<int, Carrier>> carriers;
+    CarrierGeometry geometry;
+    std::vector<std::vector<double>> edgeEnds;
+    std::vector<std::pair<const void*, const void*>> carrierShapes;
+    std::vector<int> curveIndices;
+    std::vector<NamedCurve> curves;
+    std::vector<UniqueEdge> edges;
+    std::vector<MeshLinks> blocks;
+    std::vector<PeriodicPair> periodic;
+    std::vector<int> faceIndices;
+    std::vector<std::vector<double>> faces;  ///< by unique face (only faceIndices valid)
+    std::vector<int> nodeIndices;
+    std::vector<std::vector<double>> nodes; ///< by block (only nodeIndices valid)
+    std::vector<int> updated, pending;
+  } Before;
+
   void buildDependencies();
   void run(const std::vector<int>& moved);
+  /// Saves what an update of `vertices` may change (before it changes it).
+  void save(const std::vector<int>& vertices);
+  void saveFace(int f)
+  {
+    if (std::find(Before.faceIndices.begin(), Before.faceIndices.end(), f) != Before.faceIndices.end())
+    {
+      return; // saved before this update changed it
+    }
+    Before.faceIndices.push_back(f);
+    Before.faces[f] = Topo.faces[f].xyz;
+  }
 };
 
 namespace
@@ -172,6 +212,11 @@ MeshPlan::MeshPlan(const BlockModel& model, const CarrierGeometry& carriers, dou
   {
     P->EdgeEnds.push_back(edge.at);
   }
+  P->CommittedVertices = P->Model.vertices;
+  P->CommittedCarriers = P->Model.carriers;
+  P->CommittedGeometry = P->Geometry;
+  P->Before.faces.resize(P->Topo.faces.size());
+  P->Before.nodes.resize(P->Model.blocks.size());
   P->Nodes.resize(P->Model.blocks.size());
   for (int b = 0; b < blockCount(); ++b)
   {
@@ -247,7 +292,7 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
   }
   if (std::find(changedCarrier.begin(), changedCarrier.end(), 1) != changedCarrier.end())
   {
-    Projections.clear(); // it remembers projections onto the old shapes
+    Projections.clear(changedCarrier); // it remembers projections onto the old shapes
   }
 
   // Named edge curves: those ending at a moved vertex, those on a carrier drawn again,
@@ -277,6 +322,8 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
     {
       rebuilt[follower] = 1;
     }
+    Before.curveIndices.push_back(static_cast<int>(e));
+    Before.curves.push_back(Curves[e]);
     try
     {
       followEdgeEnds(model, Geometry, static_cast<int>(e), movedVertex);
@@ -382,6 +429,7 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
   {
     if (changedFace[f] && !IsImage[f])
     {
+      saveFace(static_cast<int>(f));
       computeFaceGrid(model, Geometry, OnSurface, Topo, static_cast<int>(f), &Projections);
     }
   }
@@ -390,6 +438,7 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
     if (changedFace[pair.source] || changedFace[pair.image])
     {
       changedFace[pair.image] = 1;
+      saveFace(pair.image);
       periodicFace(model, Topo, pair, Topo.faces[pair.image].xyz);
     }
   }
@@ -434,6 +483,7 @@ Feasibility MeshPlan::update(const std::vector<int>& moved)
     }
     addUnique(vertices, v);
   }
+  P->save(vertices);
   P->Pending = vertices;
   P->Updated.clear();
   try
@@ -462,8 +512,10 @@ Feasibility MeshPlan::update(const std::vector<int>& moved)
   // Blocks are meshed and checked each on its own (on threads when a runner is
   // installed); the first infeasible block in block order is the one reported.
   std::vector<Feasibility> cells(P->Updated.size());
+  P->Before.nodeIndices = P->Updated;
   forEachChunk(static_cast<long>(P->Updated.size()), [&](long n) {
     const int b = P->Updated[n];
+    P->Before.nodes[b] = P->Nodes[b];
     meshBlockNodes(P->Model, P->Topo, b, P->Nodes[b].data());
     cells[n] = checkCells(P->Nodes[b].data(), P->Topo.blocks[b].nodes, b);
   });
@@ -475,6 +527,106 @@ Feasibility MeshPlan::update(const std::vector<int>& moved)
     }
   }
   return Feasibility();
+}
+
+void MeshPlan::Impl::save(const std::vector<int>& vertices)
+{
+  Saved& saved = Before;
+  saved.valid = true;
+  saved.vertices.clear();
+  for (const int v : vertices)
+  {
+    saved.vertices.emplace_back(v, CommittedVertices[v]);
+    CommittedVertices[v] = Model.vertices[v];
+  }
+  saved.carriers.clear();
+  bool carriersChanged = false;
+  for (std::size_t c = 0; c < Model.carriers.size(); ++c)
+  {
+    if (shape(static_cast<int>(c)) != CarrierShapes[c])
+    {
+      carriersChanged = true;
+      saved.carriers.emplace_back(static_cast<int>(c), CommittedCarriers[c]);
+      CommittedCarriers[c] = Model.carriers[c];
+    }
+  }
+  saved.geometry = CommittedGeometry;
+  if (carriersChanged)
+  {
+    CommittedGeometry = Geometry;
+  }
+  saved.edgeEnds = EdgeEnds;
+  saved.carrierShapes = CarrierShapes;
+  saved.curveIndices.clear();
+  saved.curves.clear();
+  saved.edges = Topo.edges;
+  saved.blocks = Topo.blocks;
+  saved.periodic = Topo.connectivity.periodic;
+  saved.faceIndices.clear();
+  saved.nodeIndices.clear();
+  saved.updated = Updated;
+  saved.pending = Pending;
+}
+
+bool MeshPlan::undo()
+{
+  Impl::Saved& saved = P->Before;
+  if (!saved.valid)
+  {
+    return false;
+  }
+  saved.valid = false;
+  // The projections cache remembers projections onto the shapes the update drew
+  std::vector<char> redrawn(P->Model.carriers.size(), 0);
+  for (const auto& carrier : saved.carriers)
+  {
+    redrawn[carrier.first] = 1;
+  }
+  for (auto& vertex : saved.vertices)
+  {
+    P->CommittedVertices[vertex.first] = vertex.second;
+    P->Model.vertices[vertex.first] = std::move(vertex.second);
+  }
+  for (auto& carrier : saved.carriers)
+  {
+    P->CommittedCarriers[carrier.first] = carrier.second;
+    P->Model.carriers[carrier.first] = std::move(carrier.second);
+  }
+  P->CommittedGeometry = saved.geometry;
+  P->Geometry = std::move(saved.geometry);
+  for (std::size_t c = 0; c < P->Model.carriers.size(); ++c)
+  {
+    redrawn[c] = redrawn[c] || P->shape(static_cast<int>(c)) != P->CarrierShapes[c] ? 1 : 0;
+  }
+  if (std::find(redrawn.begin(), redrawn.end(), 1) != redrawn.end())
+  {
+    P->Projections.clear(redrawn);
+  }
+  for (std::size_t e = 0; e < P->Model.edges.size(); ++e)
+  {
+    P->Model.edges[e].at = saved.edgeEnds[e];
+  }
+  std::swap(P->EdgeEnds, saved.edgeEnds);
+  std::swap(P->CarrierShapes, saved.carrierShapes);
+  for (std::size_t n = 0; n < saved.curveIndices.size(); ++n)
+  {
+    P->Curves[saved.curveIndices[n]] = std::move(saved.curves[n]);
+  }
+  std::swap(P->Topo.edges, saved.edges);
+  std::swap(P->Topo.blocks, saved.blocks);
+  std::swap(P->Topo.connectivity.periodic, saved.periodic);
+  for (const int f : saved.faceIndices)
+  {
+    std::swap(P->Topo.faces[f].xyz, saved.faces[f]);
+  }
+  for (const int b : saved.nodeIndices)
+  {
+    std::swap(P->Nodes[b], saved.nodes[b]);
+  }
+  P->Updated = saved.nodeIndices;
+  std::sort(P->Updated.begin(), P->Updated.end());
+  P->Pending = saved.pending;
+  return true;
 }
 
 void MeshPlan::rebuildCarrier(int index)

@@ -73,6 +73,16 @@ public:
    */
   Feasibility update(const std::vector<int>& moved);
 
+  /**
+   * Puts back what the last update() changed, as it was before it: the vertices passed to
+   * it (and those of earlier failed updates), the edges' ends, the carriers drawn again,
+   * the edge, face and block grids, bit for bit; updatedBlocks() then lists the blocks put
+   * back. One step only: an optimizer rejecting a trial move undoes it instead of moving
+   * back and updating again. False (nothing changed) when there is nothing to undo: after
+   * construction or after undo().
+   */
+  bool undo();
+
   /// Builds carrier `index` again from its changed definition in model() (a surface curve
   /// drawn through control points that moved); then update() the vertices of the edges on
   /// it, so they follow.

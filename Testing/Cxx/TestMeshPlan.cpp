@@ -56,6 +56,16 @@ void expectSameAsFreshMesher(const MeshPlan& plan)
   }
 }
 
+/// Every block of `plan` equals the same block of `other`, bit for bit.
+void expectSameGrids(const MeshPlan& plan, const MeshPlan& other)
+{
+  ASSERT_EQ(plan.blockCount(), other.blockCount());
+  for (int b = 0; b < plan.blockCount(); ++b)
+  {
+    EXPECT_TRUE(test::sameBits(plan.blockNodes(b), other.blockNodes(b))) << "block " << b;
+  }
+}
+
 const FreeParameter& sParameter(const std::vector<FreeParameter>& parameters, int vertex)
 {
   for (const FreeParameter& parameter : parameters)
@@ -435,10 +445,7 @@ TEST(MeshPlan, ThreadsGiveTheSameBits)
     ASSERT_TRUE(move(serial, original + delta, 1).feasible());
     ASSERT_TRUE(move(threaded, original + delta, 2).feasible());
     EXPECT_EQ(threaded.updatedBlocks(), serial.updatedBlocks());
-    for (int b = 0; b < serial.blockCount(); ++b)
-    {
-      EXPECT_TRUE(test::sameBits(threaded.blockNodes(b), serial.blockNodes(b))) << "block " << b;
-    }
+    expectSameGrids(threaded, serial);
   }
   expectSameAsFreshMesher(threaded);
 }
@@ -509,4 +516,91 @@ TEST(MeshPlan, MatchedEdgesFollowMovesAsAFreshMesherDoes)
     EXPECT_TRUE(feasibility.feasible()) << feasibility.message;
     expectSameAsFreshMesher(plan);
   }
+}
+
+TEST(MeshPlan, UndoPutsTheGridBackBitForBit)
+{
+  // An optimizer rejecting a trial move undoes it: the model, the carriers drawn through
+  // moved vertices and every grid are as before the move, bit for bit, and the next move
+  // from there gives what it gives without the rejected one in between.
+  const Passage& passage = rotor37Passage();
+  MeshPlan plan(passage.model, passage.carriers);
+  MeshPlan direct(passage.model, passage.carriers);
+  EXPECT_FALSE(plan.undo()); // nothing to undo after construction
+  const int oa = vertexIndex(plan.model(), "oa_f_h");
+  const FreeParameter s = sParameter(freeParameters(plan.model(), plan.carriers()), oa);
+  const double original = plan.model().vertices[oa].constraint.s;
+  const auto move = [&](MeshPlan& p, double value) {
+    return p.update(moveParameter(p.model(), p.carriers(), s, value));
+  };
+  ASSERT_TRUE(move(plan, original + 0.003).feasible());
+  ASSERT_TRUE(move(direct, original + 0.003).feasible());
+  std::vector<std::vector<double>> kept;
+  std::vector<Vec3> positions;
+  for (int b = 0; b < plan.blockCount(); ++b)
+  {
+    kept.push_back(plan.blockNodes(b));
+  }
+  for (const Vertex& vertex : plan.model().vertices)
+  {
+    positions.push_back(vertex.position);
+  }
+  const std::string document = writeModelDocument(plan.model());
+
+  ASSERT_TRUE(move(plan, original - 0.002).feasible()); // the trial move, rejected
+  const std::vector<int> trialBlocks = plan.updatedBlocks();
+  EXPECT_TRUE(plan.undo());
+  EXPECT_FALSE(plan.undo()); // one step only
+  EXPECT_EQ(plan.updatedBlocks(), trialBlocks);
+  EXPECT_EQ(writeModelDocument(plan.model()), document);
+  for (std::size_t v = 0; v < positions.size(); ++v)
+  {
+    EXPECT_TRUE(test::sameBits(positions[v], plan.model().vertices[v].position))
+      << plan.model().vertices[v].name;
+  }
+  for (int b = 0; b < plan.blockCount(); ++b)
+  {
+    EXPECT_TRUE(test::sameBits(plan.blockNodes(b), kept[b])) << "block " << b;
+  }
+  // The next moves from the restored state, of another corner (its blocks share faces
+  // with the trial's, not all of which it recomputes) and of the same: as if the trial
+  // had never been made.
+  const int ob = vertexIndex(plan.model(), "ob_f_h");
+  const FreeParameter other = sParameter(freeParameters(plan.model(), plan.carriers()), ob);
+  const double otherValue = plan.model().vertices[ob].constraint.s - 0.002;
+  for (MeshPlan* p : { &plan, &direct })
+  {
+    ASSERT_TRUE(p->update(moveParameter(p->model(), p->carriers(), other, otherValue)).feasible());
+  }
+  expectSameGrids(plan, direct);
+  ASSERT_TRUE(move(plan, original + 0.001).feasible());
+  ASSERT_TRUE(move(direct, original + 0.001).feasible());
+  expectSameGrids(plan, direct);
+  expectSameAsFreshMesher(plan);
+}
+
+TEST(MeshPlan, UndoAfterAnInfeasibleUpdate)
+{
+  const BlockModel model = loadTemplate(test::sourcePath("Testing/Data/two_blocks.yaml"));
+  MeshPlan plan(model, CarrierGeometry(model));
+  const int a1 = vertexIndex(plan.model(), "a1");
+  const Vec3 original = plan.model().vertices[a1].position;
+  plan.model().vertices[a1].position = Vec3(-0.5, 0.0, 0.0);
+  EXPECT_FALSE(plan.update({ a1 }).feasible());
+  EXPECT_TRUE(plan.undo());
+  EXPECT_EQ(plan.model().vertices[a1].position, original);
+  const test::Grid initial = test::meshAll(model);
+  for (int b = 0; b < plan.blockCount(); ++b)
+  {
+    EXPECT_TRUE(test::sameBits(plan.blockNodes(b), initial.xyz[b])) << "block " << b;
+  }
+  // Nothing left pending: a move elsewhere updates what it updates on a fresh plan.
+  MeshPlan fresh(model, CarrierGeometry(model));
+  for (MeshPlan* p : { &plan, &fresh })
+  {
+    p->model().vertices[a1].position = original + Vec3(0.01, 0.02, 0.0);
+    EXPECT_TRUE(p->update({ a1 }).feasible());
+  }
+  EXPECT_EQ(plan.updatedBlocks(), fresh.updatedBlocks());
+  expectSameGrids(plan, fresh);
 }
