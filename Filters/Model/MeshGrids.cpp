@@ -484,7 +484,7 @@ void copyFaceBoundary(const BlockModel& model, const MeshTopology& topology, int
 
 /// The carrier's projection of p, remembered by p's bits.
 void ProjectionCache::project(
-  const CarrierGeometry& geometry, int carrier, const Vec3& p, double& s, double& t)
+  const CarrierGeometry& geometry, int carrier, const Vec3& p, double& s, double& t, double* distance)
 {
   Key key{ carrier, {} };
   std::memcpy(key.bits.data(), p.data(), sizeof(key.bits));
@@ -493,19 +493,27 @@ void ProjectionCache::project(
     const auto found = Known.find(key);
     if (found != Known.end())
     {
-      s = found->second.first;
-      t = found->second.second;
+      s = found->second[0];
+      t = found->second[1];
+      if (distance)
+      {
+        *distance = found->second[2];
+      }
       return;
     }
   }
-  double distance = 0.0;
-  geometry.project(carrier, p, s, t, distance);
+  double away = 0.0;
+  geometry.project(carrier, p, s, t, away);
+  if (distance)
+  {
+    *distance = away;
+  }
   std::lock_guard<std::mutex> guard(Lock);
   if (Known.size() > 1000000)
   {
     Known.clear(); // bounded: a long optimisation must not grow it without end
   }
-  Known.emplace(key, std::make_pair(s, t));
+  Known.emplace(key, std::array<double, 3>{ s, t, away });
 }
 
 void ProjectionCache::clear()
@@ -577,6 +585,7 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
     loop.push_back(node(left, b));
   const int loopSize = static_cast<int>(loop.size());
   std::vector<Eigen::Vector2d> st(loopSize);
+  std::vector<double> away(loopSize, 0.0);
   // Each node is projected, and below each interior node placed, on its own: in chunks
   // on threads when a runner is installed (a face computed inside another chunked loop
   // runs in that loop's thread), the same bits.
@@ -586,14 +595,14 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
     const int last = static_cast<int>((chunk + 1) * loopSize / loopChunks);
     for (int k = first; k < last; ++k)
     {
-      double s = 0.0, t = 0.0, distance = 0.0;
+      double s = 0.0, t = 0.0;
       if (cache)
       {
-        cache->project(geometry, carrier, loop[k], s, t);
+        cache->project(geometry, carrier, loop[k], s, t, &away[k]);
       }
       else
       {
-        geometry.project(carrier, loop[k], s, t, distance);
+        geometry.project(carrier, loop[k], s, t, away[k]);
       }
       st[k] = Eigen::Vector2d(s, t);
     }
@@ -613,17 +622,23 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
   };
   // The closest point of the whole surface can lie on the far side of a thin edge (a
   // blade's leading or trailing edge, both sides closer than the projector's sample
-  // spacing): follow the loop from each node's neighbour as well, and keep the nearer.
+  // spacing): where a node is not on the surface at the point found, follow the loop to
+  // it from its neighbours, and keep the nearer point. Both ways round: from a sharp
+  // edge's tip the way on is ambiguous, from the other neighbour it is not.
   const double onSurface = 1e-9 * geometry.size(carrier);
   auto follow = [&](int k, int from) {
+    if (!(away[k] > onSurface))
+    {
+      return;
+    }
     double s = st[from][0], t = st[from][1];
     Vec3 start;
     closestNear(surface, loop[k], s, t, start);
     const double near = (geometry.point(carrier, s, t) - loop[k]).norm();
-    const double global = (geometry.point(carrier, st[k][0], st[k][1]) - loop[k]).norm();
-    if (near + onSurface < global)
+    if (near + onSurface < away[k])
     {
       st[k] = Eigen::Vector2d(s, t);
+      away[k] = near;
     }
   };
   for (int k = 1; k < loopSize; ++k)
@@ -631,8 +646,10 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
     unwrap(k, k - 1);
     follow(k, k - 1);
   }
-  follow(0, 1);
-  unwrap(0, 1);
+  for (int k = loopSize - 2; k >= 0; --k)
+  {
+    follow(k, k + 1);
+  }
   out.resize(3 * static_cast<std::size_t>(na) * nb);
   surfaceFaceGrid(surface, st, bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data());
 }

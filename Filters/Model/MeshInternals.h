@@ -267,7 +267,9 @@ void copyPeriodicEdge(const BlockModel& model, MeshTopology& topology, const Edg
 class ProjectionCache
 {
 public:
-  void project(const CarrierGeometry& geometry, int carrier, const Vec3& p, double& s, double& t);
+  /// `distance` (when given): how far p is from the point found.
+  void project(const CarrierGeometry& geometry, int carrier, const Vec3& p, double& s, double& t,
+    double* distance = nullptr);
   /// Forgets every projection (the carriers' shapes changed).
   void clear();
 
@@ -282,7 +284,7 @@ private:
   {
     std::size_t operator()(const Key& key) const;
   };
-  std::unordered_map<Key, std::pair<double, double>, KeyHash> Known;
+  std::unordered_map<Key, std::array<double, 3>, KeyHash> Known; // s, t, distance
   std::mutex Lock;
 };
 

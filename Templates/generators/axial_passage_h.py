@@ -89,7 +89,7 @@ definitions:
 carriers:
   hub: {revolve: hub, axis: machine, extend: extend}
   shroud: {revolve: shroud, axis: machine, extend: extend}
-  blade: {gordon: sections, blending: spline, closed: true}
+  blade: {gordon: sections, blending: spline, closed: true, align: axial}   # every section: leading edge at s = 0.25, trailing edge at 0.75 (the spanwise edges follow the thin edges)
   blade_h: {intersect: [blade, hub]}
   blade_s: {intersect: [blade, shroud]}
 """
