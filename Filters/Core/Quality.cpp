@@ -1,6 +1,7 @@
 /**
  * @file Quality.cpp
- * @brief Cell quality of structured hexahedral blocks.
+ * @brief Cell quality of structured hexahedral blocks: the grid pass over every cell of a
+ * multiblock grid (computeGridQuality) and the memory it writes into.
  *
  * The grid pass is written for throughput. Per block it keeps rolling buffers: two node
  * planes in structure-of-arrays form, the squared and inverse lengths of the edges
@@ -10,8 +11,12 @@
  * both cells; non-orthogonality is accumulated as a signed squared cosine, so one root
  * and one acos per cell remain. Rare special cases (collapsed edges or faces, Verdict's
  * degenerate cells) take the literal formulas, for that lane only.
+ *
+ * The faces on block sides are paired in QualityInterfaces.cpp; the measures of a single
+ * cell or face and the MinAngle classes are in QualityMeasures.cpp.
  */
 #include "Quality.h"
+#include "QualityInterfaces.h"
 #include "QualityKernels.h"
 
 #include "Parallel.h"
@@ -19,7 +24,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <string>
 
 #if defined(__linux__)
@@ -28,21 +32,8 @@
 
 namespace blockforge
 {
-using namespace quality;
-
-namespace
+namespace quality
 {
-// ---------------------------------------------------------------------------------------
-// Memory
-
-/**
- * Fresh memory is first-touched page by page, and page faults can cost as much as the
- * whole quality computation (about 10 us per 4 KiB page on some virtual machines).
- * prefault() prepares a range with two Linux hints: transparent huge pages for its
- * 2 MiB-aligned interior, then one prefault of the whole range, which costs far less
- * than faulting page by page. Neither changes memory contents; both are advisory (older
- * kernels, or other systems, simply skip them).
- */
 void prefault(std::uintptr_t begin, std::uintptr_t end)
 {
 #if defined(__linux__)
@@ -69,430 +60,12 @@ void prefault(std::uintptr_t begin, std::uintptr_t end)
   (void)end;
 #endif
 }
+} // namespace quality
 
-/// Reserves a vector's storage and prefaults it.
-template <typename Value>
-void reservePrefaulted(std::vector<Value>& values, std::size_t count)
+using namespace quality;
+
+namespace
 {
-  values.reserve(count);
-  const auto begin = reinterpret_cast<std::uintptr_t>(values.data());
-  prefault(begin, begin + sizeof(Value) * values.capacity());
-}
-
-// ---------------------------------------------------------------------------------------
-// Block interfaces
-
-/// One block's structured addressing.
-struct BlockView
-{
-  const double* xyz;
-  int ni, nj, nk; // nodes
-  int ci, cj, ck; // cells
-  long cellCount;
-  /// A neighbour layer (another rank's cells) takes part with this side only; -1: all.
-  int onlySide = -1;
-
-  explicit BlockView(const StructuredBlock& b)
-    : xyz(b.xyz)
-    , ni(b.ni)
-    , nj(b.nj)
-    , nk(b.nk)
-    , ci(std::max(b.ni - 1, 0))
-    , cj(std::max(b.nj - 1, 0))
-    , ck(std::max(b.nk - 1, 0))
-    , cellCount(static_cast<long>(ci) * cj * ck)
-  {
-  }
-  const double* node(int i, int j, int k) const
-  {
-    return xyz + 3 * (i + static_cast<long>(ni) * (j + static_cast<long>(nj) * k));
-  }
-  long cell(int i, int j, int k) const
-  {
-    return i + static_cast<long>(ci) * (j + static_cast<long>(cj) * k);
-  }
-  void cellCorners(int i, int j, int k, P3 (&c)[8]) const
-  {
-    c[0] = load(node(i, j, k));
-    c[1] = load(node(i + 1, j, k));
-    c[2] = load(node(i + 1, j + 1, k));
-    c[3] = load(node(i, j + 1, k));
-    c[4] = load(node(i, j, k + 1));
-    c[5] = load(node(i + 1, j, k + 1));
-    c[6] = load(node(i + 1, j + 1, k + 1));
-    c[7] = load(node(i, j + 1, k + 1));
-  }
-  P3 cellCentre(int i, int j, int k) const
-  {
-    P3 c[8];
-    cellCorners(i, j, k, c);
-    return cellCentroid(c);
-  }
-  /// Face grid size of a block side: 0/1 are i = 0 / i = ni-1 (indexed j, k),
-  /// 2/3 are j = 0 / nj-1 (i, k), 4/5 are k = 0 / nk-1 (i, j).
-  int sideWidth(int side) const { return side < 2 ? cj : ci; }
-  int sideHeight(int side) const { return side < 4 ? ck : cj; }
-
-  /// Corners of face (a, b) of a side, ordered so the right-hand normal points along
-  /// increasing i, j or k, and the cell that owns it.
-  void sideFace(int side, int a, int b, P3 (&q)[4], int (&cellIjk)[3]) const
-  {
-    switch (side)
-    {
-      case 0:
-      case 1:
-      {
-        const int i = side == 0 ? 0 : ni - 1;
-        q[0] = load(node(i, a, b));
-        q[1] = load(node(i, a + 1, b));
-        q[2] = load(node(i, a + 1, b + 1));
-        q[3] = load(node(i, a, b + 1));
-        cellIjk[0] = side == 0 ? 0 : ci - 1;
-        cellIjk[1] = a;
-        cellIjk[2] = b;
-        break;
-      }
-      case 2:
-      case 3:
-      {
-        const int j = side == 2 ? 0 : nj - 1;
-        q[0] = load(node(a, j, b));
-        q[1] = load(node(a, j, b + 1));
-        q[2] = load(node(a + 1, j, b + 1));
-        q[3] = load(node(a + 1, j, b));
-        cellIjk[0] = a;
-        cellIjk[1] = side == 2 ? 0 : cj - 1;
-        cellIjk[2] = b;
-        break;
-      }
-      default:
-      {
-        const int k = side == 4 ? 0 : nk - 1;
-        q[0] = load(node(a, b, k));
-        q[1] = load(node(a + 1, b, k));
-        q[2] = load(node(a + 1, b + 1, k));
-        q[3] = load(node(a, b + 1, k));
-        cellIjk[0] = a;
-        cellIjk[1] = b;
-        cellIjk[2] = side == 4 ? 0 : ck - 1;
-        break;
-      }
-    }
-  }
-};
-
-/// Order-independent hash of a face's corners (a sum of per-corner hashes), with -0.0
-/// folded onto +0.0 so that equal coordinates hash equally.
-std::uint64_t hashFaceCorners(const P3 (&q)[4])
-{
-  auto mix = [](double value)
-  {
-    value += 0.0;
-    std::uint64_t bits;
-    std::memcpy(&bits, &value, sizeof(bits));
-    bits ^= bits >> 31;
-    bits *= 0xBF58476D1CE4E5B9ull;
-    bits ^= bits >> 29;
-    return bits;
-  };
-  std::uint64_t sum = 0;
-  for (const P3& p : q)
-  {
-    std::uint64_t h = mix(p.x);
-    h = (h ^ mix(p.y)) * 0x94D049BB133111EBull;
-    h = (h ^ mix(p.z)) * 0x9E3779B97F4A7C15ull;
-    sum += h ^ (h >> 32);
-  }
-  return sum;
-}
-
-/// Same 4 corners as multisets, coordinates compared exactly.
-bool sameCorners(const P3* a, const P3* b)
-{
-  auto equal = [](const P3& p, const P3& q)
-  {
-    return p.x == q.x && p.y == q.y && p.z == q.z;
-  };
-  for (int n = 0; n < 4; ++n)
-  {
-    const P3& p = a[n];
-    int inA = 0, inB = 0;
-    for (int m = 0; m < 4; ++m)
-    {
-      inA += equal(p, a[m]);
-      inB += equal(p, b[m]);
-    }
-    if (inA != inB)
-    {
-      return false;
-    }
-  }
-  return true;
-}
-
-struct BoundaryFaceRef
-{
-  int block, side, a, b;
-};
-
-/**
- * All block-boundary faces of the grid, numbered block by block, side by side, and for
- * each the index of the coincident face (another block's, or the same block's across a
- * seam) or -1 for a true boundary.
- */
-struct InterfaceTable
-{
-  static constexpr long unmatched = -1;
-
-  std::vector<long> partner;
-  std::vector<long> sideOffset; // first face of each (block, side), block-major
-  /// Periodic faces: 2 l + 0 when the partner cell is rotated by link l's rotation into
-  /// this face's frame, 2 l + 1 by its inverse; -1 for interfaces and boundaries. Empty
-  /// when there are no periodic links.
-  std::vector<int> periodic;
-  std::vector<PeriodicSideLink> links;
-
-  /// The neighbour centre as the face at `index` sees it.
-  P3 neighbourCentre(long index, const P3& centre) const
-  {
-    const int code = periodic.empty() ? -1 : periodic[index];
-    if (code < 0)
-    {
-      return centre;
-    }
-    const PeriodicSideLink& link = links[code / 2];
-    const Vec3 relative = toVec3(centre) - link.origin;
-    return toP3(link.origin +
-      (code % 2 == 0 ? Vec3(link.rotation * relative) : Vec3(link.rotation.transpose() * relative)));
-  }
-
-  long index(int block, int side, int a, int b, const BlockView& view) const
-  {
-    return sideOffset[6 * block + side] + a + static_cast<long>(view.sideWidth(side)) * b;
-  }
-  BoundaryFaceRef face(long index, const std::vector<BlockView>& views) const
-  {
-    // The last (block, side) starting at or before index: sides without faces share
-    // their offset with the next side, so they are never the last one.
-    const auto found = std::upper_bound(sideOffset.begin(), sideOffset.end(), index) - 1;
-    const long blockSide = found - sideOffset.begin();
-    const int block = static_cast<int>(blockSide / 6), side = static_cast<int>(blockSide % 6);
-    const long local = index - *found;
-    const int width = views[block].sideWidth(side);
-    return { block, side, static_cast<int>(local % width), static_cast<int>(local / width) };
-  }
-};
-
-/**
- * Pairs boundary faces whose four corners coincide exactly. Order-independent hashes of
- * the corners are sorted (deterministic). Two faces alone with a hash are paired
- * provisionally: the boundary pass, which reads both faces' corners anyway, confirms
- * them bit for bit (a face's true partner has the same hash, so a pair that fails has no
- * partner at all). Larger groups are resolved here on the corners: a face pairs only
- * when exactly one other face has its corners; more would be an ambiguous, non-manifold
- * contact (or collapsed faces along a wedge's axis, which the boundary pass skips).
- */
-InterfaceTable matchBlockInterfaces(const std::vector<BlockView>& views)
-{
-  InterfaceTable table;
-  table.sideOffset.resize(6 * views.size());
-  long count = 0;
-  for (std::size_t blockIndex = 0; blockIndex < views.size(); ++blockIndex)
-  {
-    const BlockView& view = views[blockIndex];
-    for (int side = 0; side < 6; ++side)
-    {
-      table.sideOffset[6 * blockIndex + side] = count;
-      if (view.cellCount > 0 && (view.onlySide < 0 || view.onlySide == side))
-      {
-        count += static_cast<long>(view.sideWidth(side)) * view.sideHeight(side);
-      }
-    }
-  }
-  reservePrefaulted(table.partner, count);
-  table.partner.assign(count, InterfaceTable::unmatched);
-
-  std::vector<std::pair<std::uint64_t, long>> hashed;
-  reservePrefaulted(hashed, count);
-  for (std::size_t blockIndex = 0; blockIndex < views.size(); ++blockIndex)
-  {
-    const BlockView& view = views[blockIndex];
-    if (view.cellCount == 0)
-    {
-      continue;
-    }
-    for (int side = 0; side < 6; ++side)
-    {
-      if (view.onlySide >= 0 && view.onlySide != side)
-      {
-        continue;
-      }
-      for (int b = 0; b < view.sideHeight(side); ++b)
-      {
-        for (int a = 0; a < view.sideWidth(side); ++a)
-        {
-          P3 q[4];
-          int cellIjk[3];
-          view.sideFace(side, a, b, q, cellIjk);
-          hashed.emplace_back(
-            hashFaceCorners(q), table.index(static_cast<int>(blockIndex), side, a, b, view));
-        }
-      }
-    }
-  }
-  std::sort(hashed.begin(), hashed.end());
-
-  auto corners = [&](long index, P3(&q)[4])
-  {
-    const BoundaryFaceRef ref = table.face(index, views);
-    int cellIjk[3];
-    views[ref.block].sideFace(ref.side, ref.a, ref.b, q, cellIjk);
-  };
-  std::vector<std::array<P3, 4>> group;
-  for (std::size_t first = 0; first < hashed.size();)
-  {
-    std::size_t last = first + 1;
-    while (last < hashed.size() && hashed[last].first == hashed[first].first)
-    {
-      ++last;
-    }
-    if (last - first == 2)
-    {
-      table.partner[hashed[first].second] = hashed[first + 1].second;
-      table.partner[hashed[first + 1].second] = hashed[first].second;
-    }
-    else if (last - first > 2)
-    {
-      group.resize(last - first);
-      for (std::size_t m = 0; m < group.size(); ++m)
-      {
-        P3 q[4];
-        corners(hashed[first + m].second, q);
-        std::copy(q, q + 4, group[m].begin());
-      }
-      for (std::size_t m = 0; m < group.size(); ++m)
-      {
-        std::size_t equalCount = 0, other = m;
-        for (std::size_t n = 0; n < group.size(); ++n)
-        {
-          if (n != m && sameCorners(group[m].data(), group[n].data()))
-          {
-            ++equalCount;
-            other = n;
-          }
-        }
-        if (equalCount == 1)
-        {
-          table.partner[hashed[first + m].second] = hashed[first + other].second;
-        }
-      }
-    }
-    first = last;
-  }
-  return table;
-}
-
-/// Cells along the a and b directions of a block side.
-void sideCells(const BlockView& view, int side, int& width, int& height)
-{
-  width = view.sideWidth(side);
-  height = view.sideHeight(side);
-}
-
-/**
- * Whether the image side of `link` is its source side rotated, cell face for cell face:
- * the side sizes agree under the transform and the four corner nodes land within 1e-9
- * of the side's size.
- */
-bool linkMatches(const std::vector<BlockView>& views, const PeriodicSideLink& link)
-{
-  const int blocks = static_cast<int>(views.size());
-  if (link.sourceBlock < 0 || link.sourceBlock >= blocks || link.imageBlock < 0 ||
-    link.imageBlock >= blocks || link.sourceSide < 0 || link.sourceSide > 5 ||
-    link.imageSide < 0 || link.imageSide > 5)
-  {
-    return false;
-  }
-  const BlockView& source = views[link.sourceBlock];
-  const BlockView& image = views[link.imageBlock];
-  if (source.cellCount == 0 || image.cellCount == 0 ||
-    (source.onlySide >= 0 && source.onlySide != link.sourceSide) ||
-    (image.onlySide >= 0 && image.onlySide != link.imageSide))
-  {
-    return false;
-  }
-  int sw = 0, sh = 0, iw = 0, ih = 0;
-  sideCells(source, link.sourceSide, sw, sh);
-  sideCells(image, link.imageSide, iw, ih);
-  if ((link.transform.swap() ? ih : iw) != sw || (link.transform.swap() ? iw : ih) != sh)
-  {
-    return false;
-  }
-  // Corner nodes of the image side's cell faces at the four corners of the side.
-  const int cornerA[4] = { 0, iw - 1, iw - 1, 0 }, cornerB[4] = { 0, 0, ih - 1, ih - 1 };
-  double size = 0.0, miss = 0.0;
-  for (int n = 0; n < 4; ++n)
-  {
-    int a = 0, b = 0;
-    link.transform.map(cornerA[n], cornerB[n], sw, sh, a, b);
-    P3 q[4], r[4];
-    int ijk[3];
-    image.sideFace(link.imageSide, cornerA[n], cornerB[n], q, ijk);
-    source.sideFace(link.sourceSide, a, b, r, ijk);
-    // The face centroids (corner means) must coincide after the rotation.
-    const P3 imageMean = 0.25 * ((q[0] + q[1]) + (q[2] + q[3]));
-    const P3 sourceMean = 0.25 * ((r[0] + r[1]) + (r[2] + r[3]));
-    const Vec3 rotated = link.origin + link.rotation * (toVec3(sourceMean) - link.origin);
-    miss = std::max(miss, (rotated - toVec3(imageMean)).norm());
-    for (const P3& p : q)
-    {
-      size = std::max(size, (toVec3(p) - toVec3(imageMean)).norm());
-    }
-  }
-  return miss <= 1e-6 * size;
-}
-
-/// Pairs the faces of periodic sides (replacing what hashing found there).
-void addPeriodicLinks(InterfaceTable& table, const std::vector<BlockView>& views,
-  const std::vector<PeriodicSideLink>& links)
-{
-  if (links.empty())
-  {
-    return;
-  }
-  table.links = links;
-  table.periodic.assign(table.partner.size(), -1);
-  for (std::size_t l = 0; l < links.size(); ++l)
-  {
-    const PeriodicSideLink& link = links[l];
-    if (!linkMatches(views, link))
-    {
-      throw GeometryError("grid quality: side " + std::to_string(link.imageSide) + " of block " +
-        std::to_string(link.imageBlock) + " is not the periodic image of side " +
-        std::to_string(link.sourceSide) + " of block " + std::to_string(link.sourceBlock));
-    }
-    const BlockView& source = views[link.sourceBlock];
-    const BlockView& image = views[link.imageBlock];
-    int sw = 0, sh = 0, iw = 0, ih = 0;
-    sideCells(source, link.sourceSide, sw, sh);
-    sideCells(image, link.imageSide, iw, ih);
-    for (int b = 0; b < ih; ++b)
-    {
-      for (int a = 0; a < iw; ++a)
-      {
-        int sa = 0, sb = 0;
-        link.transform.map(a, b, sw, sh, sa, sb);
-        const long imageIndex = table.index(link.imageBlock, link.imageSide, a, b, image);
-        const long sourceIndex = table.index(link.sourceBlock, link.sourceSide, sa, sb, source);
-        table.partner[imageIndex] = sourceIndex;
-        table.partner[sourceIndex] = imageIndex;
-        table.periodic[imageIndex] = static_cast<int>(2 * l);
-        table.periodic[sourceIndex] = static_cast<int>(2 * l + 1);
-      }
-    }
-  }
-}
-
 // ---------------------------------------------------------------------------------------
 // Grid pass
 
@@ -1056,148 +629,6 @@ void finishBlock(const std::vector<BlockView>& views, int blockIndex,
   }
 }
 
-inline void loadCorners(const std::array<Vec3, 8>& corners, P3 (&c)[8])
-{
-  for (int v = 0; v < 8; ++v)
-  {
-    c[v] = toP3(corners[v]);
-  }
-}
-
-inline void loadFace(const std::array<Vec3, 4>& corners, P3 (&q)[4])
-{
-  for (int v = 0; v < 4; ++v)
-  {
-    q[v] = toP3(corners[v]);
-  }
-}
-} // namespace
-
-void hexFaceAngles(const std::array<Vec3, 8>& corners, double& minAngle, double& maxAngle)
-{
-  P3 c[8];
-  loadCorners(corners, c);
-  const CellShape shape = evaluateCellShape(c);
-  minAngle = shape.minAngle;
-  maxAngle = shape.maxAngle;
-}
-
-double hexScaledJacobian(const std::array<Vec3, 8>& corners)
-{
-  P3 c[8];
-  loadCorners(corners, c);
-  return evaluateCellShape(c).scaledJacobian;
-}
-
-double hexAspectRatio(const std::array<Vec3, 8>& corners)
-{
-  P3 c[8];
-  loadCorners(corners, c);
-  return evaluateCellShape(c).aspectRatio;
-}
-
-Vec3 hexCentre(const std::array<Vec3, 8>& corners)
-{
-  P3 c[8];
-  loadCorners(corners, c);
-  return toVec3(cellCentroid(c));
-}
-
-void quadAreaAndCentre(
-  const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Vec3& area, Vec3& centre)
-{
-  const P3 q[4] = { toP3(a), toP3(b), toP3(c), toP3(d) };
-  const FaceGeometry<double> face = scalarFace(q);
-  area = toVec3(face.area);
-  centre = toVec3(face.centre);
-}
-
-double faceNonOrthogonality(
-  const Vec3& ownerCentre, const Vec3& neighbourCentre, const Vec3& faceArea)
-{
-  return angleFromCosine(
-    orthogonalityCosine(toP3(neighbourCentre) - toP3(ownerCentre), toP3(faceArea)));
-}
-
-double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre, const Vec3& faceArea,
-  const Vec3& faceCentre)
-{
-  const P3 owner = toP3(ownerCentre);
-  const P3 d = toP3(neighbourCentre) - owner;
-  const P3 area = toP3(faceArea);
-  const P3 ownerToFace = toP3(faceCentre) - owner;
-  const P3 sv = ownerToFace - (dot(area, ownerToFace) / (dot(area, d) + rootVSmall)) * d;
-  return std::sqrt(dot(sv, sv)) / (std::sqrt(dot(d, d)) + rootVSmall);
-}
-
-double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea, const Vec3& faceCentre)
-{
-  const Vec3 normal = faceArea / (faceArea.norm() + rootVSmall);
-  const Vec3 mirrored = ownerCentre + 2.0 * normal * normal.dot(faceCentre - ownerCentre);
-  return faceSkewness(ownerCentre, mirrored, faceArea, faceCentre);
-}
-
-double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre, const Vec3& faceArea,
-  const Vec3& faceCentre, const std::array<Vec3, 4>& faceCorners)
-{
-  P3 q[4];
-  loadFace(faceCorners, q);
-  const P3 owner = toP3(ownerCentre);
-  return skewness(owner, toP3(neighbourCentre) - owner, 0.2, toP3(faceArea), toP3(faceCentre), q);
-}
-
-double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea, const Vec3& faceCentre,
-  const std::array<Vec3, 4>& faceCorners)
-{
-  P3 q[4];
-  loadFace(faceCorners, q);
-  return boundarySkewness(toP3(ownerCentre), toP3(faceArea), toP3(faceCentre), q);
-}
-
-namespace
-{
-std::vector<BlockView> blockViews(const std::vector<StructuredBlock>& blocks, double& totalCells)
-{
-  std::vector<BlockView> views;
-  views.reserve(blocks.size());
-  totalCells = 0.0;
-  for (std::size_t n = 0; n < blocks.size(); ++n)
-  {
-    const StructuredBlock& block = blocks[n];
-    if (block.ni < 0 || block.nj < 0 || block.nk < 0)
-    {
-      throw GeometryError(
-        "grid quality: block " + std::to_string(n) + " has a negative node count");
-    }
-    views.emplace_back(block);
-    if (views.back().cellCount > 0 && !block.xyz)
-    {
-      throw GeometryError("grid quality: block " + std::to_string(n) + " has no nodes");
-    }
-    totalCells += static_cast<double>(views.back().cellCount);
-  }
-  return views;
-}
-
-/// Appends the views of neighbour layers (one side each) after the measured blocks'.
-void addNeighbourViews(std::vector<BlockView>& views, const std::vector<NeighbourLayer>& neighbours)
-{
-  for (std::size_t n = 0; n < neighbours.size(); ++n)
-  {
-    const NeighbourLayer& neighbour = neighbours[n];
-    const StructuredBlock& cells = neighbour.cells;
-    const int across[3] = { cells.ni, cells.nj, cells.nk };
-    if (neighbour.side < 0 || neighbour.side > 5 || across[neighbour.side / 2] != 2 ||
-      cells.ni < 2 || cells.nj < 2 || cells.nk < 2 || !cells.xyz)
-    {
-      throw GeometryError("grid quality: neighbour layer " + std::to_string(n) +
-        " is not two node layers at a block side");
-    }
-    views.emplace_back(cells);
-    views.back().onlySide = neighbour.side;
-  }
-}
-
 /// Measures the first `measured` views; the views after them are neighbour layers.
 void evaluateBlocks(const std::vector<BlockView>& views, std::size_t measured, double totalCells,
   const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
@@ -1251,12 +682,6 @@ void computeGridQuality(const std::vector<StructuredBlock>& blocks,
   computeGridQuality(blocks, std::vector<PeriodicSideLink>(), outputs, progress);
 }
 
-bool periodicSidesMatch(const std::vector<StructuredBlock>& blocks, const PeriodicSideLink& link)
-{
-  double totalCells = 0.0;
-  return linkMatches(blockViews(blocks, totalCells), link);
-}
-
 void computeGridQuality(const std::vector<StructuredBlock>& blocks,
   const std::vector<PeriodicSideLink>& periodic, const std::vector<CellQualityPointers>& outputs,
   const std::function<void(double)>& progress)
@@ -1277,37 +702,6 @@ void computeGridQuality(const std::vector<StructuredBlock>& blocks,
   std::vector<BlockView> views = blockViews(blocks, totalCells);
   addNeighbourViews(views, neighbours);
   evaluateBlocks(views, blocks.size(), totalCells, periodic, outputs, progress);
-}
-
-StructuredBlock sideLayer(const StructuredBlock& block, int side, std::vector<double>& nodes)
-{
-  if (side < 0 || side > 5 || block.ni < 2 || block.nj < 2 || block.nk < 2 || !block.xyz)
-  {
-    throw GeometryError("grid quality: no side " + std::to_string(side) + " to take a layer of");
-  }
-  int begin[3] = { 0, 0, 0 };
-  int count[3] = { block.ni, block.nj, block.nk };
-  const int axis = side / 2;
-  begin[axis] = side % 2 == 0 ? 0 : count[axis] - 2;
-  count[axis] = 2;
-  nodes.resize(3 * static_cast<std::size_t>(count[0]) * count[1] * count[2]);
-  double* out = nodes.data();
-  for (int k = 0; k < count[2]; ++k)
-  {
-    for (int j = 0; j < count[1]; ++j)
-    {
-      const double* row = block.xyz +
-        3 * (begin[0] + static_cast<long>(block.ni) * (begin[1] + j + static_cast<long>(block.nj) * (begin[2] + k)));
-      std::copy_n(row, 3 * static_cast<std::size_t>(count[0]), out);
-      out += 3 * count[0];
-    }
-  }
-  StructuredBlock layer;
-  layer.xyz = nodes.data();
-  layer.ni = count[0];
-  layer.nj = count[1];
-  layer.nk = count[2];
-  return layer;
 }
 
 void prepareOutputMemory(void* begin, std::size_t bytes)
@@ -1338,31 +732,5 @@ void prepareOutputMemory(const std::vector<std::pair<void*, std::size_t>>& buffe
   forEachChunk(static_cast<long>(pieces.size()), [&](long piece) {
     prefault(pieces[piece].first, pieces[piece].second);
   });
-}
-
-std::array<long long, 5> minAngleClasses(const double* minAngles, std::size_t count)
-{
-  std::array<long long, 5> counts{};
-  for (std::size_t c = 0; c < count; ++c)
-  {
-    // Comparisons rather than a cast so that a NaN cannot index out of range.
-    const double angle = minAngles[c];
-    ++counts[(angle >= 20.0) + (angle >= 40.0) + (angle >= 60.0) + (angle >= 80.0)];
-  }
-  return counts;
-}
-
-std::array<long long, 5> minAngleClasses(const std::vector<CellQualityArrays>& quality)
-{
-  std::array<long long, 5> counts{};
-  for (const CellQualityArrays& block : quality)
-  {
-    const auto blockCounts = minAngleClasses(block.minAngle.data(), block.minAngle.size());
-    for (int c = 0; c < 5; ++c)
-    {
-      counts[c] += blockCounts[c];
-    }
-  }
-  return counts;
 }
 } // namespace blockforge

@@ -1,6 +1,7 @@
 /**
  * @file QualityKernels.h
- * @brief Private to Quality.cpp and its tests (not installed): the per-cell and per-face
+ * @brief Private to the quality measures (Quality.cpp, QualityInterfaces.cpp,
+ * QualityMeasures.cpp) and their tests (not installed): the per-cell and per-face
  * kernels of the quality measures, written once as templates on T = double (one cell) or
  * Lanes (several cells in SIMD lanes): lane arithmetic, cell shape (angles, scaled
  * Jacobian, aspect ratio), face area and centre, OpenFOAM's non-orthogonality and
