@@ -19,7 +19,7 @@
 // variable's range, steps up to T times the direction each way), with the lowest blocks;
 // --probe: the smallest angle after moving each variable alone a little from the result;
 // --max-skew: skew distributions (OptimizerSettings::skewDistributions) by at most this
-// (1: none, the default).
+// (default 3; 1: none).
 #include "Optimizer.h"
 
 #include "../Testing/Cxx/TestTurboInputs.h"

@@ -105,10 +105,10 @@ public:
   ///@}
 
   ///@{
-  /// On: the automatic run also skews the node distributions of block directions graded
-  /// `ends` (a blade passage's O-grid sides), so that the H lines beside a staggered blade
-  /// cross the passage at a fairer angle; off (default) keeps every distribution as the
-  /// template gives it (OptimizerSettings::skewDistributions says why).
+  /// On (default): the automatic run also skews the node distributions of block
+  /// directions graded `ends` (a blade passage's O-grid sides), so that the H lines beside
+  /// a staggered blade cross the passage at a fairer angle; off keeps every distribution
+  /// as the template gives it.
   vtkSetMacro(SkewDistributions, bool);
   vtkGetMacro(SkewDistributions, bool);
   vtkBooleanMacro(SkewDistributions, bool);
@@ -169,7 +169,7 @@ protected:
   double DensityMultiplier = 1.0;
   double MaximumMemory = 0.0;
   bool Automatic = true;
-  bool SkewDistributions = false;
+  bool SkewDistributions = true;
   std::vector<std::string> FixedControlPoints;
   std::vector<std::pair<std::string, std::string>> ControlPointMoves;
   char* HandleControlPoint = nullptr;

@@ -69,6 +69,9 @@ done
     printf '| %s, %s | %.2f s | %.2f s | %.2f s |\n' "$name" "$input" "$with" "$without" \
       "$(echo "$with - $without" | bc -l)"
   done
+  echo
+  echo "Where the smallest angles are held, what was tried and what lifts them (the skewed"
+  echo "distributions, on by default): [OPTIMIZER_LIMITS.md](OPTIMIZER_LIMITS.md)."
 } >Benchmark/OPTIMIZER.md
 cp "$work/optimizer.csv" Benchmark/optimizer.csv
 cp "$process" Benchmark/optimizer_process.csv

@@ -35,16 +35,17 @@ def corner_angle(offset):
 
 class OptimizerProxyTest(unittest.TestCase):
     def test_skew_distributions(self):
-        # Off by default: nothing to move in a model without control points.
+        # Off: nothing to move in a model without control points.
         source = BlockTemplateSource(TemplateFile=SKEW)
         optimizer = BlockOptimizer(Input=source, Tolerance=1e-12)
-        self.assertEqual(optimizer.SkewDistributions, 0)
+        self.assertEqual(optimizer.SkewDistributions, 1)
+        optimizer.SkewDistributions = 0
         optimizer.UpdatePipeline()
         model = servermanager.Fetch(optimizer)
         before = field_values(model, "MinAngleBefore")[0]
         self.assertLess(before, 85.0)
         self.assertEqual(field_values(model, "MinAngleAfter")[0], before)
-        # On: the lower block's i-direction is skewed until the shared edge's nodes lie
+        # On (the default): the lower block's i-direction is skewed until the shared edge's nodes lie
         # under the top edge's geometric ones (every element angle 90 degrees).
         optimizer.SkewDistributions = 1
         optimizer.UpdatePipeline()

@@ -42,12 +42,13 @@ struct OptimizerSettings
   /// false: only the manual moves are applied (no automatic run).
   bool automatic = true;
   /// The automatic run also skews the node distributions of block directions graded
-  /// `ends` (ControlProblem): axial_passage_oh's blade sides. Off by default until the
-  /// O-grid's edge blocks take the skewed end cells (issue 8's regrade): on today's OH
-  /// template the end cells next to the thin edge blocks make checkMesh fail face tets
-  /// and volume ratio on Rotor 37 (Benchmark/OPTIMIZER_LIMITS.md).
-  bool skewDistributions = false;
-  /// A skewed distribution's end cells change at most this many times either way.
+  /// `ends` (ControlProblem): axial_passage_oh's blade sides, which the O-grid's sides
+  /// follow (`project_from`) and its edge blocks match (`match`). OH smallest angle on the
+  /// four machines 28.5 / 22.8 / 22.7 / 29.0 -> 34.1 / 28.7 / 24.1 / 29.2 degrees
+  /// (Benchmark/OPTIMIZER_LIMITS.md).
+  bool skewDistributions = true;
+  /// A skewed distribution's end cells change at most this many times either way (2
+  /// left one more checkMesh failure on Rotor 37's OH grid, an interpolation weight).
   double maximumSkew = 3.0;
 };
 
