@@ -244,13 +244,7 @@ void joinProjectedMatchEnds(const BlockModel& model, MeshTopology& topology)
       root = topology.edges[root].projectedFrom;
     }
     const UniqueEdge& source = topology.edges[root];
-    // the source runs the same way or the other way round: its nearer ends decide (as
-    // projectEdgeParameters)
-    const Vec3& a = model.vertices[edge.a].position;
-    const Vec3& b = model.vertices[edge.b].position;
-    const Vec3& sa = model.vertices[source.a].position;
-    const Vec3& sb = model.vertices[source.b].position;
-    const bool crossed = (a - sb).norm() + (b - sa).norm() < (a - sa).norm() + (b - sb).norm();
+    const bool crossed = runsAgainst(model, edge, source);
     for (int end = 0; end < 2; ++end)
     {
       const int key = 2 * static_cast<int>(u) + end;

@@ -182,6 +182,9 @@ void buildProjections(const BlockModel& model, MeshTopology& topology);
  * join nothing.
  */
 void joinProjectedMatchEnds(const BlockModel& model, MeshTopology& topology);
+/// Whether `edge` runs against `source` (its a end nearer the source's b end): their nearer
+/// ends decide, so a projected edge takes its source's nodes in the right order.
+bool runsAgainst(const BlockModel& model, const UniqueEdge& edge, const UniqueEdge& source);
 /**
  * Node parameters of projected edge `e`: the closest points on its curve of the interior
  * nodes of the edge it projects from (whose parameters must be current), as arc-length

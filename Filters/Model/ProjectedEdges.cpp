@@ -74,6 +74,16 @@ int projectedSource(const BlockModel& model, const UniqueEdge& edge)
 }
 } // namespace
 
+bool runsAgainst(const BlockModel& model, const UniqueEdge& edge, const UniqueEdge& source)
+{
+  const Vec3& start = model.vertices[edge.a].position;
+  const Vec3& end = model.vertices[edge.b].position;
+  const Vec3& sourceStart = model.vertices[source.a].position;
+  const Vec3& sourceEnd = model.vertices[source.b].position;
+  return (start - sourceEnd).norm() + (end - sourceStart).norm() <
+    (start - sourceStart).norm() + (end - sourceEnd).norm();
+}
+
 void buildProjections(const BlockModel& model, MeshTopology& topology)
 {
   topology.projectionOrder.clear();
@@ -189,11 +199,7 @@ void projectEdgeParameters(const BlockModel& model, const std::vector<NamedCurve
   const bool curveReversed = named && model.edges[edge.named].from != edge.a;
   const CurvePtr curve = named ? named->curve : std::make_shared<LineCurve>(start, end);
   const CurveProjector projector(curve);
-  // The source runs the same way or the other way round: its nearer ends decide.
-  const Vec3& sourceStart = model.vertices[source.a].position;
-  const Vec3& sourceEnd = model.vertices[source.b].position;
-  const bool crossed = (start - sourceEnd).norm() + (end - sourceStart).norm() <
-    (start - sourceStart).norm() + (end - sourceEnd).norm();
+  const bool crossed = runsAgainst(model, edge, source);
   std::vector<double> params(n, 0.0);
   params[n - 1] = 1.0;
   for (int i = 1; i < n - 1; ++i)
