@@ -88,6 +88,9 @@ parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
+  o_shear: 0deg           # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none)
+  follow_shear: 0.5       # H lines leaving a sheared corner up- or downstream: this fraction of the way from slope_in/out to the bisector of the corner's outer angle
+  o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
   o_fan: 30               # ... where the edge block's outer chord is at most this many times its blade chord (sharper edges keep corners and feet on the tip: a fan)
   probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
@@ -183,6 +186,47 @@ def template_text():
         # H lines upstream / downstream: slope d(r theta)/d(axial distance from the O-grid)
         w(f'  slope_in_{l}: "tan(follow_le*atan2(le_uy_{l}, -le_ux_{l}))"')
         w(f'  slope_out_{l}: "tan(follow_te*atan2(te_uy_{l}, te_ux_{l}))"')
+        # The shear (o_shear): a line across the passage at a station of the blade runs from
+        # side a to the side b of the blade one pitch below. With both sides' corners at the
+        # same chordwise station it runs along the pitch, at 90 deg - stagger to the blade. Its
+        # angle to the blade's direction t near the edge (from the edge to the mid-camber
+        # point) is raised to o_shear by taking the pitch p = (p.t) t + (p.n) n as
+        # lam (p.t) t + (p.n) n, lam = |t_axial| / (|t_theta| tan(o_shear)) (< 1 only where
+        # the stagger is above 90 deg - o_shear): d_x, d_y below, in (axial, r theta). The
+        # side whose points must then lie downstream of the other's (side b at the leading
+        # edge where the blade leans +theta, side a at the trailing edge; the reverse where it
+        # leans -theta) gets its corner where the line through its partner's image, along d,
+        # meets the O curve.
+        w(f'  mc_ax_{l}: "(fm_{l}.axial + bm_{l}.axial)/2"      # mid-camber point')
+        w(f'  mc_th_{l}: "(fm_{l}.theta + bm_{l}.theta)/2"')
+        for e, (x0, y0) in (('le', (f'mc_ax_{l} - le_{l}.axial', f'rm_{l}*(mc_th_{l} - le_{l}.theta)')),
+                            ('te', (f'te_{l}.axial - mc_ax_{l}', f'rm_{l}*(te_{l}.theta - mc_th_{l})'))):
+            w(f'  {e}_tx_{l}: "({x0})/sqrt(({x0})^2 + ({y0})^2)"      # unit direction of the blade near the edge, downstream')
+            w(f'  {e}_ty_{l}: "({y0})/sqrt(({x0})^2 + ({y0})^2)"')
+            w(f'  {e}_shear_{l}: "abs({e}_ty_{l})*tan(o_shear) > abs({e}_tx_{l})"      # 1: the corners are sheared at this edge')
+            w(f'  {e}_lam_{l}: "{e}_shear_{l} ? abs({e}_tx_{l})/(abs({e}_ty_{l})*tan(o_shear)) : 1"')
+            w(f'  {e}_dx_{l}: "{e}_tx_{l}*{e}_ty_{l}*({e}_lam_{l} - 1)"      # direction of the sheared lines across the passage')
+            w(f'  {e}_dy_{l}: "{e}_lam_{l}*{e}_ty_{l}^2 + {e}_tx_{l}^2"')
+        # which corner moves: at the leading edge the side whose points go downstream
+        w(f'  sb_f_{l}: "le_shear_{l} && le_ty_{l} > 0"      # ob_f moved downstream along side b')
+        w(f'  sa_f_{l}: "le_shear_{l} && le_ty_{l} < 0"      # oa_f moved downstream along side a')
+        w(f'  sa_r_{l}: "te_shear_{l} && te_ty_{l} > 0"      # oa_r moved upstream along side a')
+        w(f'  sb_r_{l}: "te_shear_{l} && te_ty_{l} < 0"      # ob_r moved upstream along side b')
+        # the H line leaving a sheared corner up- or downstream bisects the angle there between
+        # the blade (towards the edge) and the sheared line across the passage; the other
+        # corner's keeps slope_in/out, the periodic line's takes the mean of the two
+        for e, sgn, tx, ty in (('le', '-', f'-le_tx_{l}', f'-le_ty_{l}'), ('te', '+', f'te_tx_{l}', f'te_ty_{l}')):
+            n = f'sqrt({e}_dx_{l}^2 + {e}_dy_{l}^2)'
+            for side, away in (('a', '-'), ('b', '+')):
+                bx = f'{tx} {away} {e}_dx_{l}/{n}'
+                by = f'{ty} {away} {e}_dy_{l}/{n}'
+                w(f'  {e}_bx_{side}_{l}: "{bx}"      # bisector at a sheared corner of side {side}')
+                w(f'  {e}_by_{side}_{l}: "{by}"')
+        for e, f, base in (('le', 'f', 'slope_in'), ('te', 'r', 'slope_out')):
+            sign = '-' if e == 'le' else ''
+            for side in ('a', 'b'):
+                w(f'  {base}_{side}_{l}: "s{side}_{f}_{l} ? {base}_{l} + follow_shear*({sign}{e}_by_{side}_{l}/{e}_bx_{side}_{l} - {base}_{l}) : {base}_{l}"')
+            w(f'  {base}_lo_{l}: "({base}_a_{l} + {base}_b_{l})/2"')
         # parameter gaps (in the dir sense) between consecutive O corners on the blade and the O curve
         def gap(name, a, b):
             x = f'dir_{l}*({b}_{l}.s - {a}_{l}.s)'
@@ -214,13 +258,25 @@ def template_text():
         w(f'  ole_{l}: {{project: le_{l}, onto: o_{l}}}')
         w(f'  ote_{l}: {{project: te_{l}, onto: o_{l}}}')
         # each corner is searched on its own side only: from the edge towards side a (b)
-        for v, e, side, towards in (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+')):
+        corners = (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+'))
+        for v, e, side, towards in corners:
             c = 'o_corner'
             dx = f'(cos({c})*{e}_ux_{l} {side} sin({c})*{e}_vx_{l})'
             dy = f'(cos({c})*{e}_uy_{l} {side} sin({c})*{e}_vy_{l})'
             far = f'o{e}_{l}.s {towards} dir_{l}*o_window'
+            w(f'  q{v[1:]}_{l}: {{on_curve: o_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+        # the sheared corner: where the line along the sheared direction through its partner's
+        # image one pitch across (side b's partner one pitch up, side a's one down) meets the O curve
+        for v, e, side, towards in corners:
             b = v[1:]  # the corner's foot on the blade
-            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+            partner = {'a_f': 'b_f', 'b_f': 'a_f', 'a_r': 'b_r', 'b_r': 'a_r'}[b]
+            image = '-' if b[0] == 'b' else '+'
+            far = f'o{e}_{l}.s {towards} dir_{l}*o_reach'
+            cross = f'((axial - q{partner}_{l}.axial)*{e}_dy_{l} - rm_{l}*(theta - q{partner}_{l}.theta {image} pitch)*{e}_dx_{l})^2'
+            dq = f'(x - q{b}_{l}.x)^2 + (y - q{b}_{l}.y)^2 + (z - q{b}_{l}.z)^2'
+            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{min: "s{b}_{l} ? {cross} : {dq}", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+        for v, e, side, towards in corners:
+            b = v[1:]  # the corner's foot on the blade
             # (nearest points by a search, not `project`: a search only places a helper once,
             # a projection would be redone at every step of the optimizer)
             near = lambda P: f'"(x - {P}.x)^2 + (y - {P}.y)^2 + (z - {P}.z)^2"'
@@ -246,11 +302,11 @@ def template_text():
         w(f'  hi_f_{l}: {{periodic: lo_f_{l}}}')
         w(f'  hi_r_{l}: {{periodic: lo_r_{l}}}')
         w(f'  # inlet and outlet: on the axial planes, H lines leaving the O-grid along slope_in/out')
-        for v, src in (('lo_in', 'lo_f'), ('a_in', 'oa_f'), ('b_in', 'ob_f')):
-            w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "{src}_{l}.theta + ({src}_{l}.axial - inlet_axial)*slope_in_{l}/rm_{l}"}}')
+        for v, src, k in (('lo_in', 'lo_f', 'lo'), ('a_in', 'oa_f', 'a'), ('b_in', 'ob_f', 'b')):
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "{src}_{l}.theta + ({src}_{l}.axial - inlet_axial)*slope_in_{k}_{l}/rm_{l}"}}')
         w(f'  hi_in_{l}: {{periodic: lo_in_{l}}}')
-        for v, src in (('lo_out', 'lo_r'), ('a_out', 'oa_r'), ('b_out', 'ob_r')):
-            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*slope_out_{l}/rm_{l}"}}')
+        for v, src, k in (('lo_out', 'lo_r', 'lo'), ('a_out', 'oa_r', 'a'), ('b_out', 'ob_r', 'b')):
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*slope_out_{k}_{l}/rm_{l}"}}')
         w(f'  hi_out_{l}: {{periodic: lo_out_{l}}}')
     w('')
     w('edges:')
