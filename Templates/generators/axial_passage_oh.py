@@ -89,7 +89,7 @@ parameters:
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
   o_shear: 0deg           # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none)
-  follow_shear: 0.5       # H lines leaving a sheared corner up- or downstream: this fraction of the way from slope_in/out to the bisector of the corner's outer angle
+  o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
   o_fan: 30               # ... where the edge block's outer chord is at most this many times its blade chord (sharper edges keep corners and feet on the tip: a fan)
@@ -208,25 +208,29 @@ def template_text():
             w(f'  {e}_dx_{l}: "{e}_tx_{l}*{e}_ty_{l}*({e}_lam_{l} - 1)"      # direction of the sheared lines across the passage')
             w(f'  {e}_dy_{l}: "{e}_lam_{l}*{e}_ty_{l}^2 + {e}_tx_{l}^2"')
         # which corner moves: at the leading edge the side whose points go downstream
-        w(f'  sb_f_{l}: "le_shear_{l} && le_ty_{l} > 0"      # ob_f moved downstream along side b')
-        w(f'  sa_f_{l}: "le_shear_{l} && le_ty_{l} < 0"      # oa_f moved downstream along side a')
-        w(f'  sa_r_{l}: "te_shear_{l} && te_ty_{l} > 0"      # oa_r moved upstream along side a')
-        w(f'  sb_r_{l}: "te_shear_{l} && te_ty_{l} < 0"      # ob_r moved upstream along side b')
-        # the H line leaving a sheared corner up- or downstream bisects the angle there between
-        # the blade (towards the edge) and the sheared line across the passage; the other
-        # corner's keeps slope_in/out, the periodic line's takes the mean of the two
-        for e, sgn, tx, ty in (('le', '-', f'-le_tx_{l}', f'-le_ty_{l}'), ('te', '+', f'te_tx_{l}', f'te_ty_{l}')):
-            n = f'sqrt({e}_dx_{l}^2 + {e}_dy_{l}^2)'
-            for side, away in (('a', '-'), ('b', '+')):
-                bx = f'{tx} {away} {e}_dx_{l}/{n}'
-                by = f'{ty} {away} {e}_dy_{l}/{n}'
-                w(f'  {e}_bx_{side}_{l}: "{bx}"      # bisector at a sheared corner of side {side}')
-                w(f'  {e}_by_{side}_{l}: "{by}"')
-        for e, f, base in (('le', 'f', 'slope_in'), ('te', 'r', 'slope_out')):
-            sign = '-' if e == 'le' else ''
-            for side in ('a', 'b'):
-                w(f'  {base}_{side}_{l}: "s{side}_{f}_{l} ? {base}_{l} + follow_shear*({sign}{e}_by_{side}_{l}/{e}_bx_{side}_{l} - {base}_{l}) : {base}_{l}"')
-            w(f'  {base}_lo_{l}: "({base}_a_{l} + {base}_b_{l})/2"')
+        # only at a round edge: where the O curve's arc between the o_corner points is at most
+        # o_fan times the blade's arc between their feet (a sharp edge's edge block is a fan on
+        # its tip, which a corner moved along one side would fold)
+        for e, (a, b) in (('le', ('a_f', 'b_f')), ('te', ('a_r', 'b_r'))):
+            outer = f'sqrt((h{a}_{l}.axial - h{b}_{l}.axial)^2 + (rm_{l}*(h{a}_{l}.theta - h{b}_{l}.theta))^2)'
+            inner = f'sqrt((g{a}_{l}.axial - g{b}_{l}.axial)^2 + (rm_{l}*(g{a}_{l}.theta - g{b}_{l}.theta))^2)'
+            w(f'  round_{e}_{l}: "{outer} <= o_fan*{inner}"')
+        w(f'  sb_f_{l}: "le_shear_{l} && round_le_{l} && le_ty_{l} > 0"      # ob_f moved downstream along side b')
+        w(f'  sa_f_{l}: "le_shear_{l} && round_le_{l} && le_ty_{l} < 0"      # oa_f moved downstream along side a')
+        w(f'  sa_r_{l}: "te_shear_{l} && round_te_{l} && te_ty_{l} > 0"      # oa_r moved upstream along side a')
+        w(f'  sb_r_{l}: "te_shear_{l} && round_te_{l} && te_ty_{l} < 0"      # ob_r moved upstream along side b')
+        # At a sheared edge the unsheared corner sits o_lean_shear from the edge (its normal
+        # leaning that far from the camber direction), and every H line up- or downstream
+        # leaves along the bisector of the O curve's directions towards the edge at the two
+        # corners (at the unsheared one: towards w_le/w_te, probe along the O curve): the
+        # block round the edge (U_M, D_M) gets about half their angle at each.
+        for e, f, ta, ua, base, sign in (('le', 'f', '-', 'sb_f', 'slope_in', '-'), ('te', 'r', '+', 'sb_r', 'slope_out', '')):
+            U = lambda q: f'({ua}_{l} ? oa_{f}_{l}.{q} : ob_{f}_{l}.{q})'   # the unsheared corner
+            x0 = f'(w{e}_{l}.axial - {U("axial")})'
+            y0 = f'rm_{l}*(w{e}_{l}.theta - {U("theta")})'
+            w(f'  {e}_bx_{l}: "{x0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_tx_{l}"      # bisector at a sheared edge')
+            w(f'  {e}_by_{l}: "{y0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_ty_{l}"')
+            w(f'  {base}_x_{l}: "{e}_shear_{l} && round_{e}_{l} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
         # parameter gaps (in the dir sense) between consecutive O corners on the blade and the O curve
         def gap(name, a, b):
             x = f'dir_{l}*({b}_{l}.s - {a}_{l}.s)'
@@ -259,17 +263,24 @@ def template_text():
         w(f'  ote_{l}: {{project: te_{l}, onto: o_{l}}}')
         # each corner is searched on its own side only: from the edge towards side a (b)
         corners = (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+'))
-        for v, e, side, towards in corners:
-            c = 'o_corner'
-            dx = f'(cos({c})*{e}_ux_{l} {side} sin({c})*{e}_vx_{l})'
-            dy = f'(cos({c})*{e}_uy_{l} {side} sin({c})*{e}_vy_{l})'
-            far = f'o{e}_{l}.s {towards} dir_{l}*o_window'
-            w(f'  q{v[1:]}_{l}: {{on_curve: o_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+        partners = {'a_f': 'b_f', 'b_f': 'a_f', 'a_r': 'b_r', 'b_r': 'a_r'}
+        near = lambda P: f'"(x - {P}.x)^2 + (y - {P}.y)^2 + (z - {P}.z)^2"'
+        for pass_ in ('h', 'q'):
+            # h: the o_corner points and (g) their feet, for round_le/te; q: the corners before the
+            # shear (at a sheared edge the unsheared one leans o_lean_shear)
+            for v, e, side, towards in corners:
+                c = 'o_corner' if pass_ == 'h' else f'(s{partners[v[1:]]}_{l} ? o_lean_shear : o_corner)'
+                dx = f'(cos({c})*{e}_ux_{l} {side} sin({c})*{e}_vx_{l})'
+                dy = f'(cos({c})*{e}_uy_{l} {side} sin({c})*{e}_vy_{l})'
+                far = f'o{e}_{l}.s {towards} dir_{l}*o_window'
+                w(f'  {pass_}{v[1:]}_{l}: {{on_curve: o_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+                if pass_ == 'h':
+                    w(f'  g{v[1:]}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"h{v[1:]}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
         # the sheared corner: where the line along the sheared direction through its partner's
         # image one pitch across (side b's partner one pitch up, side a's one down) meets the O curve
         for v, e, side, towards in corners:
             b = v[1:]  # the corner's foot on the blade
-            partner = {'a_f': 'b_f', 'b_f': 'a_f', 'a_r': 'b_r', 'b_r': 'a_r'}[b]
+            partner = partners[b]
             image = '-' if b[0] == 'b' else '+'
             far = f'o{e}_{l}.s {towards} dir_{l}*o_reach'
             cross = f'((axial - q{partner}_{l}.axial)*{e}_dy_{l} - rm_{l}*(theta - q{partner}_{l}.theta {image} pitch)*{e}_dx_{l})^2'
@@ -292,6 +303,9 @@ def template_text():
             dc = f'(x - c{b}_{l}.x)^2 + (y - c{b}_{l}.y)^2 + (z - c{b}_{l}.z)^2'
             w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {dr} : {dc}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
             w(f'  {b}_{l}: {{project: {v}_{l}, onto: blade_{l}}}')
+        # a step along the O curve from the unsheared corner of a sheared edge towards the edge
+        w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*probe : ob_f_{l}.s + dir_{l}*probe", fixed: true}}')
+        w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*probe : ob_r_{l}.s - dir_{l}*probe", fixed: true}}')
         w(f'  a_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s + dir_{l}*side_a_{l}/2"}}')
         w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
         w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')
@@ -302,11 +316,11 @@ def template_text():
         w(f'  hi_f_{l}: {{periodic: lo_f_{l}}}')
         w(f'  hi_r_{l}: {{periodic: lo_r_{l}}}')
         w(f'  # inlet and outlet: on the axial planes, H lines leaving the O-grid along slope_in/out')
-        for v, src, k in (('lo_in', 'lo_f', 'lo'), ('a_in', 'oa_f', 'a'), ('b_in', 'ob_f', 'b')):
-            w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "{src}_{l}.theta + ({src}_{l}.axial - inlet_axial)*slope_in_{k}_{l}/rm_{l}"}}')
+        for v, src in (('lo_in', 'lo_f'), ('a_in', 'oa_f'), ('b_in', 'ob_f')):
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "{src}_{l}.theta + ({src}_{l}.axial - inlet_axial)*slope_in_x_{l}/rm_{l}"}}')
         w(f'  hi_in_{l}: {{periodic: lo_in_{l}}}')
-        for v, src, k in (('lo_out', 'lo_r', 'lo'), ('a_out', 'oa_r', 'a'), ('b_out', 'ob_r', 'b')):
-            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*slope_out_{k}_{l}/rm_{l}"}}')
+        for v, src in (('lo_out', 'lo_r'), ('a_out', 'oa_r'), ('b_out', 'ob_r')):
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*slope_out_x_{l}/rm_{l}"}}')
         w(f'  hi_out_{l}: {{periodic: lo_out_{l}}}')
     w('')
     w('edges:')
