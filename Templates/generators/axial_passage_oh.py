@@ -215,10 +215,12 @@ def template_text():
             outer = f'sqrt((h{a}_{l}.axial - h{b}_{l}.axial)^2 + (rm_{l}*(h{a}_{l}.theta - h{b}_{l}.theta))^2)'
             inner = f'sqrt((g{a}_{l}.axial - g{b}_{l}.axial)^2 + (rm_{l}*(g{a}_{l}.theta - g{b}_{l}.theta))^2)'
             w(f'  round_{e}_{l}: "{outer} <= o_fan*{inner}"')
-        w(f'  sb_f_{l}: "le_shear_{l} && round_le_{l} && le_ty_{l} > 0"      # ob_f moved downstream along side b')
-        w(f'  sa_f_{l}: "le_shear_{l} && round_le_{l} && le_ty_{l} < 0"      # oa_f moved downstream along side a')
-        w(f'  sa_r_{l}: "te_shear_{l} && round_te_{l} && te_ty_{l} > 0"      # oa_r moved upstream along side a')
-        w(f'  sb_r_{l}: "te_shear_{l} && round_te_{l} && te_ty_{l} < 0"      # ob_r moved upstream along side b')
+        # an edge is sheared on both layers or on none (a corner moved on one layer only would
+        # twist the edge block between hub and shroud): shear_le/te below
+        w(f'  sb_f_{l}: "shear_le && le_ty_{l} > 0"      # ob_f moved downstream along side b')
+        w(f'  sa_f_{l}: "shear_le && le_ty_{l} < 0"      # oa_f moved downstream along side a')
+        w(f'  sa_r_{l}: "shear_te && te_ty_{l} > 0"      # oa_r moved upstream along side a')
+        w(f'  sb_r_{l}: "shear_te && te_ty_{l} < 0"      # ob_r moved upstream along side b')
         # At a sheared edge the unsheared corner sits o_lean_shear from the edge (its normal
         # leaning that far from the camber direction), and every H line up- or downstream
         # leaves along the bisector of the O curve's directions towards the edge at the two
@@ -230,13 +232,15 @@ def template_text():
             y0 = f'rm_{l}*(w{e}_{l}.theta - {U("theta")})'
             w(f'  {e}_bx_{l}: "{x0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_tx_{l}"      # bisector at a sheared edge')
             w(f'  {e}_by_{l}: "{y0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_ty_{l}"')
-            w(f'  {base}_x_{l}: "{e}_shear_{l} && round_{e}_{l} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
+            w(f'  {base}_x_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
         # parameter gaps (in the dir sense) between consecutive O corners on the blade and the O curve
         def gap(name, a, b):
             x = f'dir_{l}*({b}_{l}.s - {a}_{l}.s)'
             w(f'  {name}_{l}: "{x} - rint({x} - 0.5)"')
         gap('gap_le', 'b_f', 'a_f'); gap('gap_a', 'a_f', 'a_r'); gap('gap_te', 'a_r', 'b_r'); gap('gap_b', 'b_r', 'b_f')
         gap('ogap_le', 'ob_f', 'oa_f'); gap('ogap_a', 'oa_f', 'oa_r'); gap('ogap_te', 'oa_r', 'ob_r'); gap('ogap_b', 'ob_r', 'ob_f')
+    for e in ('le', 'te'):
+        w(f'  shear_{e}: "({e}_shear_h || {e}_shear_s) && round_{e}_h && round_{e}_s && {e}_ty_h*{e}_ty_s > 0"      # 1: the corners at this edge are sheared (both layers)')
     w('')
     w('carriers:')
     w('  hub: {revolve: hub, axis: machine, extend: extend}')
