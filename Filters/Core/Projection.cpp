@@ -50,9 +50,11 @@ public:
     }
     else
     {
-      jet.P = TheCurve.point(t);
-      jet.D1 = TheCurve.derivative(t, 1);
-      jet.D2 = TheCurve.derivative(t, 2);
+      Vec3 values[3];
+      TheCurve.jet(t, values);
+      jet.P = values[0];
+      jet.D1 = values[1];
+      jet.D2 = values[2];
     }
   }
 
