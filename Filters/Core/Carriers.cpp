@@ -269,12 +269,7 @@ public:
   {
   }
 
-  Vec3 point(double s) const override
-  {
-    const Vec3 v = Contour->point(s) - AxisPoint;
-    const double axial = Axis.dot(v);
-    return Vec3(axial, (v - axial * Axis).norm(), 0.0);
-  }
+  Vec3 point(double s) const override { return meridionalPoint(Contour->point(s)); }
 
   Vec3 derivative(double s, int order = 1) const override
   {
@@ -296,13 +291,22 @@ public:
   /// point and both): the same bits as point(), derivative(s, 1) and derivative(s, 2).
   void jet(double s, Vec3 out[3]) const override
   {
-    out[0] = point(s);
     Vec3 c[3];
     contourJet(s, 2, c);
+    // A B-spline's derivatives() gives its point() bit for bit (basisDerivatives), so the point
+    // comes from the same evaluation.
+    out[0] = Spline ? meridionalPoint(c[0]) : point(s);
     meridionalDerivatives(c, 2, out + 1);
   }
 
 private:
+  Vec3 meridionalPoint(const Vec3& contourPoint) const
+  {
+    const Vec3 v = contourPoint - AxisPoint;
+    const double axial = Axis.dot(v);
+    return Vec3(axial, (v - axial * Axis).norm(), 0.0);
+  }
+
   void contourJet(double s, int order, Vec3 c[3]) const
   {
     if (Spline)
