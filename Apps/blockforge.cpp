@@ -5,7 +5,7 @@
  * writes the grid in a solver format, without Python or VTK (start-up in milliseconds):
  *
  *   blockforge TEMPLATE [-i POINTS] [-p NAME=EXPR ...] [-d DENSITY] [-m GB] -o OUTPUT [--ascii]
- *              [--no-optimize]
+ *              [--no-optimize] [--objective NAME]
  *
  * OUTPUT's extension picks the writer: DIR/NAME.foam (OpenFOAM case: DIR/constant/polyMesh
  * and an empty NAME.foam), NAME.xyz (Plot3D multiblock), NAME.cgns (CGNS). `python3 -m
@@ -40,7 +40,7 @@ namespace
 {
 const char* const Usage =
   "usage: blockforge TEMPLATE [-i POINTS] [-p NAME=EXPR ...] [-d DENSITY] [-m GB] -o OUTPUT\n"
-  "                  [--ascii] [--no-optimize]\n"
+  "                  [--ascii] [--no-optimize] [--objective NAME]\n"
   "\n"
   "Applies a BlockForge template (to the point data of -i: a BladeGen .inf, an Info.txt or a\n"
   "point file), optimizes its control points (the BlockOptimizer with its defaults, as\n"
@@ -59,6 +59,9 @@ const char* const Usage =
   "  -o, --output FILE       grid to write\n"
   "  --ascii                 ASCII instead of binary where the format has both\n"
   "  --no-optimize           keep the control points where the template put them\n"
+  "  --objective NAME        what the optimizer improves: min-angle (default, the\n"
+  "                          smallest element angle), non-orthogonality (OpenFOAM's\n"
+  "                          largest) or min-angle-and-size-ratio\n"
   "The grid is written under a temporary name and moved into place: a failure leaves no\n"
   "partial grid and keeps an older one. Exit status 1 with a message on any error.\n";
 
@@ -70,6 +73,7 @@ struct Arguments
   double maximumMemory = 0.0; ///< GB, 0: what the machine has available
   bool ascii = false;
   bool optimize = true;
+  optimize::ObjectiveKind objective = optimize::ObjectiveKind::MinAngle;
 };
 
 bool endsWith(const std::string& text, const std::string& suffix)
@@ -135,6 +139,19 @@ Arguments parse(int argc, char** argv)
       args.ascii = true;
     else if (arg == "--no-optimize")
       args.optimize = false;
+    else if (arg == "--objective")
+    {
+      const std::string name = value();
+      if (name == "min-angle")
+        args.objective = optimize::ObjectiveKind::MinAngle;
+      else if (name == "non-orthogonality")
+        args.objective = optimize::ObjectiveKind::NonOrthogonality;
+      else if (name == "min-angle-and-size-ratio")
+        args.objective = optimize::ObjectiveKind::MinAngleAndSizeRatio;
+      else
+        throw std::invalid_argument("--objective must be min-angle, non-orthogonality or "
+                                    "min-angle-and-size-ratio, got '" + name + "'");
+    }
     else if (!arg.empty() && arg[0] == '-')
       throw std::invalid_argument("unknown option " + arg);
     else if (args.templateFile.empty())
@@ -248,6 +265,7 @@ int main(int argc, char** argv)
       optimize::OptimizerSettings settings;
       settings.densityMultiplier = args.density;
       settings.maximumMemory = args.maximumMemory;
+      settings.objective.kind = args.objective;
       const optimize::OptimizerResult result = optimize::optimizeModel(model, carriers, settings);
       model = result.model;
       char line[256];

@@ -89,9 +89,13 @@ def _path_argument(path):
         return os.fsencode(path)
 
 
+# The optimizer's objectives by their command-line names (vtkBlockOptimizer::Objective).
+OBJECTIVES = {"min-angle": 0, "non-orthogonality": 1, "min-angle-and-size-ratio": 2}
+
+
 def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_file=None,
                   timings=None, allow_inverted_cells=False, warnings=None,
-                  maximum_memory=0.0, optimize=True):
+                  maximum_memory=0.0, optimize=True, objective="min-angle"):
     """:func:`mesh_template`; with a dict *timings*, also records the seconds of each
     stage under "read" (only with an input file), "template", "optimize" (unless
     *optimize* is false) and "mesh + quality"; with a list *warnings*, collects the stages'
@@ -124,6 +128,7 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
         # refuse for memory is refused before the optimizer works on it.
         optimizer.SetDensityMultiplier(float(density_multiplier))
         optimizer.SetMaximumMemory(float(maximum_memory))
+        optimizer.SetObjective(OBJECTIVES[objective])
         optimizer.SetInputConnection(template.GetOutputPort())
         stages.append(("optimize", optimizer))
         model = optimizer
@@ -169,7 +174,8 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
 
 
 def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None,
-                  allow_inverted_cells=False, maximum_memory=0.0, optimize=True):
+                  allow_inverted_cells=False, maximum_memory=0.0, optimize=True,
+                  objective="min-angle"):
     """Applies a template, optimizes its control points, meshes it and measures the grid.
 
     Without *input_file* the pipeline is vtkBlockTemplateSource -> vtkBlockOptimizer ->
@@ -194,6 +200,9 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
     :param optimize: True (default): the vtkBlockOptimizer moves the control points along
         their carriers to maximise the smallest element angle (paper step 3); False: the
         template's vertices are meshed as placed
+    :param objective: what the optimizer improves (a key of :data:`OBJECTIVES`):
+        "min-angle" (default, the smallest element angle), "non-orthogonality" (OpenFOAM's
+        largest non-orthogonality) or "min-angle-and-size-ratio"
     :returns: the vtkGridQuality algorithm after its update (port 0: the grid with the
         quality arrays; port 1: MinAngle class table; port 2: statistics table)
     :raises RuntimeError: when a stage (reader, template, mesher or quality) reports an
@@ -203,4 +212,5 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
     """
     return _run_pipeline(template_file, parameters, density_multiplier, input_file,
                          allow_inverted_cells=allow_inverted_cells,
-                         maximum_memory=maximum_memory, optimize=optimize)
+                         maximum_memory=maximum_memory, optimize=optimize,
+                         objective=objective)

@@ -1,5 +1,6 @@
 """Command line: ``python3 -m blockforge TEMPLATE [-i POINTS] [-o grid.vtm] [-p NAME=EXPR ...]
-[-d DENSITY] [-m GB] [--ascii] [--compress] [--allow-inverted-cells] [--no-optimize]``.
+[-d DENSITY] [-m GB] [--ascii] [--compress] [--allow-inverted-cells] [--no-optimize]
+[--objective NAME]``.
 
 Applies a template (to the point data of -i, read by the TurboPointSetsReader, for a
 template with inputs), optimizes its control points (the BlockOptimizer; --no-optimize
@@ -112,6 +113,9 @@ def main(argv=None):
     parser.add_argument("--allow-inverted-cells", action="store_true",
                         help="output a grid with inverted cells anyway, for inspection "
                              "(default: an error naming the block and the cell range)")
+    parser.add_argument("--objective", choices=sorted(blockforge.OBJECTIVES), default="min-angle",
+                        help="what the optimizer improves (default min-angle: the smallest "
+                             "element angle; non-orthogonality: OpenFOAM's largest)")
     parser.add_argument("--no-optimize", action="store_true",
                         help="mesh the template's vertices as placed (default: the "
                              "BlockOptimizer moves the control points first)")
@@ -129,7 +133,8 @@ def main(argv=None):
         quality = blockforge._run_pipeline(args.template, dict(args.parameter), args.density,
                                            args.input, timings, args.allow_inverted_cells,
                                            warnings, args.max_memory,
-                                           optimize=not args.no_optimize)
+                                           optimize=not args.no_optimize,
+                                           objective=args.objective)
     except (RuntimeError, MemoryError) as error:
         print(f"error: {printable(error) if str(error) else 'out of memory'}", file=sys.stderr)
         return 1

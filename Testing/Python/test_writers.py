@@ -321,6 +321,34 @@ class NativeCommandLineTest(unittest.TestCase):
                                     os.path.join(folder, "no_optimize/native/grid.nmf"),
                                     shallow=False))
 
+    def test_objective_non_orthogonality(self):
+        """--objective non-orthogonality: both command lines write the same bytes, and the
+        grid's largest non-orthogonality is lower than with the default objective (the
+        smallest angle), which raises it on the distributor's O-grid."""
+        folder = bftest.output_path("objective")
+        shutil.rmtree(folder, ignore_errors=True)
+        arguments = [AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "n_span=8"]
+        largest = {}
+        for objective in ("min-angle", "non-orthogonality"):
+            for label, command in (("python", [sys.executable, "-m", "blockforge"]),
+                                   ("native", [CLI])):
+                run = subprocess.run(command + arguments + ["--objective", objective, "-o",
+                                     os.path.join(folder, objective, label, "grid.xyz")],
+                                     capture_output=True, text=True)
+                self.assertEqual(run.returncode, 0, run.stderr)
+                if label == "python":
+                    line = next(l for l in run.stdout.splitlines()
+                                if l.strip().startswith("NonOrthogonality"))
+                    largest[objective] = float(line.split()[-1])
+            self.assertTrue(filecmp.cmp(os.path.join(folder, objective, "python", "grid.xyz"),
+                                        os.path.join(folder, objective, "native", "grid.xyz"),
+                                        shallow=False), objective)
+        self.assertLess(largest["non-orthogonality"], largest["min-angle"] - 5.0, largest)
+        run = subprocess.run([CLI, CYLINDER, "--objective", "smoothness", "-o", "x.foam"],
+                             capture_output=True, text=True)
+        self.assertEqual(run.returncode, 2)
+        self.assertIn("--objective must be", run.stderr)
+
     def test_errors_name_the_problem(self):
         run = subprocess.run([CLI, os.path.join(SOURCE, "Testing", "Data", "bad_syntax.yaml"),
                               "-o", bftest.output_path("bad/x.foam")], capture_output=True, text=True)
