@@ -88,7 +88,7 @@ parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
-  o_shear: 0deg           # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none)
+  o_shear: 45deg          # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none)
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
@@ -310,8 +310,12 @@ def template_text():
         # a step along the O curve from the unsheared corner of a sheared edge towards the edge
         w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*probe : ob_f_{l}.s + dir_{l}*probe", fixed: true}}')
         w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*probe : ob_r_{l}.s - dir_{l}*probe", fixed: true}}')
-        w(f'  a_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s + dir_{l}*side_a_{l}/2"}}')
-        w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
+        # the sides' mid-points (where the periodic line's middle point lo_m looks across): half-way
+        # along each side, between the corners' feet where the corners are sheared
+        ga = f'dir_{l}*(fa_r_{l}.s - fa_f_{l}.s)'
+        gb = f'dir_{l}*(fb_f_{l}.s - fb_r_{l}.s)'
+        w(f'  a_m_{l}: {{on_curve: blade_{l}, at: "shear_le || shear_te ? fa_f_{l}.s + dir_{l}*({ga} - rint({ga} - 0.5))/2 : le_{l}.s + dir_{l}*side_a_{l}/2"}}')
+        w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "shear_le || shear_te ? fb_r_{l}.s + dir_{l}*({gb} - rint({gb} - 0.5))/2 : le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
         w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')
         w(f'  ob_m_{l}: {{project: b_m_{l}, onto: o_{l}}}')
         w(f'  # mid-passage points between side a and the side b of the blade one pitch below')

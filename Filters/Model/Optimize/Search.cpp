@@ -112,7 +112,8 @@ struct SearchState
  * Compass search (Torczon's coordinate pattern search): each variable in turn tries a step
  * up and down (the direction that last succeeded first); a step that lowers the objective
  * is taken and grows by half, one that does not halves. Stops when every step is below
- * 1e-7 of its range, or when a pass that took steps gained less than `tolerance`.
+ * 1e-7 of its range, when a pass that took steps gained less than `tolerance`, or when a
+ * pass ending after `stallAfter` trials gained less than `stallGain`.
  * A trial `mayGain` rules out is counted as a failed one without being evaluated.
  */
 void compassSearch(SearchState& state, const std::vector<double>& start,
@@ -196,6 +197,12 @@ void compassSearch(SearchState& state, const std::vector<double>& start,
     if (moved && passStart - value < settings.tolerance)
     {
       result.stopReason = "objective tolerance reached";
+      return;
+    }
+    if (state.trials >= settings.stallAfter && passStart - value < settings.stallGain)
+    {
+      result.stopReason = "a pass after " + std::to_string(settings.stallAfter) +
+        " trials gained less than " + std::to_string(settings.stallGain);
       return;
     }
   }

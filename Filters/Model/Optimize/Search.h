@@ -33,7 +33,16 @@ struct SearchSettings
   /// BOBYQA, with evaluations about 5 times cheaper (README, "The optimizer").
   SearchAlgorithm algorithm = SearchAlgorithm::Compass;
   /// Evaluations at most (compass: trials, evaluated or left out by a TrialFilter).
-  int maxEvaluations = 400;
+  /// 700: on axial_passage_oh with sheared O corners the compass search still gains
+  /// 1-2 degrees per 100 trials after 400 (Rotor 37 reaches 40 degrees after about 580
+  /// trials, the distributor after about 540; Benchmark/OPTIMIZER_LIMITS.md, section 7).
+  int maxEvaluations = 700;
+  /// Compass: once this many trials are done, a pass that gains less than stallGain
+  /// (degrees for the angle objectives) ends the search, so cases that have stopped
+  /// gaining do not spend the whole budget (the compressor's OH grid gains about 0.1
+  /// degree per pass by then). Passes before it stop only on `tolerance`.
+  int stallAfter = 400;
+  double stallGain = 0.2;
   /// Stop when a step changes the objective by less than this (degrees for the angle
   /// objectives) or moves every variable by less than 1e-9 of its range.
   double tolerance = 1.0e-3;
