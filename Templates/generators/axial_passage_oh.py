@@ -59,6 +59,23 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   downstream the H lines leave the O-grid along the camber direction at the edges
 #   (follow_le, follow_te: 1 = the blade angle, 0 = axial) to the inlet and outlet planes;
 #   on staggered blades much below 0.5 folds cells where they meet the O-grid.
+# - Shear (o_shear): a line across the passage beside the blade runs from side a's node j to
+#   side b's node j of the blade one pitch below; with both sides' corners at one chordwise
+#   station it runs along the pitch, at 90 deg - stagger to the blade (28 deg at Rotor 37's
+#   shroud). Where the stagger near an edge (from the edge to the mid-camber point) is above
+#   90 deg - o_shear on hub or shroud, that edge's corners are sheared on both layers: the
+#   side whose nodes must lie downstream of the other's (side b at the leading edge of a
+#   blade leaning +theta, side a at its trailing edge; the reverse leaning -theta) gets its
+#   corner where the line through its partner's image one pitch across, at o_shear to the
+#   blade, meets the O curve (within o_reach of the edge); the partner sits o_lean_shear
+#   from the edge; the mid-passage points follow (lo_f/lo_r half-way across, lo_m between
+#   the sides' mid-points), and the H lines up- or downstream of a sheared edge all leave
+#   along the bisector of the O curve's directions towards the edge at its two corners.
+#   Only at round edges (round_le/te: the O arc between the o_corner points at most o_fan
+#   times the blade arc between their feet): the edge block of a sharp edge is a fan on its
+#   tip, which a corner moved along one side folds. The distributor's trailing edge and
+#   Rotor 37's edges are sheared; the compressor (sharp) and the turbine (stagger below
+#   45 deg) are not.
 # - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
