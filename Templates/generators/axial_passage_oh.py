@@ -228,10 +228,9 @@ def template_text():
         # only at a round edge: where the O curve's arc between the o_corner points is at most
         # o_fan times the blade's arc between their feet (a sharp edge's edge block is a fan on
         # its tip, which a corner moved along one side would fold)
-        for e, (a, b) in (('le', ('a_f', 'b_f')), ('te', ('a_r', 'b_r'))):
-            outer = f'sqrt((h{a}_{l}.axial - h{b}_{l}.axial)^2 + (rm_{l}*(h{a}_{l}.theta - h{b}_{l}.theta))^2)'
-            inner = f'sqrt((g{a}_{l}.axial - g{b}_{l}.axial)^2 + (rm_{l}*(g{a}_{l}.theta - g{b}_{l}.theta))^2)'
-            w(f'  round_{e}_{l}: "{outer} <= o_fan*{inner}"')
+        span = lambda p, q: f'sqrt(({p}.axial - {q}.axial)^2 + (rm_{l}*({p}.theta - {q}.theta))^2)'
+        for e, a, b in (('le', 'a_f', 'b_f'), ('te', 'a_r', 'b_r')):
+            w(f'  round_{e}_{l}: "{span(f"h{a}_{l}", f"h{b}_{l}")} <= o_fan*{span(f"g{a}_{l}", f"g{b}_{l}")}"')
         # an edge is sheared on both layers or on none (a corner moved on one layer only would
         # twist the edge block between hub and shroud): shear_le/te below
         w(f'  sb_f_{l}: "shear_le && le_ty_{l} > 0"      # ob_f moved downstream along side b')
