@@ -186,9 +186,14 @@ const model::TemplateInputs& rotor37Inputs()
   return inputs;
 }
 
+/// Templates/axial_passage_oh.yaml, or the template named by BLOCKFORGE_BENCH_TEMPLATE
+/// (an older revision of it, to compare what a template change costs).
 const std::string& templatePath()
 {
-  static const std::string path = Source + "/Templates/axial_passage_oh.yaml";
+  static const std::string path = [] {
+    const char* chosen = std::getenv("BLOCKFORGE_BENCH_TEMPLATE");
+    return chosen && *chosen ? std::string(chosen) : Source + "/Templates/axial_passage_oh.yaml";
+  }();
   return path;
 }
 

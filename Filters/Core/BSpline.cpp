@@ -436,6 +436,10 @@ void basisDerivatives(int span, double t, int degree, int order,
   {
     basisDerivativesOf<3, 1>(span, t, degree, order, knots, ders); // arc lengths, tangents
   }
+  else if (degree == 3 && order == 2)
+  {
+    basisDerivativesOf<3, 2>(span, t, degree, order, knots, ders); // projections' Newton steps
+  }
   else if (degree == 3)
   {
     basisDerivativesOf<3>(span, t, degree, order, knots, ders);

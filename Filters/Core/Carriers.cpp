@@ -269,12 +269,7 @@ public:
   {
   }
 
-  Vec3 point(double s) const override
-  {
-    const Vec3 v = Contour->point(s) - AxisPoint;
-    const double axial = Axis.dot(v);
-    return Vec3(axial, (v - axial * Axis).norm(), 0.0);
-  }
+  Vec3 point(double s) const override { return meridionalPoint(Contour->point(s)); }
 
   Vec3 derivative(double s, int order = 1) const override
   {
@@ -286,7 +281,34 @@ public:
     {
       return Vec3::Zero();
     }
+    Vec3 c[3], d[2];
+    contourJet(s, order, c);
+    meridionalDerivatives(c, order, d);
+    return d[order - 1];
+  }
+
+  /// One contour evaluation for both derivatives (a projection's Newton step needs the
+  /// point and both): the same bits as point(), derivative(s, 1) and derivative(s, 2).
+  void jet(double s, Vec3 out[3]) const override
+  {
     Vec3 c[3];
+    contourJet(s, 2, c);
+    // A B-spline's derivatives() gives its point() bit for bit (basisDerivatives), so the point
+    // comes from the same evaluation.
+    out[0] = Spline ? meridionalPoint(c[0]) : point(s);
+    meridionalDerivatives(c, 2, out + 1);
+  }
+
+private:
+  Vec3 meridionalPoint(const Vec3& contourPoint) const
+  {
+    const Vec3 v = contourPoint - AxisPoint;
+    const double axial = Axis.dot(v);
+    return Vec3(axial, (v - axial * Axis).norm(), 0.0);
+  }
+
+  void contourJet(double s, int order, Vec3 c[3]) const
+  {
     if (Spline)
     {
       Spline->derivatives(s, 2, c);
@@ -297,6 +319,11 @@ public:
       c[1] = Contour->derivative(s, 1);
       c[2] = order == 2 ? Contour->derivative(s, 2) : Vec3::Zero();
     }
+  }
+
+  /// (axial, radius, 0)' and, for order 2, '' from the contour's jet c.
+  void meridionalDerivatives(const Vec3 c[3], int order, Vec3 d[2]) const
+  {
     const Vec3 v = c[0] - AxisPoint;
     const Vec3 w = v - Axis.dot(v) * Axis; // radial vector
     const double r = w.norm();
@@ -304,18 +331,18 @@ public:
     const Vec3 w1 = c[1] - axial1 * Axis;
     // r = |w|: r' = w.w'/r. On the axis (r = 0) the one-sided limit |w'| is used.
     const double r1 = r > 0.0 ? w.dot(w1) / r : w1.norm();
-    if (order == 1)
+    d[0] = Vec3(axial1, r1, 0.0);
+    if (order < 2)
     {
-      return Vec3(axial1, r1, 0.0);
+      return;
     }
     const double axial2 = Axis.dot(c[2]);
     const Vec3 w2 = c[2] - axial2 * Axis;
     // From r r' = w.w': r'^2 + r r'' = w'.w' + w.w''.
     const double r2 = r > 0.0 ? (w1.squaredNorm() + w.dot(w2) - r1 * r1) / r : 0.0;
-    return Vec3(axial2, r2, 0.0);
+    d[1] = Vec3(axial2, r2, 0.0);
   }
 
-private:
   CurvePtr Contour;
   const BSplineCurve* Spline;
   Vec3 AxisPoint, Axis;

@@ -25,6 +25,17 @@ public:
   virtual ~Curve() = default;
   virtual Vec3 point(double t) const = 0;
   virtual Vec3 derivative(double t, int order = 1) const = 0;
+  /**
+   * point(t), derivative(t, 1) and derivative(t, 2) into out[0..2], the same bits as the
+   * three calls. Curves whose derivatives share their work (one basis evaluation gives
+   * both) override it: a Newton step of a projection needs all three.
+   */
+  virtual void jet(double t, Vec3 out[3]) const
+  {
+    out[0] = point(t);
+    out[1] = derivative(t, 1);
+    out[2] = derivative(t, 2);
+  }
 };
 
 using CurvePtr = std::shared_ptr<const Curve>;

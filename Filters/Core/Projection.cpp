@@ -50,9 +50,11 @@ public:
     }
     else
     {
-      jet.P = TheCurve.point(t);
-      jet.D1 = TheCurve.derivative(t, 1);
-      jet.D2 = TheCurve.derivative(t, 2);
+      Vec3 values[3];
+      TheCurve.jet(t, values);
+      jet.P = values[0];
+      jet.D1 = values[1];
+      jet.D2 = values[2];
     }
   }
 
@@ -328,6 +330,24 @@ CurveProjector::CurveProjector(CurvePtr curve, int samples)
   {
     SamplePoints[i] = TheCurve->point(SampleT[i]);
   }
+  SampleX.resize(samples);
+  SampleY.resize(samples);
+  SampleZ.resize(samples);
+  Spacing.assign(samples, 0.0);
+  for (int i = 0; i < samples; ++i)
+  {
+    SampleX[i] = SamplePoints[i].x();
+    SampleY[i] = SamplePoints[i].y();
+    SampleZ[i] = SamplePoints[i].z();
+    if (i > 0)
+    {
+      Spacing[i] = std::max(Spacing[i], (SamplePoints[i] - SamplePoints[i - 1]).norm());
+    }
+    if (i + 1 < samples)
+    {
+      Spacing[i] = std::max(Spacing[i], (SamplePoints[i + 1] - SamplePoints[i]).norm());
+    }
+  }
 }
 
 CurveProjection CurveProjector::project(const Vec3& p, double tolerance) const
@@ -340,12 +360,16 @@ CurveProjection CurveProjector::project(const Vec3& p, double tolerance) const
   // exceeds the best sampled distance cannot contain the closest point.
   thread_local std::vector<double> distances;
   distances.resize(n);
-  double best = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < n; ++i)
+  // (sample - p).norm() written out: the same operations in the same order, the same
+  // bits, as a loop the compiler vectorises (most of a projection's time otherwise).
   {
-    distances[i] = (SamplePoints[i] - p).norm();
-    best = std::min(best, distances[i]);
+    using Column = Eigen::Map<const Eigen::ArrayXd>;
+    const Column x(SampleX.data(), n), y(SampleY.data(), n), z(SampleZ.data(), n);
+    Eigen::Map<Eigen::ArrayXd> out(distances.data(), n);
+    out = ((x - p.x()).square() + (y - p.y()).square() + (z - p.z()).square()).sqrt();
   }
+  // The smallest (finite, non-negative distances: any order gives the same value).
+  const double best = Eigen::Map<const Eigen::ArrayXd>(distances.data(), n).minCoeff();
   CandidateList candidates;
   for (int i = 0; i < n; ++i)
   {
@@ -354,16 +378,7 @@ CurveProjection CurveProjector::project(const Vec3& p, double tolerance) const
     {
       continue;
     }
-    double spacing = 0.0;
-    if (i > 0)
-    {
-      spacing = std::max(spacing, (SamplePoints[i] - SamplePoints[i - 1]).norm());
-    }
-    if (i + 1 < n)
-    {
-      spacing = std::max(spacing, (SamplePoints[i + 1] - SamplePoints[i]).norm());
-    }
-    if (d - spacing <= best)
+    if (d - Spacing[i] <= best)
     {
       candidates.offer({ d, i });
     }

@@ -40,6 +40,10 @@ private:
   CurvePtr TheCurve;
   std::vector<double> SampleT;
   std::vector<Vec3> SamplePoints;
+  /// The samples' coordinates one array each (the distance scan runs as a vector loop,
+  /// the same operations as (sample - p).norm()), and each sample's largest distance to a
+  /// neighbour.
+  std::vector<double> SampleX, SampleY, SampleZ, Spacing;
 };
 
 /**

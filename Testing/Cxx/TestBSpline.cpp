@@ -190,6 +190,35 @@ TEST(BSplineCurve, InterpolationPassesThroughEveryPoint)
   }
 }
 
+TEST(BSplineCurve, DerivativesGivePointAndLowerOrdersBitForBit)
+{
+  // Projections take the point and both derivatives from one derivatives(t, 2) call
+  // (Curve::jet); the grids keep their bits only if that point is point(t) and the first
+  // derivative is derivative(t, 1), at the ends and at knots too.
+  const std::vector<Vec3> points = helixPoints(23);
+  for (int degree = 1; degree <= 5; ++degree)
+  {
+    const BSplineCurve curve = BSplineCurve::interpolate(points, degree, ParameterMethod::ChordLength);
+    std::vector<double> at = curve.dataParameters();
+    for (int i = 0; i <= 997; ++i)
+    {
+      at.push_back(i / 997.0);
+    }
+    for (const double t : at)
+    {
+      Vec3 jet[3];
+      curve.derivatives(t, 2, jet);
+      EXPECT_EQ(jet[0], curve.point(t)) << "degree " << degree << " t " << t;
+      EXPECT_EQ(jet[1], curve.derivative(t, 1)) << "degree " << degree << " t " << t;
+      Vec3 generic[3];
+      curve.Curve::jet(t, generic);
+      EXPECT_EQ(generic[0], jet[0]);
+      EXPECT_EQ(generic[1], jet[1]);
+      EXPECT_EQ(generic[2], jet[2]);
+    }
+  }
+}
+
 TEST(BSplineCurve, DegreeLoweredForFewPoints)
 {
   const std::vector<Vec3> points = { Vec3(0, 0, 0), Vec3(1, 1, 0), Vec3(2, 0, 1) };
