@@ -475,7 +475,8 @@ double crossingAngleAtLeadingEdge(const BlockModel& model, const std::string& la
 TEST(PassageTemplates, AxialPassageOHShearedCorners)
 {
   const TemplateInputs inputs = readTemplateInputs(dataSets()[0].inf);
-  const BlockModel sheared = loadTemplate(templatePath("axial_passage_oh"), {}, &inputs);
+  const BlockModel sheared =
+    loadTemplate(templatePath("axial_passage_oh"), { { "o_shear", "45deg" } }, &inputs);
   const BlockModel plain =
     loadTemplate(templatePath("axial_passage_oh"), { { "o_shear", "0" } }, &inputs);
   std::printf("SHEAR Rotor 37 leading edge: crossing at %.2f (hub) %.2f (shroud) deg, "

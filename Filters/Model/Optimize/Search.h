@@ -33,10 +33,10 @@ struct SearchSettings
   /// BOBYQA, with evaluations about 5 times cheaper (README, "The optimizer").
   SearchAlgorithm algorithm = SearchAlgorithm::Compass;
   /// Evaluations at most (compass: trials, evaluated or left out by a TrialFilter).
-  /// 700: on axial_passage_oh with sheared O corners the compass search still gains
-  /// 1-2 degrees per 100 trials after 400 (Rotor 37 reaches 40 degrees after about 580
+  /// With axial_passage_oh's sheared O corners (o_shear) give 700: the compass search still
+  /// gains 1-2 degrees per 100 trials after 400 (Rotor 37 reaches 40 degrees after about 580
   /// trials, the distributor after about 540; Benchmark/OPTIMIZER_LIMITS.md, section 7).
-  int maxEvaluations = 700;
+  int maxEvaluations = 400;
   /// Compass: at this many trials the search goes on only when its last complete pass
   /// gained at least stallGain (degrees for the angle objectives), and then until a pass
   /// gains less: a case that has stopped gaining ends where a budget of stallAfter
