@@ -7,7 +7,7 @@
 //   same search (NLopt BOBYQA) maximising the smooth minimum of those blocks' corner
 //   angles, then the real grid measured.
 // Not a test (nothing asserts a time). Prints a Markdown table.
-// Usage: bench_optimizer [--repetitions N] [--evaluations N] [--sharpness K] [--step F]
+// Usage: bench_optimizer [--repetitions N] [--evaluations N] [--sharpness K] [--step F] [--tolerance T] [--stall-gain G]
 //          [--algorithm bobyqa|cobyla|subplex] [--blocks] [--timing] [--csv FILE]
 //          [--history FILE] [--no-baselines] [--objective NAME] [--size-weight W]
 //          [--scan name:weight,... T] [--probe] [--max-skew S] template.yaml input.inf [...]
@@ -410,6 +410,14 @@ int main(int argc, char** argv)
     else if (arg == "--step" && a + 1 < argc)
     {
       settings.search.initialStep = std::atof(argv[++a]);
+    }
+    else if (arg == "--tolerance" && a + 1 < argc)
+    {
+      settings.search.tolerance = std::atof(argv[++a]);
+    }
+    else if (arg == "--stall-gain" && a + 1 < argc)
+    {
+      settings.search.stallGain = std::atof(argv[++a]);
     }
     else if (arg == "--algorithm" && a + 1 < argc)
     {

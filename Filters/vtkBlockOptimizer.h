@@ -68,7 +68,7 @@ public:
   ///@}
 
   ///@{
-  /// Largest number of grid evaluations of the automatic run (default 400); the compass
+  /// Largest number of grid evaluations of the automatic run (default 400; 700 for axial_passage_oh with o_shear 45deg); the compass
   /// search counts the trials it leaves out because they cannot gain as evaluations.
   vtkSetClampMacro(MaximumEvaluations, int, 1, 1000000);
   vtkGetMacro(MaximumEvaluations, int);

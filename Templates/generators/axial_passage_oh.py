@@ -59,6 +59,23 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   downstream the H lines leave the O-grid along the camber direction at the edges
 #   (follow_le, follow_te: 1 = the blade angle, 0 = axial) to the inlet and outlet planes;
 #   on staggered blades much below 0.5 folds cells where they meet the O-grid.
+# - Shear (o_shear): a line across the passage beside the blade runs from side a's node j to
+#   side b's node j of the blade one pitch below; with both sides' corners at one chordwise
+#   station it runs along the pitch, at 90 deg - stagger to the blade (28 deg at Rotor 37's
+#   shroud). Where the stagger near an edge (from the edge to the mid-camber point) is above
+#   90 deg - o_shear on hub or shroud, that edge's corners are sheared on both layers: the
+#   side whose nodes must lie downstream of the other's (side b at the leading edge of a
+#   blade leaning +theta, side a at its trailing edge; the reverse leaning -theta) gets its
+#   corner where the line through its partner's image one pitch across, at o_shear to the
+#   blade, meets the O curve (within o_reach of the edge); the partner sits o_lean_shear
+#   from the edge; the mid-passage points follow (lo_f/lo_r half-way across, lo_m between
+#   the sides' mid-points), and the H lines up- or downstream of a sheared edge all leave
+#   along the bisector of the O curve's directions towards the edge at its two corners.
+#   Only at round edges (round_le/te: the O arc between the o_corner points at most o_fan
+#   times the blade arc between their feet): the edge block of a sharp edge is a fan on its
+#   tip, which a corner moved along one side folds. Off by default (o_shear 0); at 45deg the distributor's trailing edge and
+#   Rotor 37's edges are sheared; the compressor (sharp) and the turbine (stagger below
+#   45 deg) are not.
 # - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
@@ -88,7 +105,7 @@ parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
-  o_shear: 0deg           # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none)
+  o_shear: 0deg           # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg lifts the optimized distributor and Rotor 37 above 40 deg with 700 optimizer trials)
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
@@ -211,10 +228,9 @@ def template_text():
         # only at a round edge: where the O curve's arc between the o_corner points is at most
         # o_fan times the blade's arc between their feet (a sharp edge's edge block is a fan on
         # its tip, which a corner moved along one side would fold)
-        for e, (a, b) in (('le', ('a_f', 'b_f')), ('te', ('a_r', 'b_r'))):
-            outer = f'sqrt((h{a}_{l}.axial - h{b}_{l}.axial)^2 + (rm_{l}*(h{a}_{l}.theta - h{b}_{l}.theta))^2)'
-            inner = f'sqrt((g{a}_{l}.axial - g{b}_{l}.axial)^2 + (rm_{l}*(g{a}_{l}.theta - g{b}_{l}.theta))^2)'
-            w(f'  round_{e}_{l}: "{outer} <= o_fan*{inner}"')
+        span = lambda p, q: f'sqrt(({p}.axial - {q}.axial)^2 + (rm_{l}*({p}.theta - {q}.theta))^2)'
+        for e, a, b in (('le', 'a_f', 'b_f'), ('te', 'a_r', 'b_r')):
+            w(f'  round_{e}_{l}: "{span(f"h{a}_{l}", f"h{b}_{l}")} <= o_fan*{span(f"g{a}_{l}", f"g{b}_{l}")}"')
         # an edge is sheared on both layers or on none (a corner moved on one layer only would
         # twist the edge block between hub and shroud): shear_le/te below
         w(f'  sb_f_{l}: "shear_le && le_ty_{l} > 0"      # ob_f moved downstream along side b')
@@ -310,8 +326,12 @@ def template_text():
         # a step along the O curve from the unsheared corner of a sheared edge towards the edge
         w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*probe : ob_f_{l}.s + dir_{l}*probe", fixed: true}}')
         w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*probe : ob_r_{l}.s - dir_{l}*probe", fixed: true}}')
-        w(f'  a_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s + dir_{l}*side_a_{l}/2"}}')
-        w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
+        # the sides' mid-points (where the periodic line's middle point lo_m looks across): half-way
+        # along each side, between the corners' feet where the corners are sheared
+        ga = f'dir_{l}*(fa_r_{l}.s - fa_f_{l}.s)'
+        gb = f'dir_{l}*(fb_f_{l}.s - fb_r_{l}.s)'
+        w(f'  a_m_{l}: {{on_curve: blade_{l}, at: "shear_le || shear_te ? fa_f_{l}.s + dir_{l}*({ga} - rint({ga} - 0.5))/2 : le_{l}.s + dir_{l}*side_a_{l}/2"}}')
+        w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "shear_le || shear_te ? fb_r_{l}.s + dir_{l}*({gb} - rint({gb} - 0.5))/2 : le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
         w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')
         w(f'  ob_m_{l}: {{project: b_m_{l}, onto: o_{l}}}')
         w(f'  # mid-passage points between side a and the side b of the blade one pitch below')

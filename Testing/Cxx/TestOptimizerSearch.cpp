@@ -348,3 +348,42 @@ TEST(GridObjective, ActiveBlocksAreThoseInTheSmoothMinimumsWindow)
   const GridMeasures without = measureGrid({ a.block(), c.block() }, {}, ObjectiveSettings{});
   EXPECT_EQ(without.objective, m.objective);
 }
+
+TEST(Search, StallRuleAtStallAfter)
+{
+  // A climb that gains `rate` per unit of the sum of ten variables (no optimum within
+  // reach): slow, the search stops at stallAfter trials exactly as a budget of stallAfter
+  // does (the same history, bit for bit); fast, it goes on to the evaluation limit.
+  auto run = [](double rate, int maxEvaluations, int stallAfter) {
+    SearchSettings settings;
+    settings.tolerance = 0.0;
+    settings.initialStep = 1.0e-6;
+    settings.maxEvaluations = maxEvaluations;
+    settings.stallAfter = stallAfter;
+    settings.stallGain = 1.0;
+    const std::vector<double> start(10, 0.0), low(10, 0.0), high(10, 1.0);
+    return search(start, low, high, ObjectiveKind::MinAngle,
+      [rate](const std::vector<double>& x) {
+        GridMeasures m;
+        m.feasible = true;
+        m.objective = 0.0;
+        for (double value : x)
+        {
+          m.objective -= rate * value;
+        }
+        m.minAngle = -m.objective;
+        return m;
+      },
+      settings);
+  };
+  const SearchResult slow = run(1.0, 100, 20), budget = run(1.0, 20, 1000);
+  ASSERT_EQ(slow.history.size(), budget.history.size());
+  EXPECT_EQ(slow.evaluations, 20);
+  for (std::size_t i = 0; i < slow.history.size(); ++i)
+  {
+    EXPECT_EQ(slow.history[i].objective, budget.history[i].objective);
+  }
+  EXPECT_EQ(slow.best, budget.best);
+  const SearchResult fast = run(1.0e7, 100, 20);
+  EXPECT_EQ(fast.evaluations, 100);
+}

@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <set>
@@ -434,4 +435,56 @@ TEST(PassageTemplates, ShortContoursInletAndOutletAtTheirEndsOrExtended)
   // Long contours: nothing to say.
   const TemplateInputs rotor = readTemplateInputs(dataSets()[0].inf);
   EXPECT_TRUE(loadTemplate(templatePath("axial_passage_oh"), {}, &rotor).notes.empty());
+}
+
+namespace
+{
+/// The angle (degrees) between the lines oa_f -> lo_f (across the passage from side a's
+/// leading-edge O corner to the mid-passage point) and le -> mid-camber point (the blade
+/// near its leading edge), in the unrolled (axial, r theta) plane of a layer (_h, _s).
+double crossingAngleAtLeadingEdge(const BlockModel& model, const std::string& layer)
+{
+  auto position = [&](const std::string& name) {
+    for (const auto& vertex : model.vertices)
+      if (vertex.name == name + layer)
+        return vertex.position;
+    ADD_FAILURE() << "no vertex " << name + layer;
+    return Vec3(0, 0, 0);
+  };
+  const Vec3 axis = model.machine.axis.normalized(), origin = model.machine.axisPoint;
+  const Vec3 le = position("le");
+  const Vec3 reference = (le - origin) - axis.dot(le - origin) * axis;
+  const double rm = reference.norm();
+  auto unrolled = [&](const Vec3& p) {
+    const Vec3 radial = (p - origin) - axis.dot(p - origin) * axis;
+    const double theta = std::atan2(axis.dot(reference.cross(radial)), reference.dot(radial));
+    return Eigen::Vector2d(axis.dot(p - origin), rm * theta);
+  };
+  const Eigen::Vector2d chord =
+    0.5 * (unrolled(position("fm")) + unrolled(position("bm"))) - unrolled(le);
+  const Eigen::Vector2d crossing = unrolled(position("lo_f")) - unrolled(position("oa_f"));
+  const double cosine = std::abs(chord.dot(crossing)) / (chord.norm() * crossing.norm());
+  return std::acos(std::min(1.0, cosine)) * 180.0 / M_PI;
+}
+} // namespace
+
+// Sheared O corners (o_shear): at Rotor 37's leading edge (stagger 62 degrees at the shroud,
+// 48 at the hub) the line across the passage from side a's corner meets the blade at
+// o_shear (45.0 degrees at hub and shroud when written) instead of
+// about 90 - stagger: without the shear (o_shear 0) 36.8 at the hub, 24.4 at the shroud.
+TEST(PassageTemplates, AxialPassageOHShearedCorners)
+{
+  const TemplateInputs inputs = readTemplateInputs(dataSets()[0].inf);
+  const BlockModel sheared =
+    loadTemplate(templatePath("axial_passage_oh"), { { "o_shear", "45deg" } }, &inputs);
+  const BlockModel plain =
+    loadTemplate(templatePath("axial_passage_oh"), { { "o_shear", "0" } }, &inputs);
+  std::printf("SHEAR Rotor 37 leading edge: crossing at %.2f (hub) %.2f (shroud) deg, "
+              "without the shear %.2f %.2f\n",
+    crossingAngleAtLeadingEdge(sheared, "_h"), crossingAngleAtLeadingEdge(sheared, "_s"),
+    crossingAngleAtLeadingEdge(plain, "_h"), crossingAngleAtLeadingEdge(plain, "_s"));
+  EXPECT_NEAR(crossingAngleAtLeadingEdge(sheared, "_s"), 45.0, 0.5);
+  EXPECT_NEAR(crossingAngleAtLeadingEdge(sheared, "_h"), 45.0, 0.5);
+  EXPECT_LT(crossingAngleAtLeadingEdge(plain, "_s"), 30.0);
+  EXPECT_GT(crossingAngleAtLeadingEdge(sheared, "_s"), crossingAngleAtLeadingEdge(plain, "_s") + 8.0);
 }

@@ -3,6 +3,7 @@
 #include <nlopt.hpp>
 
 #include <algorithm>
+#include <limits>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -112,7 +113,9 @@ struct SearchState
  * Compass search (Torczon's coordinate pattern search): each variable in turn tries a step
  * up and down (the direction that last succeeded first); a step that lowers the objective
  * is taken and grows by half, one that does not halves. Stops when every step is below
- * 1e-7 of its range, or when a pass that took steps gained less than `tolerance`.
+ * 1e-7 of its range, when a pass that took steps gained less than `tolerance`, at
+ * `stallAfter` trials when the last complete pass gained less than `stallGain`, and after
+ * that at the end of a pass that gained less than `stallGain`.
  * A trial `mayGain` rules out is counted as a failed one without being evaluated.
  */
 void compassSearch(SearchState& state, const std::vector<double>& start,
@@ -138,6 +141,10 @@ void compassSearch(SearchState& state, const std::vector<double>& start,
     }
     return largest;
   };
+  // The gain of the last complete pass decides at stallAfter trials whether the search
+  // goes on (a run that stops there is the run of a budget of stallAfter, bit for bit).
+  double lastPassGain = std::numeric_limits<double>::infinity();
+  bool extended = false;
   while (true)
   {
     const double passStart = value;
@@ -155,6 +162,16 @@ void compassSearch(SearchState& state, const std::vector<double>& start,
         {
           result.stopReason = "evaluation limit reached";
           return;
+        }
+        if (!extended && state.trials >= settings.stallAfter)
+        {
+          if (lastPassGain < settings.stallGain)
+          {
+            result.stopReason = "the last pass before " + std::to_string(settings.stallAfter) +
+              " trials gained little";
+            return;
+          }
+          extended = true;
         }
         std::vector<double> y = x;
         y[i] = std::min(high[i], std::max(low[i], x[i] + sign * step[i]));
@@ -196,6 +213,13 @@ void compassSearch(SearchState& state, const std::vector<double>& start,
     if (moved && passStart - value < settings.tolerance)
     {
       result.stopReason = "objective tolerance reached";
+      return;
+    }
+    lastPassGain = passStart - value;
+    if (extended && lastPassGain < settings.stallGain)
+    {
+      result.stopReason = "a pass after " + std::to_string(settings.stallAfter) +
+        " trials gained little";
       return;
     }
   }

@@ -33,7 +33,17 @@ struct SearchSettings
   /// BOBYQA, with evaluations about 5 times cheaper (README, "The optimizer").
   SearchAlgorithm algorithm = SearchAlgorithm::Compass;
   /// Evaluations at most (compass: trials, evaluated or left out by a TrialFilter).
+  /// With axial_passage_oh's sheared O corners (o_shear) give 700: the compass search still
+  /// gains 1-2 degrees per 100 trials after 400 (Rotor 37 reaches 40 degrees after about 580
+  /// trials, the distributor after about 540; Benchmark/OPTIMIZER_LIMITS.md, section 7).
   int maxEvaluations = 400;
+  /// Compass: at this many trials the search goes on only when its last complete pass
+  /// gained at least stallGain (degrees for the angle objectives), and then until a pass
+  /// gains less: a case that has stopped gaining ends where a budget of stallAfter
+  /// (the budget before the sheared O-grid) ended it, bit for bit, while the sheared
+  /// axial_passage_oh, still gaining 1-3 degrees a pass, goes on.
+  int stallAfter = 400;
+  double stallGain = 1.0;
   /// Stop when a step changes the objective by less than this (degrees for the angle
   /// objectives) or moves every variable by less than 1e-9 of its range.
   double tolerance = 1.0e-3;
