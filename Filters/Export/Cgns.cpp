@@ -4,6 +4,7 @@
 
 #include <cgnslib.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -30,6 +31,7 @@ class CgnsFile
 public:
   CgnsFile(const std::string& staging, const std::string& target)
     : Target(target)
+    , Staging(staging)
   {
     check(cg_set_file_type(CG_FILE_HDF5));
     check(cg_open(staging.c_str(), CG_MODE_WRITE, &Number));
@@ -46,7 +48,11 @@ public:
   {
     if (status != CG_OK)
     {
-      throw std::runtime_error("could not write " + Target + ": " + cg_get_error());
+      // HDF5 says only that a write failed: add why (a full disk, the file-size limit).
+      const int error = errno;
+      const std::string why = writeFailureReason(Staging, error);
+      throw std::runtime_error("could not write " + Target + ": " + cg_get_error() +
+        (why.empty() ? std::string() : " (" + why + ")"));
     }
   }
   void close()
@@ -57,7 +63,7 @@ public:
   int number() const { return Number; }
 
 private:
-  std::string Target;
+  std::string Target, Staging;
   int Number = -1;
   bool Open = false;
 };

@@ -10,7 +10,9 @@
 #include <dirent.h>
 #include <fcntl.h>
 #include <stdio.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 namespace blockforge
@@ -355,6 +357,27 @@ void removeTree(const std::string& path)
     return;
   }
   ::unlink(path.c_str());
+}
+std::string writeFailureReason(const std::string& path, int error)
+{
+  struct statvfs space;
+  if (::statvfs(folderOf(path).c_str(), &space) == 0 && space.f_bavail == 0)
+  {
+    return reason(ENOSPC);
+  }
+  struct rlimit limit;
+  struct stat status;
+  if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
+    ::stat(path.c_str(), &status) == 0 &&
+    static_cast<unsigned long long>(status.st_size) >= limit.rlim_cur)
+  {
+    return reason(EFBIG);
+  }
+  if (error == ENOSPC || error == EFBIG || error == EDQUOT || error == EIO || error == EROFS)
+  {
+    return reason(error);
+  }
+  return std::string();
 }
 } // namespace exporting
 } // namespace blockforge

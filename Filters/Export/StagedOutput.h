@@ -132,5 +132,13 @@ void removeStaleStaging(const std::string& target);
 void makeDirectories(const std::string& path);
 /// Removes a file or a directory tree; errors are ignored.
 void removeTree(const std::string& path);
+
+/**
+ * Why writing `path` most likely failed when a library reported only that it failed
+ * (HDF5 under CGNS): "No space left on device" when its file system has no block left for
+ * the user, "File too large" when the file reached the process's file-size limit; else
+ * the text of `error` (errno as the library left it) when that is a write error, else "".
+ */
+std::string writeFailureReason(const std::string& path, int error);
 } // namespace exporting
 } // namespace blockforge

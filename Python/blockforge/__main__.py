@@ -1,5 +1,5 @@
 """Command line: ``python3 -m blockforge TEMPLATE [-i POINTS] [-o grid.vtm] [-p NAME=EXPR ...]
-[-d DENSITY] [-m GB] [--allow-inverted-cells] [--no-optimize]``.
+[-d DENSITY] [-m GB] [--ascii] [--compress] [--allow-inverted-cells] [--no-optimize]``.
 
 Applies a template (to the point data of -i, read by the TurboPointSetsReader, for a
 template with inputs), optimizes its control points (the BlockOptimizer; --no-optimize
@@ -79,12 +79,12 @@ def summary_lines(quality):
     return lines
 
 
-def write_grid(data_object, path):
+def write_grid(data_object, path, compress=False):
     """Writes *data_object* (a vtkMultiBlockDataSet) as the .vtm *path* plus a fresh folder
     of its pieces beside it, checked after writing and published with one rename
     (:func:`blockforge.output.write_vtm`); the older grid at *path* stays whole until then.
     :raises RuntimeError: when writing fails or what was written is incomplete."""
-    blockforge.output.write_vtm(data_object, path)
+    blockforge.output.write_vtm(data_object, path, compress)
 
 
 def main(argv=None):
@@ -98,6 +98,9 @@ def main(argv=None):
                         "(OpenFOAM case)")
     parser.add_argument("--ascii", action="store_true",
                         help="ASCII instead of binary where the format has both")
+    parser.add_argument("--compress", action="store_true",
+                        help=".vtm: compress the pieces (zlib; smaller, several times slower "
+                             "to write; default: raw binary)")
     parser.add_argument("-p", "--parameter", action="append", type=_parse_parameter,
                         default=[], metavar="NAME=EXPR", help="override a template parameter")
     parser.add_argument("-d", "--density", type=float, default=1.0,
@@ -147,7 +150,7 @@ def main(argv=None):
                 writers.write_solver_grid(quality.GetOutputDataObject(0), args.output,
                                           binary=not args.ascii)
             else:
-                write_grid(quality.GetOutputDataObject(0), args.output)
+                write_grid(quality.GetOutputDataObject(0), args.output, args.compress)
         except (RuntimeError, OSError, ValueError) as error:
             print(f"error: {printable(error)}", file=sys.stderr)
             return 1

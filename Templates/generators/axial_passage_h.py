@@ -67,6 +67,7 @@ parameters:
   n_down: 8               # cells from trailing edge to outlet (fewer where the outlet is nearer than asked)
   n_pitch: 8              # cells across each half pitch
   n_span: 12              # cells from hub to shroud
+  span_wall: 0.5          # hub and shroud cells' height relative to the mean spanwise cell (law ends; 1: uniform): end-wall layers, and wall cells whose internal faces span three directions where a blade side meets the trailing-edge line at an acute angle (turbine)
   k_match: 1.2            # largest growth ratio of the cells along the axis and across the pitch, whose end cells match their neighbours' (law match)
   lean: 75deg             # blade sides: the first cell at a leading or trailing edge leans at most this much from the side's chord (a round edge is left across the pitch: its cell is lengthened, and the cells continuing it too)
 
@@ -95,14 +96,14 @@ carriers:
 """
 
 FOOTER = """blocks:
-  UL: {vertices: [lo_in_h, mi_h, le_h, lo_le_h, lo_in_s, mi_s, le_s, lo_le_s], cells: [n_pitch, cells_up, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
-  UR: {vertices: [mi_h, hi_in_h, hi_le_h, le_h, mi_s, hi_in_s, hi_le_s, le_s], cells: [n_pitch, cells_up, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
-  BL: {vertices: [lo_le_h, le_h, a_mid_h, lo_mid_h, lo_le_s, le_s, a_mid_s, lo_mid_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}}}
-  BR: {vertices: [le_h, hi_le_h, hi_mid_h, b_mid_h, le_s, hi_le_s, hi_mid_s, b_mid_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}}}
-  AL: {vertices: [lo_mid_h, a_mid_h, te_h, lo_te_h, lo_mid_s, a_mid_s, te_s, lo_te_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}}}
-  AR: {vertices: [b_mid_h, hi_mid_h, hi_te_h, te_h, b_mid_s, hi_mid_s, hi_te_s, te_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}}}
-  DL: {vertices: [lo_te_h, te_h, mo_h, lo_out_h, lo_te_s, te_s, mo_s, lo_out_s], cells: [n_pitch, cells_down, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
-  DR: {vertices: [te_h, hi_te_h, hi_out_h, mo_h, te_s, hi_te_s, hi_out_s, mo_s], cells: [n_pitch, cells_down, n_span], grading: {i: {match: k_match}, j: {match: k_match}}}
+  UL: {vertices: [lo_in_h, mi_h, le_h, lo_le_h, lo_in_s, mi_s, le_s, lo_le_s], cells: [n_pitch, cells_up, n_span], grading: {i: {match: k_match}, j: {match: k_match}, k: {ends: [span_wall, span_wall]}}}
+  UR: {vertices: [mi_h, hi_in_h, hi_le_h, le_h, mi_s, hi_in_s, hi_le_s, le_s], cells: [n_pitch, cells_up, n_span], grading: {i: {match: k_match}, j: {match: k_match}, k: {ends: [span_wall, span_wall]}}}
+  BL: {vertices: [lo_le_h, le_h, a_mid_h, lo_mid_h, lo_le_s, le_s, a_mid_s, lo_mid_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}, k: {ends: [span_wall, span_wall]}}}
+  BR: {vertices: [le_h, hi_le_h, hi_mid_h, b_mid_h, le_s, hi_le_s, hi_mid_s, b_mid_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}, k: {ends: [span_wall, span_wall]}}}
+  AL: {vertices: [lo_mid_h, a_mid_h, te_h, lo_te_h, lo_mid_s, a_mid_s, te_s, lo_te_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}, k: {ends: [span_wall, span_wall]}}}
+  AR: {vertices: [b_mid_h, hi_mid_h, hi_te_h, te_h, b_mid_s, hi_mid_s, hi_te_s, te_s], cells: [n_pitch, n_chord, n_span], grading: {i: {match: k_match}, j: {match: k_match, lean: lean}, k: {ends: [span_wall, span_wall]}}}
+  DL: {vertices: [lo_te_h, te_h, mo_h, lo_out_h, lo_te_s, te_s, mo_s, lo_out_s], cells: [n_pitch, cells_down, n_span], grading: {i: {match: k_match}, j: {match: k_match}, k: {ends: [span_wall, span_wall]}}}
+  DR: {vertices: [te_h, hi_te_h, hi_out_h, mo_h, te_s, hi_te_s, hi_out_s, mo_s], cells: [n_pitch, cells_down, n_span], grading: {i: {match: k_match}, j: {match: k_match}, k: {ends: [span_wall, span_wall]}}}
 
 faces:
   hub_faces: {on_surface: hub, faces: [UL.k0, UR.k0, BL.k0, BR.k0, AL.k0, AR.k0, DL.k0, DR.k0]}

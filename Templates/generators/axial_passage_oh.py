@@ -88,6 +88,9 @@ parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
+  o_shear: 0deg           # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none)
+  o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
+  o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
   o_fan: 30               # ... where the edge block's outer chord is at most this many times its blade chord (sharper edges keep corners and feet on the tip: a fan)
   probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
@@ -183,12 +186,61 @@ def template_text():
         # H lines upstream / downstream: slope d(r theta)/d(axial distance from the O-grid)
         w(f'  slope_in_{l}: "tan(follow_le*atan2(le_uy_{l}, -le_ux_{l}))"')
         w(f'  slope_out_{l}: "tan(follow_te*atan2(te_uy_{l}, te_ux_{l}))"')
+        # The shear (o_shear): a line across the passage at a station of the blade runs from
+        # side a to the side b of the blade one pitch below. With both sides' corners at the
+        # same chordwise station it runs along the pitch, at 90 deg - stagger to the blade. Its
+        # angle to the blade's direction t near the edge (from the edge to the mid-camber
+        # point) is raised to o_shear by taking the pitch p = (p.t) t + (p.n) n as
+        # lam (p.t) t + (p.n) n, lam = |t_axial| / (|t_theta| tan(o_shear)) (< 1 only where
+        # the stagger is above 90 deg - o_shear): d_x, d_y below, in (axial, r theta). The
+        # side whose points must then lie downstream of the other's (side b at the leading
+        # edge where the blade leans +theta, side a at the trailing edge; the reverse where it
+        # leans -theta) gets its corner where the line through its partner's image, along d,
+        # meets the O curve.
+        w(f'  mc_ax_{l}: "(fm_{l}.axial + bm_{l}.axial)/2"      # mid-camber point')
+        w(f'  mc_th_{l}: "(fm_{l}.theta + bm_{l}.theta)/2"')
+        for e, (x0, y0) in (('le', (f'mc_ax_{l} - le_{l}.axial', f'rm_{l}*(mc_th_{l} - le_{l}.theta)')),
+                            ('te', (f'te_{l}.axial - mc_ax_{l}', f'rm_{l}*(te_{l}.theta - mc_th_{l})'))):
+            w(f'  {e}_tx_{l}: "({x0})/sqrt(({x0})^2 + ({y0})^2)"      # unit direction of the blade near the edge, downstream')
+            w(f'  {e}_ty_{l}: "({y0})/sqrt(({x0})^2 + ({y0})^2)"')
+            w(f'  {e}_shear_{l}: "abs({e}_ty_{l})*tan(o_shear) > abs({e}_tx_{l})"      # 1: the corners are sheared at this edge')
+            w(f'  {e}_lam_{l}: "{e}_shear_{l} ? abs({e}_tx_{l})/(abs({e}_ty_{l})*tan(o_shear)) : 1"')
+            w(f'  {e}_dx_{l}: "{e}_tx_{l}*{e}_ty_{l}*({e}_lam_{l} - 1)"      # direction of the sheared lines across the passage')
+            w(f'  {e}_dy_{l}: "{e}_lam_{l}*{e}_ty_{l}^2 + {e}_tx_{l}^2"')
+        # which corner moves: at the leading edge the side whose points go downstream
+        # only at a round edge: where the O curve's arc between the o_corner points is at most
+        # o_fan times the blade's arc between their feet (a sharp edge's edge block is a fan on
+        # its tip, which a corner moved along one side would fold)
+        for e, (a, b) in (('le', ('a_f', 'b_f')), ('te', ('a_r', 'b_r'))):
+            outer = f'sqrt((h{a}_{l}.axial - h{b}_{l}.axial)^2 + (rm_{l}*(h{a}_{l}.theta - h{b}_{l}.theta))^2)'
+            inner = f'sqrt((g{a}_{l}.axial - g{b}_{l}.axial)^2 + (rm_{l}*(g{a}_{l}.theta - g{b}_{l}.theta))^2)'
+            w(f'  round_{e}_{l}: "{outer} <= o_fan*{inner}"')
+        # an edge is sheared on both layers or on none (a corner moved on one layer only would
+        # twist the edge block between hub and shroud): shear_le/te below
+        w(f'  sb_f_{l}: "shear_le && le_ty_{l} > 0"      # ob_f moved downstream along side b')
+        w(f'  sa_f_{l}: "shear_le && le_ty_{l} < 0"      # oa_f moved downstream along side a')
+        w(f'  sa_r_{l}: "shear_te && te_ty_{l} > 0"      # oa_r moved upstream along side a')
+        w(f'  sb_r_{l}: "shear_te && te_ty_{l} < 0"      # ob_r moved upstream along side b')
+        # At a sheared edge the unsheared corner sits o_lean_shear from the edge (its normal
+        # leaning that far from the camber direction), and every H line up- or downstream
+        # leaves along the bisector of the O curve's directions towards the edge at the two
+        # corners (at the unsheared one: towards w_le/w_te, probe along the O curve): the
+        # block round the edge (U_M, D_M) gets about half their angle at each.
+        for e, f, ta, ua, base, sign in (('le', 'f', '-', 'sb_f', 'slope_in', '-'), ('te', 'r', '+', 'sb_r', 'slope_out', '')):
+            U = lambda q: f'({ua}_{l} ? oa_{f}_{l}.{q} : ob_{f}_{l}.{q})'   # the unsheared corner
+            x0 = f'(w{e}_{l}.axial - {U("axial")})'
+            y0 = f'rm_{l}*(w{e}_{l}.theta - {U("theta")})'
+            w(f'  {e}_bx_{l}: "{x0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_tx_{l}"      # bisector at a sheared edge')
+            w(f'  {e}_by_{l}: "{y0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_ty_{l}"')
+            w(f'  {base}_x_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
         # parameter gaps (in the dir sense) between consecutive O corners on the blade and the O curve
         def gap(name, a, b):
             x = f'dir_{l}*({b}_{l}.s - {a}_{l}.s)'
             w(f'  {name}_{l}: "{x} - rint({x} - 0.5)"')
         gap('gap_le', 'b_f', 'a_f'); gap('gap_a', 'a_f', 'a_r'); gap('gap_te', 'a_r', 'b_r'); gap('gap_b', 'b_r', 'b_f')
         gap('ogap_le', 'ob_f', 'oa_f'); gap('ogap_a', 'oa_f', 'oa_r'); gap('ogap_te', 'oa_r', 'ob_r'); gap('ogap_b', 'ob_r', 'ob_f')
+    for e in ('le', 'te'):
+        w(f'  shear_{e}: "({e}_shear_h || {e}_shear_s) && round_{e}_h && round_{e}_s && {e}_ty_h*{e}_ty_s > 0"      # 1: the corners at this edge are sheared (both layers)')
     w('')
     w('carriers:')
     w('  hub: {revolve: hub, axis: machine, extend: extend}')
@@ -214,13 +266,32 @@ def template_text():
         w(f'  ole_{l}: {{project: le_{l}, onto: o_{l}}}')
         w(f'  ote_{l}: {{project: te_{l}, onto: o_{l}}}')
         # each corner is searched on its own side only: from the edge towards side a (b)
-        for v, e, side, towards in (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+')):
-            c = 'o_corner'
-            dx = f'(cos({c})*{e}_ux_{l} {side} sin({c})*{e}_vx_{l})'
-            dy = f'(cos({c})*{e}_uy_{l} {side} sin({c})*{e}_vy_{l})'
-            far = f'o{e}_{l}.s {towards} dir_{l}*o_window'
+        corners = (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+'))
+        partners = {'a_f': 'b_f', 'b_f': 'a_f', 'a_r': 'b_r', 'b_r': 'a_r'}
+        near = lambda P: f'"(x - {P}.x)^2 + (y - {P}.y)^2 + (z - {P}.z)^2"'
+        for pass_ in ('h', 'q'):
+            # h: the o_corner points and (g) their feet, for round_le/te; q: the corners before the
+            # shear (at a sheared edge the unsheared one leans o_lean_shear)
+            for v, e, side, towards in corners:
+                c = 'o_corner' if pass_ == 'h' else f'(s{partners[v[1:]]}_{l} ? o_lean_shear : o_corner)'
+                dx = f'(cos({c})*{e}_ux_{l} {side} sin({c})*{e}_vx_{l})'
+                dy = f'(cos({c})*{e}_uy_{l} {side} sin({c})*{e}_vy_{l})'
+                far = f'o{e}_{l}.s {towards} dir_{l}*o_window'
+                w(f'  {pass_}{v[1:]}_{l}: {{on_curve: o_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+                if pass_ == 'h':
+                    w(f'  g{v[1:]}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"h{v[1:]}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
+        # the sheared corner: where the line along the sheared direction through its partner's
+        # image one pitch across (side b's partner one pitch up, side a's one down) meets the O curve
+        for v, e, side, towards in corners:
             b = v[1:]  # the corner's foot on the blade
-            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+            partner = partners[b]
+            image = '-' if b[0] == 'b' else '+'
+            far = f'o{e}_{l}.s {towards} dir_{l}*o_reach'
+            cross = f'((axial - q{partner}_{l}.axial)*{e}_dy_{l} - rm_{l}*(theta - q{partner}_{l}.theta {image} pitch)*{e}_dx_{l})^2'
+            dq = f'(x - q{b}_{l}.x)^2 + (y - q{b}_{l}.y)^2 + (z - q{b}_{l}.z)^2'
+            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{min: "s{b}_{l} ? {cross} : {dq}", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+        for v, e, side, towards in corners:
+            b = v[1:]  # the corner's foot on the blade
             # (nearest points by a search, not `project`: a search only places a helper once,
             # a projection would be redone at every step of the optimizer)
             near = lambda P: f'"(x - {P}.x)^2 + (y - {P}.y)^2 + (z - {P}.z)^2"'
@@ -236,6 +307,9 @@ def template_text():
             dc = f'(x - c{b}_{l}.x)^2 + (y - c{b}_{l}.y)^2 + (z - c{b}_{l}.z)^2'
             w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {dr} : {dc}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
             w(f'  {b}_{l}: {{project: {v}_{l}, onto: blade_{l}}}')
+        # a step along the O curve from the unsheared corner of a sheared edge towards the edge
+        w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*probe : ob_f_{l}.s + dir_{l}*probe", fixed: true}}')
+        w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*probe : ob_r_{l}.s - dir_{l}*probe", fixed: true}}')
         w(f'  a_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s + dir_{l}*side_a_{l}/2"}}')
         w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
         w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')
@@ -247,10 +321,10 @@ def template_text():
         w(f'  hi_r_{l}: {{periodic: lo_r_{l}}}')
         w(f'  # inlet and outlet: on the axial planes, H lines leaving the O-grid along slope_in/out')
         for v, src in (('lo_in', 'lo_f'), ('a_in', 'oa_f'), ('b_in', 'ob_f')):
-            w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "{src}_{l}.theta + ({src}_{l}.axial - inlet_axial)*slope_in_{l}/rm_{l}"}}')
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "{src}_{l}.theta + ({src}_{l}.axial - inlet_axial)*slope_in_x_{l}/rm_{l}"}}')
         w(f'  hi_in_{l}: {{periodic: lo_in_{l}}}')
         for v, src in (('lo_out', 'lo_r'), ('a_out', 'oa_r'), ('b_out', 'ob_r')):
-            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*slope_out_{l}/rm_{l}"}}')
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*slope_out_x_{l}/rm_{l}"}}')
         w(f'  hi_out_{l}: {{periodic: lo_out_{l}}}')
     w('')
     w('edges:')
