@@ -64,22 +64,10 @@ double smallestMinAngle(const double* xyz, int ni, int nj, int nk)
         anyCell = true;
         // As evaluateCellShape: edge vectors, lengths, the corners' cosines.
         P3 e[12];
-        edgeVectors(c, e);
         double length2[12], inverseLength[12];
-        for (int n = 0; n < 12; ++n)
-        {
-          length2[n] = dot(e[n], e[n]);
-          inverseLength[n] = length2[n] > 0.0 ? 1.0 / std::sqrt(length2[n]) : 0.0;
-        }
+        cellEdges(c, e, length2, inverseLength);
         CornerAccumulator<double> corners{ e, inverseLength, 1.0, -1.0, verdictMax };
-        corners.corner<0, 3, 8, 1, 1, 1>();
-        corners.corner<1, 0, 9, 1, -1, 1>();
-        corners.corner<2, 1, 10, -1, -1, 1>();
-        corners.corner<3, 2, 11, -1, 1, 1>();
-        corners.corner<7, 4, 8, 1, 1, -1>();
-        corners.corner<4, 5, 9, -1, 1, -1>();
-        corners.corner<5, 6, 10, -1, -1, -1>();
-        corners.corner<6, 7, 11, 1, -1, -1>();
+        corners.all();
         double shortest2 = length2[0], longest2 = length2[0];
         for (int n = 0; n < 12; ++n)
         {
