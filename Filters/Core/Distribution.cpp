@@ -577,6 +577,9 @@ DistributionLaw reversedLaw(const DistributionLaw& law)
     case DistributionLaw::Kind::FirstCell:
       throw GeometryError("a first-cell distribution cannot be reversed into another "
         "first-cell law; reverse its node parameters instead");
+    case DistributionLaw::Kind::ProjectFrom:
+      std::swap(reversed.fadeStart, reversed.fadeEnd);
+      return reversed;
     case DistributionLaw::Kind::Ends:
     case DistributionLaw::Kind::Match:
       std::swap(reversed.firstCellSize, reversed.lastCellSize);

@@ -56,12 +56,22 @@ struct DistributionLaw
   /// pitch) gets its end cell lengthened until it leans no more, and the edges continuing
   /// it across the interface take that cell too (Filters/Model/MatchedEdges.cpp).
   double leanLimit = 0.0;
+  /// ProjectFrom only: where the first (last) vertex of the edge is not the projection of
+  /// the source edge's end vertex (an O-grid corner off the normal of its foot on the
+  /// blade), the projected nodes near that end move along the edge towards it, by the
+  /// whole distance at the end and by less farther in (a smoothstep in the edge's arc
+  /// length over fadeStart (fadeEnd) times that distance), so the end cell keeps the
+  /// projected length and no cell grows by more than 1 + 1.5 / fade; 0: that end vertex as
+  /// it is (the end cell takes up the difference).
+  double fadeStart = 0.0;
+  double fadeEnd = 0.0;
 
   bool operator==(const DistributionLaw& o) const
   {
     return kind == o.kind && expansionRatio == o.expansionRatio &&
       firstCellSize == o.firstCellSize && lastCellSize == o.lastCellSize &&
-      sourceEdge == o.sourceEdge && leanLimit == o.leanLimit;
+      sourceEdge == o.sourceEdge && leanLimit == o.leanLimit && fadeStart == o.fadeStart &&
+      fadeEnd == o.fadeEnd;
   }
   bool operator!=(const DistributionLaw& o) const { return !(*this == o); }
 };

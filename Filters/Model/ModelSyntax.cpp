@@ -265,7 +265,8 @@ namespace
 {
 const char* const LawSyntax =
   "uniform, {geometric: k}, {two_sided: k}, {first_cell: h, ratio: r}, "
-  "{ends: [a, b]}, match, {match: r}, {match: r, lean: angle} or {project_from: edge}";
+  "{ends: [a, b]}, match, {match: r}, {match: r, lean: angle}, {project_from: edge} or "
+  "{project_from: edge, fade: k} (or fade: [k_first, k_last])";
 }
 
 DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entityText,
@@ -295,22 +296,51 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
   }
   const std::vector<MapEntry> entries = mapEntries(node, here, entityText, what, reporter);
   checkKeys(entries,
-    { "geometric", "two_sided", "first_cell", "ratio", "ends", "match", "lean", "project_from" },
+    { "geometric", "two_sided", "first_cell", "ratio", "ends", "match", "lean", "project_from",
+      "fade" },
     entityText, reporter);
+  const MapEntry* fade = findEntry(entries, "fade");
   if (const MapEntry* project = findEntry(entries, "project_from"))
   {
-    if (entries.size() != 1)
+    if (entries.size() != (fade ? 2u : 1u))
     {
-      reporter.fail(project->line, entityText, what + ": expected {project_from: edge} alone");
+      reporter.fail(project->line, entityText,
+        what + ": expected {project_from: edge} or {project_from: edge, fade: k} alone");
     }
-    if (!edges)
+    if (fade)
     {
-      reporter.fail(project->line, entityText, what + ": project_from names an edge, and "
-        "there are no named edges here");
+      const auto fadeOf = [&](const YAML::Node& value, const std::string& which) {
+        const double k = number(value, fade->line, what + " fade" + which);
+        if (!(k == 0.0 || k >= 2.0) || !std::isfinite(k))
+        {
+          reporter.fail(fade->line, entityText,
+            what + ": the fade of a projected edge's end shift must be 0 (none) or at least "
+                   "2 (times the shift), got " + formatNumber(k));
+        }
+        return k;
+      };
+      if (fade->value.IsSequence() && fade->value.size() == 2)
+      {
+        law.fadeStart = fadeOf(fade->value[0], " (first end)");
+        law.fadeEnd = fadeOf(fade->value[1], " (last end)");
+      }
+      else if (fade->value.IsScalar())
+      {
+        law.fadeStart = law.fadeEnd = fadeOf(fade->value, "");
+      }
+      else
+      {
+        reporter.fail(fade->line, entityText,
+          what + ": expected fade: k or fade: [k_first, k_last]");
+      }
     }
     law.kind = DistributionLaw::Kind::ProjectFrom;
     law.sourceEdge = edges(project->value, project->line, what + " project_from");
     return law;
+  }
+  if (fade)
+  {
+    reporter.fail(fade->line, entityText, what + ": 'fade' belongs to the law project_from");
   }
   const MapEntry* lean = findEntry(entries, "lean");
   if (const MapEntry* match = findEntry(entries, "match"))
@@ -446,7 +476,13 @@ void emitLaw(YAML::Emitter& out, const DistributionLaw& law, const BlockModel& m
       return;
     case DistributionLaw::Kind::ProjectFrom:
       out << YAML::Flow << YAML::BeginMap << YAML::Key << "project_from" << YAML::Value
-          << model.edges.at(law.sourceEdge).name << YAML::EndMap;
+          << model.edges.at(law.sourceEdge).name;
+      if (law.fadeStart > 0.0 || law.fadeEnd > 0.0)
+      {
+        out << YAML::Key << "fade" << YAML::Value << YAML::Flow << YAML::BeginSeq
+            << formatNumber(law.fadeStart) << formatNumber(law.fadeEnd) << YAML::EndSeq;
+      }
+      out << YAML::EndMap;
       return;
   }
 }

@@ -91,7 +91,7 @@ using EdgeReader = std::function<int(const YAML::Node& node, int line, const std
  * `{first_cell: h, ratio: r}` (ratio optional), `{ends: [a, b]}`, `match` or `{match: r}`
  * (end cells from the neighbour edges, growing by r, default DefaultMatchRatio), or
  * `{project_from: edge}` (the nodes of that named edge projected onto this one; needs
- * `edges`). `what` names the law in messages ("grading j", "grading E9").
+ * `edges`), with `fade: k` the end shifts faded out (DistributionLaw::fade). `what` names the law in messages ("grading j", "grading E9").
  */
 DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entity,
   const std::string& what, const NumberReader& number, const Reporter& reporter,

@@ -40,6 +40,14 @@ std::string uniqueEdgeText(const BlockModel& model, const UniqueEdge& edge)
   return "edge " + edgeText(model, edge.a, edge.b);
 }
 
+/// The law of `use` seen along `edge`'s own direction (a -> b).
+DistributionLaw lawAlongEdge(const BlockModel& model, const UniqueEdge& edge, const EdgeUse& use)
+{
+  const int start = model.blocks[use.block].vertices[edgeVertices(use.localEdge)[0]];
+  const DistributionLaw& law = useLaw(model, use);
+  return start == edge.a ? law : reversedLaw(law);
+}
+
 /// The named edge every use of `edge` projects from, -1 when none does; fails when some
 /// uses do and others do not, or name different edges.
 int projectedSource(const BlockModel& model, const UniqueEdge& edge)
@@ -61,13 +69,14 @@ int projectedSource(const BlockModel& model, const UniqueEdge& edge)
   for (const EdgeUse& use : edge.uses)
   {
     const DistributionLaw& law = useLaw(model, use);
-    if (law.kind != DistributionLaw::Kind::ProjectFrom || law.sourceEdge != source)
+    if (law.kind != DistributionLaw::Kind::ProjectFrom ||
+      lawAlongEdge(model, edge, use) != lawAlongEdge(model, edge, *projecting))
     {
       failOnUse(model, use,
         uniqueEdgeText(model, edge) + " (" + syntax::edgeLabel(use.localEdge) +
           ") takes its nodes from edge '" + model.edges[source].name + "' in block '" +
           model.blocks[projecting->block].name + "': give it the same law {project_from: " +
-          model.edges[source].name + "} here");
+          model.edges[source].name + "} here (with the same fade)");
     }
   }
   return source;
@@ -217,6 +226,55 @@ void projectEdgeParameters(const BlockModel& model, const std::vector<NamedCurve
           " is not between those of its neighbours (at " + shortNumber(params[i]) +
           " of the edge): the edges are too far apart or too differently curved for their "
           "nodes to project in order");
+    }
+  }
+  const DistributionLaw law = lawAlongEdge(model, edge, use);
+  if (law.fadeStart > 0.0 || law.fadeEnd > 0.0)
+  {
+    // Where an end vertex is not the projection of the source's end vertex, the nodes near
+    // it move towards it: by the whole shift at the end, less farther in (smoothstep over
+    // fade times the shift), so the end cell keeps its projected length.
+    const auto fractionOf = [&](const Vec3& point) {
+      const double t = projector.project(point).t;
+      const double fraction = named && named->lengthTable
+        ? named->lengthTable->lengthAt(t) / named->lengthTable->totalLength()
+        : t;
+      return curveReversed ? 1.0 - fraction : fraction;
+    };
+    const double startShift = law.fadeStart > 0.0
+      ? -fractionOf(edgeNodePoint(model, curves, geometry, source, crossed ? n - 1 : 0))
+      : 0.0;
+    const double endShift = law.fadeEnd > 0.0
+      ? 1.0 - fractionOf(edgeNodePoint(model, curves, geometry, source, crossed ? 0 : n - 1))
+      : 0.0;
+    const auto smoothstep = [](double x) {
+      return x <= 0.0 ? 1.0 : x >= 1.0 ? 0.0 : 1.0 - x * x * (3.0 - 2.0 * x);
+    };
+    for (int i = 1; i < n - 1; ++i)
+    {
+      const double f = params[i];
+      double moved = f;
+      if (startShift != 0.0)
+      {
+        moved +=
+          startShift * smoothstep((f + startShift) / (law.fadeStart * std::abs(startShift)));
+      }
+      if (endShift != 0.0)
+      {
+        moved +=
+          endShift * smoothstep((1.0 - endShift - f) / (law.fadeEnd * std::abs(endShift)));
+      }
+      params[i] = moved;
+    }
+    for (int i = 1; i < n; ++i)
+    {
+      if (!(params[i] > params[i - 1]))
+      {
+        failOnUse(model, use,
+          names + ", but its nodes " + std::to_string(i - 1) + " and " + std::to_string(i) +
+            " come out of order once the end shifts are faded in (fade " +
+            shortNumber(law.fadeStart) + ", " + shortNumber(law.fadeEnd) + "): give a larger fade");
+      }
     }
   }
   edge.params = std::move(params);

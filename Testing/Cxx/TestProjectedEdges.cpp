@@ -387,3 +387,52 @@ TEST(ProjectedEdges, ErrorsNameTheEdges)
     contains(unknown, "grading E3 project_from: unknown edge 'im0' (did you mean 'in0'?)"))
     << unknown;
 }
+
+TEST(ProjectedEdges, FadeMovesTheNodesNearAnEndOffTheNormalTowardsIt)
+{
+  // The outer arc reaches 10 degrees past the normal offset of the inner arc's end at p0
+  // (90 degrees): without a fade its first cell takes the whole 10 degrees on top of the
+  // projected 11.25; with {fade: [6, 0]} (its own direction, from p3) the nodes near p3
+  // move towards it, the shift fading out over 6 x 0.1 of the arc, and nodes beyond are the
+  // projections still.
+  const auto mesh = [](const std::string& outerLaw) {
+    std::string text = quarterRing("uniform", outerLaw);
+    const std::size_t at = text.find("p3: [0, 1.5, 0]");
+    text.replace(at, 15, "p3: [1.5*cos(100*pi/180), 1.5*sin(100*pi/180), 0]");
+    const std::size_t top = text.find("p7: [0, 1.5, 1]");
+    text.replace(top, 15, "p7: [1.5*cos(100*pi/180), 1.5*sin(100*pi/180), 1]");
+    return test::meshAll(parseTemplate(text, "ring.yaml"));
+  };
+  const double degree = std::acos(-1.0) / 180.0;
+  const auto outerAngle = [&](const test::Grid& grid, int i) {
+    return angleOf(node(grid, 0, i, grid.nodes[0][1] - 1, 0)) / degree;
+  };
+  const test::Grid plain = mesh("{project_from: in#}");
+  EXPECT_NEAR(outerAngle(plain, 0) - outerAngle(plain, 1), 21.25, 1e-9);
+  const test::Grid faded = mesh("{project_from: in#, fade: [6, 0]}");
+  EXPECT_NEAR(outerAngle(faded, 0), 100.0, 1e-9);
+  for (const int i : { 6, 7, 8 })
+  {
+    EXPECT_NEAR(outerAngle(faded, i), 90.0 - 11.25 * i, 1e-9) << i;
+  }
+  double previous = outerAngle(faded, 0) - outerAngle(faded, 1);
+  EXPECT_GT(previous, 11.25);
+  EXPECT_LT(previous, 13.0); // the projected 11.25, not 21.25
+  for (int i = 1; i < 8; ++i)
+  {
+    const double cell = outerAngle(faded, i) - outerAngle(faded, i + 1);
+    EXPECT_GT(cell, 0.0) << i;
+    EXPECT_LT(std::max(cell / previous, previous / cell), 1.0 + 1.5 / 6.0 + 1e-9) << i;
+    previous = cell;
+  }
+  // the law travels in the model document
+  const BlockModel model =
+    parseTemplate(quarterRing("uniform", "{project_from: in#, fade: [6, 0]}"), "ring.yaml");
+  const std::string document = writeModelDocument(model);
+  EXPECT_TRUE(contains(document, "{project_from: in0, fade: [6, 0]}")) << document;
+  EXPECT_EQ(readModelDocument(document).blocks[0].laws, model.blocks[0].laws);
+  EXPECT_TRUE(contains(errorOf(quarterRing("uniform", "{project_from: in#, fade: 1}")),
+    "must be 0 (none) or at least 2"));
+  EXPECT_TRUE(contains(errorOf(quarterRing("{geometric: 1.2, fade: 3}", "uniform")),
+    "'fade' belongs to the law project_from"));
+}
