@@ -25,6 +25,7 @@ std::string reason(int error)
 {
   return std::strerror(error);
 }
+} // namespace
 
 std::string folderOf(const std::string& path)
 {
@@ -37,7 +38,6 @@ std::string nameOf(const std::string& path)
   const std::size_t slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
-} // namespace
 
 CheckedFile::CheckedFile(const std::string& path)
   : Path(path)

@@ -128,6 +128,10 @@ private:
 /// Removes the staging entries of `target` left by processes that no longer run.
 void removeStaleStaging(const std::string& target);
 
+/// The folder of `path` ("." for a bare name) and its last component.
+std::string folderOf(const std::string& path);
+std::string nameOf(const std::string& path);
+
 /// mkdir -p; throws std::runtime_error naming the folder that could not be made.
 void makeDirectories(const std::string& path);
 /// Removes a file or a directory tree; errors are ignored.
