@@ -178,6 +178,8 @@ namespace
 {
 const char* const StagingSuffix = ".staging";
 
+} // namespace
+
 bool processAlive(long pid)
 {
   if (pid == static_cast<long>(::getpid()))
@@ -186,7 +188,6 @@ bool processAlive(long pid)
   }
   return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM;
 }
-} // namespace
 
 void removeStaleStaging(const std::string& target)
 {

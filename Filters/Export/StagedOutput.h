@@ -132,6 +132,9 @@ void removeStaleStaging(const std::string& target);
 std::string folderOf(const std::string& path);
 std::string nameOf(const std::string& path);
 
+/// Whether another process `pid` runs (this process's own leftovers count as stale).
+bool processAlive(long pid);
+
 /// mkdir -p; throws std::runtime_error naming the folder that could not be made.
 void makeDirectories(const std::string& path);
 /// Removes a file or a directory tree; errors are ignored.

@@ -2,6 +2,7 @@
 
 #include "StagedOutput.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
@@ -10,6 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include <dirent.h>
 #include <stdio.h>
 #include <sys/stat.h>
 
@@ -107,6 +109,48 @@ std::vector<std::string> referencedFolders(const std::string& vtm)
   return folders;
 }
 
+/// Removes the pieces folders "STEM.pieces-<pid>-<token>" in `folder` that killed runs
+/// left: of processes that no longer run and not in `inUse` (as blockforge.output does).
+void removeStalePieces(
+  const std::string& folder, const std::string& stem, const std::vector<std::string>& inUse)
+{
+  const std::string prefix = stem + PiecesMark;
+  DIR* directory = ::opendir(folder.c_str());
+  if (!directory)
+  {
+    return;
+  }
+  std::vector<std::string> stale;
+  while (dirent* entry = ::readdir(directory))
+  {
+    const std::string name = entry->d_name;
+    if (name.compare(0, prefix.size(), prefix) != 0)
+    {
+      continue;
+    }
+    const std::string token = name.substr(prefix.size());
+    const std::size_t dash = token.find('-');
+    if (dash == std::string::npos || dash == 0 || dash + 1 == token.size() ||
+      token.find_first_not_of("0123456789") != dash ||
+      token.find_first_not_of("0123456789abcdef", dash + 1) != std::string::npos ||
+      std::find(inUse.begin(), inUse.end(), name) != inUse.end() ||
+      processAlive(std::stol(token.substr(0, dash))))
+    {
+      continue;
+    }
+    stale.push_back(folder + "/" + name);
+  }
+  ::closedir(directory);
+  for (const std::string& path : stale)
+  {
+    struct stat status;
+    if (::lstat(path.c_str(), &status) == 0 && S_ISDIR(status.st_mode))
+    {
+      removeTree(path);
+    }
+  }
+}
+
 /// One block as an XML structured grid: its points, Float64, raw appended.
 void writePiece(const GridBlock& block, const std::string& path)
 {
@@ -156,6 +200,8 @@ void writeVtkMultiBlock(const ExportGrid& grid, const std::string& path)
   const std::size_t tokenStart = nameOf(path).size() + 2;
   const std::string token = stagingName.substr(
     tokenStart, stagingName.size() - tokenStart - std::strlen(StagingSuffix));
+  const std::vector<std::string> referenced = referencedFolders(path);
+  removeStalePieces(folder, stem, referenced);
   const std::string pieces = stem + PiecesMark + token;
   const std::string stagedPieces = staged.path() + "/" + pieces;
   if (::mkdir(stagedPieces.c_str(), 0777) != 0)
@@ -183,7 +229,7 @@ void writeVtkMultiBlock(const ExportGrid& grid, const std::string& path)
   }
   // What the older grid references, removed only once the new one is in place.
   std::vector<std::string> old;
-  for (const std::string& name : referencedFolders(path))
+  for (const std::string& name : referenced)
   {
     if (name == stem || name.compare(0, stem.size() + std::strlen(PiecesMark),
                           stem + PiecesMark) == 0)
