@@ -251,27 +251,12 @@ void BM_FullEvaluation(benchmark::State& state)
 }
 
 #ifdef BLOCKFORGE_HAS_MESH_PLAN
-/// Smallest MinAngle of the cells of block b (hexFaceAngles cell by cell).
-double smallestMinAngle(const std::vector<double>& xyz, const std::array<int, 3>& n, long long& cells)
+/// Smallest MinAngle of the cells of block b (Quality.h: the smallest hexFaceAngles
+/// minAngle of its cells, bit for bit).
+double smallestMinAngleOf(const std::vector<double>& xyz, const std::array<int, 3>& n, long long& cells)
 {
-  double smallest = 180.0;
-  auto at = [&](int i, int j, int k) {
-    const double* p = &xyz[3 * (i + static_cast<std::size_t>(n[0]) * (j + static_cast<std::size_t>(n[1]) * k))];
-    return Vec3(p[0], p[1], p[2]);
-  };
-  for (int k = 0; k + 1 < n[2]; ++k)
-    for (int j = 0; j + 1 < n[1]; ++j)
-      for (int i = 0; i + 1 < n[0]; ++i)
-      {
-        const std::array<Vec3, 8> corners = { at(i, j, k), at(i + 1, j, k), at(i + 1, j + 1, k),
-          at(i, j + 1, k), at(i, j, k + 1), at(i + 1, j, k + 1), at(i + 1, j + 1, k + 1),
-          at(i, j + 1, k + 1) };
-        double minAngle = 0.0, maxAngle = 0.0;
-        hexFaceAngles(corners, minAngle, maxAngle);
-        smallest = std::min(smallest, minAngle);
-        ++cells;
-      }
-  return smallest;
+  cells += static_cast<long long>(n[0] - 1) * (n[1] - 1) * (n[2] - 1);
+  return smallestMinAngle(xyz.data(), n[0], n[1], n[2]);
 }
 
 /// The model without what follows through expressions and curves (as before issue 7's
@@ -352,7 +337,7 @@ void moveOneControlPoint(benchmark::State& state, const Applied& a, bool undo = 
     std::vector<double> smallestOf(updated.size(), 180.0);
     std::vector<long long> cellsOf(updated.size(), 0);
     forEachChunk(static_cast<long>(updated.size()), [&](long n) {
-      smallestOf[n] = smallestMinAngle(plan.blockNodes(updated[n]), plan.nodeCounts(updated[n]), cellsOf[n]);
+      smallestOf[n] = smallestMinAngleOf(plan.blockNodes(updated[n]), plan.nodeCounts(updated[n]), cellsOf[n]);
     });
     double smallest = 180.0;
     cells = 0;

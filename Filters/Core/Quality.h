@@ -25,6 +25,15 @@ namespace blockforge
 /// count as triangles; collapsed faces are skipped; a cell with no face left gets 0, 180.
 void hexFaceAngles(const std::array<Vec3, 8>& corners, double& minAngle, double& maxAngle);
 
+/**
+ * The smallest MinAngle (hexFaceAngles' minAngle) of the cells of one structured block of
+ * ni x nj x nk nodes (xyz: 3 doubles per node, i fastest), the same bits as the smallest
+ * of hexFaceAngles over its cells, at a fraction of the cost: only the angles, and one
+ * arccosine for the block (the arccosine is monotonic). 180 for a block without cells.
+ * What an optimizer or a move measures on the blocks it changed.
+ */
+double smallestMinAngle(const double* xyz, int ni, int nj, int nk);
+
 /// Verdict's hex scaled Jacobian (as vtkMeshQuality::HexScaledJacobian): the minimum of
 /// the normalised Jacobian determinant at the 8 corners and the centre; 1 for a cube,
 /// negative for an inverted cell.

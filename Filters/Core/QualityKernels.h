@@ -282,6 +282,19 @@ struct CornerAccumulator
     const T jacobian = double(sa * sb * sw) * dot(e[ea], cross(e[eb], e[ew])) * (ia * ib * iw);
     minJacobian = vmin(minJacobian, jacobian);
   }
+
+  /// All eight corners.
+  inline void all()
+  {
+    corner<0, 3, 8, 1, 1, 1>();     // V0: V1, V3, V4
+    corner<1, 0, 9, 1, -1, 1>();    // V1: V2, V0, V5
+    corner<2, 1, 10, -1, -1, 1>();  // V2: V3, V1, V6
+    corner<3, 2, 11, -1, 1, 1>();   // V3: V0, V2, V7
+    corner<7, 4, 8, 1, 1, -1>();    // V4: V7, V5, V0
+    corner<4, 5, 9, -1, 1, -1>();   // V5: V4, V6, V1
+    corner<5, 6, 10, -1, -1, -1>(); // V6: V5, V7, V2
+    corner<6, 7, 11, 1, -1, -1>();  // V7: V6, V4, V3
+  }
 };
 
 /**
@@ -296,14 +309,7 @@ inline ShapeSums<T> shapeKernel(
   ShapeSums<T> sums;
   CornerAccumulator<T> corners{ e, inverseLength, splat<T>(1.0), splat<T>(-1.0),
     splat<T>(verdictMax) };
-  corners.template corner<0, 3, 8, 1, 1, 1>();     // V0: V1, V3, V4
-  corners.template corner<1, 0, 9, 1, -1, 1>();    // V1: V2, V0, V5
-  corners.template corner<2, 1, 10, -1, -1, 1>();  // V2: V3, V1, V6
-  corners.template corner<3, 2, 11, -1, 1, 1>();   // V3: V0, V2, V7
-  corners.template corner<7, 4, 8, 1, 1, -1>();    // V4: V7, V5, V0
-  corners.template corner<4, 5, 9, -1, 1, -1>();   // V5: V4, V6, V1
-  corners.template corner<5, 6, 10, -1, -1, -1>(); // V6: V5, V7, V2
-  corners.template corner<6, 7, 11, 1, -1, -1>();  // V7: V6, V4, V3
+  corners.all();
   sums.minCos = corners.minCos;
   sums.maxCos = corners.maxCos;
   sums.minCornerJacobian = corners.minJacobian;
@@ -483,16 +489,22 @@ inline CellShape finishShape(const ShapeSums<double>& sums, const V3<T> (&c)[8],
   return shape;
 }
 
-inline CellShape evaluateCellShape(const P3 (&c)[8])
+/// Edge vectors of one cell with their squared and inverse lengths (0 for zero length).
+inline void cellEdges(const P3 (&c)[8], P3 (&e)[12], double (&length2)[12], double (&inverseLength)[12])
 {
-  P3 e[12];
   edgeVectors(c, e);
-  double length2[12], inverseLength[12];
   for (int n = 0; n < 12; ++n)
   {
     length2[n] = dot(e[n], e[n]);
     inverseLength[n] = length2[n] > 0.0 ? 1.0 / std::sqrt(length2[n]) : 0.0;
   }
+}
+
+inline CellShape evaluateCellShape(const P3 (&c)[8])
+{
+  P3 e[12];
+  double length2[12], inverseLength[12];
+  cellEdges(c, e, length2, inverseLength);
   return finishShape(shapeKernel(e, length2, inverseLength), c, 0);
 }
 

@@ -43,6 +43,54 @@ void hexFaceAngles(const std::array<Vec3, 8>& corners, double& minAngle, double&
   maxAngle = shape.maxAngle;
 }
 
+double smallestMinAngle(const double* xyz, int ni, int nj, int nk)
+{
+  // hexFaceAngles' minAngle is angleFromCosine(largest corner cosine) for a cell without
+  // collapsed edges: the largest cosine over the block gives the smallest of those angles.
+  double largestCosine = -1.0, smallestCollapsed = 180.0;
+  bool anyCell = false;
+  const auto node = [&](int i, int j, int k) {
+    return load(xyz + 3 * (i + static_cast<std::size_t>(ni) * (j + static_cast<std::size_t>(nj) * k)));
+  };
+  for (int k = 0; k + 1 < nk; ++k)
+  {
+    for (int j = 0; j + 1 < nj; ++j)
+    {
+      for (int i = 0; i + 1 < ni; ++i)
+      {
+        const P3 c[8] = { node(i, j, k), node(i + 1, j, k), node(i + 1, j + 1, k),
+          node(i, j + 1, k), node(i, j, k + 1), node(i + 1, j, k + 1),
+          node(i + 1, j + 1, k + 1), node(i, j + 1, k + 1) };
+        anyCell = true;
+        // As evaluateCellShape: edge vectors, lengths, the corners' cosines.
+        P3 e[12];
+        double length2[12], inverseLength[12];
+        cellEdges(c, e, length2, inverseLength);
+        CornerAccumulator<double> corners{ e, inverseLength, 1.0, -1.0, verdictMax };
+        corners.all();
+        double shortest2 = length2[0], longest2 = length2[0];
+        for (int n = 0; n < 12; ++n)
+        {
+          shortest2 = vmin(shortest2, length2[n]);
+          longest2 = vmax(longest2, length2[n]);
+        }
+        const double collapsedLength2 = collapsedEdgeFraction * collapsedEdgeFraction * longest2;
+        if (shortest2 > collapsedLength2)
+        {
+          largestCosine = std::max(largestCosine, corners.maxCos);
+        }
+        else
+        {
+          double minAngle = 0.0, maxAngle = 0.0;
+          collapsedCellAngles(c, collapsedLength2, minAngle, maxAngle);
+          smallestCollapsed = std::min(smallestCollapsed, minAngle);
+        }
+      }
+    }
+  }
+  return anyCell ? std::min(angleFromCosine(largestCosine), smallestCollapsed) : 180.0;
+}
+
 double hexScaledJacobian(const std::array<Vec3, 8>& corners)
 {
   P3 c[8];

@@ -511,3 +511,33 @@ TEST(Quality, CollapsedCellScaledJacobianInGridPass)
     Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 1), Vec3(0, 1, 1), Vec3(0, 0, 1) };
   EXPECT_EQ(hexScaledJacobian(corners), 1e30);
 }
+
+TEST(Quality, SmallestMinAngleOfABlockIsTheSmallestOfItsCells)
+{
+  // Randomly perturbed and sheared blocks, one with a face collapsed onto a line (wedge
+  // cells): smallestMinAngle gives the smallest hexFaceAngles minAngle bit for bit.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> jitter(-0.2, 0.2);
+  const Grid perturbed = makeGrid(7, 5, 4, [&](int i, int j, int k) {
+    return Vec3(i + jitter(random) + 0.3 * k, j + jitter(random), 0.7 * k + jitter(random));
+  });
+  const Grid wedge =
+    makeGrid(4, 3, 3, [](int i, int j, int k) { return Vec3(i, i * (j - 1.0) * 0.5, k); });
+  const Grid sheared =
+    makeGrid(3, 3, 3, [](int i, int j, int k) { return Vec3(i + std::tan(0.4) * k, j, k); });
+  for (const Grid* g : { &perturbed, &wedge, &sheared })
+  {
+    double smallest = 180.0;
+    for (int k = 0; k + 1 < g->nk; ++k)
+      for (int j = 0; j + 1 < g->nj; ++j)
+        for (int i = 0; i + 1 < g->ni; ++i)
+        {
+          double minAngle = 0.0, maxAngle = 0.0;
+          hexFaceAngles(cellCorners(*g, i, j, k), minAngle, maxAngle);
+          smallest = std::min(smallest, minAngle);
+        }
+    EXPECT_EQ(smallestMinAngle(g->xyz.data(), g->ni, g->nj, g->nk), smallest);
+  }
+  EXPECT_NEAR(smallestMinAngle(sheared.xyz.data(), 3, 3, 3), 90.0 - 0.4 * degrees, 1e-12);
+  EXPECT_EQ(smallestMinAngle(sheared.xyz.data(), 3, 3, 1), 180.0); // no cells
+}
