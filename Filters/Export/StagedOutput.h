@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <vector>
 
 namespace blockforge
 {
@@ -132,8 +133,10 @@ void removeStaleStaging(const std::string& target);
 std::string folderOf(const std::string& path);
 std::string nameOf(const std::string& path);
 
-/// Whether another process `pid` runs (this process's own leftovers count as stale).
-bool processAlive(long pid);
+/// The entries of `folder` named PREFIX<pid>-<hex token>SUFFIX whose process no longer
+/// runs (this process's own count as stale), as full paths.
+std::vector<std::string> staleEntries(
+  const std::string& folder, const std::string& prefix, const std::string& suffix);
 
 /// mkdir -p; throws std::runtime_error naming the folder that could not be made.
 void makeDirectories(const std::string& path);

@@ -11,7 +11,6 @@
 #include <stdexcept>
 #include <vector>
 
-#include <dirent.h>
 #include <stdio.h>
 #include <sys/stat.h>
 
@@ -114,37 +113,11 @@ std::vector<std::string> referencedFolders(const std::string& vtm)
 void removeStalePieces(
   const std::string& folder, const std::string& stem, const std::vector<std::string>& inUse)
 {
-  const std::string prefix = stem + PiecesMark;
-  DIR* directory = ::opendir(folder.c_str());
-  if (!directory)
-  {
-    return;
-  }
-  std::vector<std::string> stale;
-  while (dirent* entry = ::readdir(directory))
-  {
-    const std::string name = entry->d_name;
-    if (name.compare(0, prefix.size(), prefix) != 0)
-    {
-      continue;
-    }
-    const std::string token = name.substr(prefix.size());
-    const std::size_t dash = token.find('-');
-    if (dash == std::string::npos || dash == 0 || dash + 1 == token.size() ||
-      token.find_first_not_of("0123456789") != dash ||
-      token.find_first_not_of("0123456789abcdef", dash + 1) != std::string::npos ||
-      std::find(inUse.begin(), inUse.end(), name) != inUse.end() ||
-      processAlive(std::stol(token.substr(0, dash))))
-    {
-      continue;
-    }
-    stale.push_back(folder + "/" + name);
-  }
-  ::closedir(directory);
-  for (const std::string& path : stale)
+  for (const std::string& path : staleEntries(folder, stem + PiecesMark, ""))
   {
     struct stat status;
-    if (::lstat(path.c_str(), &status) == 0 && S_ISDIR(status.st_mode))
+    if (std::find(inUse.begin(), inUse.end(), nameOf(path)) == inUse.end() &&
+      ::lstat(path.c_str(), &status) == 0 && S_ISDIR(status.st_mode))
     {
       removeTree(path);
     }
