@@ -5,11 +5,12 @@
  * writes the grid in a solver format, without Python or VTK (start-up in milliseconds):
  *
  *   blockforge TEMPLATE [-i POINTS] [-p NAME=EXPR ...] [-d DENSITY] [-m GB] -o OUTPUT [--ascii]
- *              [--no-optimize] [--objective NAME]
+ *              [--no-optimize] [--objective NAME] [--max-evaluations N]
  *
  * OUTPUT's extension picks the writer: DIR/NAME.foam (OpenFOAM case: DIR/constant/polyMesh
- * and an empty NAME.foam), NAME.xyz (Plot3D multiblock), NAME.cgns (CGNS). `python3 -m
- * blockforge` takes the same arguments and also writes .vtm with the quality arrays.
+ * and an empty NAME.foam), NAME.xyz (Plot3D multiblock), NAME.cgns (CGNS), NAME.vtm (VTK
+ * XML multiblock, points only, written without VTK). `python3 -m blockforge` takes the
+ * same arguments and writes .vtm with the quality arrays.
  */
 #include "Cgns.h"
 #include "ExportModel.h"
@@ -21,9 +22,11 @@
 #include "PolyMesh.h"
 #include "PrintableText.h"
 #include "Template.h"
+#include "VtkXml.h"
 #include "TurboTemplateInputs.h"
 
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -40,7 +43,7 @@ namespace
 {
 const char* const Usage =
   "usage: blockforge TEMPLATE [-i POINTS] [-p NAME=EXPR ...] [-d DENSITY] [-m GB] -o OUTPUT\n"
-  "                  [--ascii] [--no-optimize] [--objective NAME]\n"
+  "                  [--ascii] [--no-optimize] [--objective NAME] [--max-evaluations N]\n"
   "\n"
   "Applies a BlockForge template (to the point data of -i: a BladeGen .inf, an Info.txt or a\n"
   "point file), optimizes its control points (the BlockOptimizer with its defaults, as\n"
@@ -49,6 +52,9 @@ const char* const Usage =
   "  DIR/NAME.foam  OpenFOAM case (DIR/constant/polyMesh, binary unless --ascii)\n"
   "  NAME.xyz       Plot3D multi-grid (binary unless --ascii), NAME.nmf beside it\n"
   "  NAME.cgns      CGNS (HDF5): zones, 1-to-1 and periodic connectivity, BCs by family\n"
+  "  NAME.vtm       VTK XML multiblock, one .vts per block in a folder NAME.pieces-ID/\n"
+  "                 beside it (points only, raw binary; python3 -m blockforge adds the\n"
+  "                 quality arrays and --compress)\n"
   "Options:\n"
   "  -i, --input FILE        point data for a template with inputs\n"
   "  -p, --parameter N=EXPR  override a template parameter (repeatable)\n"
@@ -62,6 +68,7 @@ const char* const Usage =
   "  --objective NAME        what the optimizer improves: min-angle (default, the\n"
   "                          smallest element angle), non-orthogonality (OpenFOAM's\n"
   "                          largest) or min-angle-and-size-ratio\n"
+  "  --max-evaluations N     the optimizer's trial budget (default 400, 1 to 1000000)\n"
   "The grid is written under a temporary name and moved into place: a failure leaves no\n"
   "partial grid and keeps an older one. Exit status 1 with a message on any error.\n";
 
@@ -74,6 +81,7 @@ struct Arguments
   bool ascii = false;
   bool optimize = true;
   optimize::ObjectiveKind objective = optimize::ObjectiveKind::MinAngle;
+  int maximumEvaluations = optimize::SearchSettings{}.maxEvaluations;
 };
 
 bool endsWith(const std::string& text, const std::string& suffix)
@@ -152,6 +160,22 @@ Arguments parse(int argc, char** argv)
         throw std::invalid_argument("--objective must be min-angle, non-orthogonality or "
                                     "min-angle-and-size-ratio, got '" + name + "'");
     }
+    else if (arg == "--max-evaluations")
+    {
+      const std::string text = value();
+      char* end = nullptr;
+      errno = 0;
+      const long count = std::strtol(text.c_str(), &end, 10);
+      if (end == text.c_str() || *end != '\0' || errno != 0 || count < 1 || count > 1000000)
+      {
+        throw std::invalid_argument(
+          "--max-evaluations needs a whole number from 1 to 1000000, got '" + text + "'");
+      }
+      args.maximumEvaluations = static_cast<int>(count);
+    }
+    else if (arg == "--compress")
+      throw std::invalid_argument("--compress (zlib .vtm pieces) is only in python3 -m "
+                                  "blockforge; the native command line writes raw binary");
     else if (!arg.empty() && arg[0] == '-')
       throw std::invalid_argument("unknown option " + arg);
     else if (args.templateFile.empty())
@@ -169,10 +193,10 @@ Arguments parse(int argc, char** argv)
     throw std::invalid_argument("no output given (-o DIR/NAME.foam)");
   }
   if (!endsWith(args.output, ".foam") && !endsWith(args.output, ".xyz") &&
-    !endsWith(args.output, ".cgns"))
+    !endsWith(args.output, ".cgns") && !endsWith(args.output, ".vtm"))
   {
-    throw std::invalid_argument("the output must end in .foam (OpenFOAM case), .xyz (Plot3D) "
-                                "or .cgns; for .vtm use python3 -m blockforge, got '" +
+    throw std::invalid_argument("the output must end in .foam (OpenFOAM case), .xyz (Plot3D), "
+                                ".cgns or .vtm (VTK XML multiblock), got '" +
       args.output + "'");
   }
   return args;
@@ -197,6 +221,13 @@ void writeGrid(const exporting::ExportGrid& grid, const Arguments& args)
     exporting::writeCgns(grid, args.output);
     std::printf("blocks: %zu   cells: %lld   nodes: %lld (CGNS zones), interfaces: %zu\n",
       grid.blocks.size(), grid.cellCount(), grid.nodeCount(), grid.interfaces.size());
+    return;
+  }
+  if (endsWith(args.output, ".vtm"))
+  {
+    exporting::writeVtkMultiBlock(grid, args.output);
+    std::printf("blocks: %zu   cells: %lld   nodes: %lld (VTK XML multiblock, points only)\n",
+      grid.blocks.size(), grid.cellCount(), grid.nodeCount());
     return;
   }
   if (endsWith(args.output, ".xyz"))
@@ -266,6 +297,7 @@ int main(int argc, char** argv)
       settings.densityMultiplier = args.density;
       settings.maximumMemory = args.maximumMemory;
       settings.objective.kind = args.objective;
+      settings.search.maxEvaluations = args.maximumEvaluations;
       const optimize::OptimizerResult result = optimize::optimizeModel(model, carriers, settings);
       model = result.model;
       char line[256];
@@ -313,7 +345,7 @@ int main(int argc, char** argv)
     std::printf("time [s]: template %.3f, optimize %.3f, mesh %.3f, write %.3f, total %.3f\n",
       templateTime, optimizeTime, meshTime, writeTime, seconds(start));
     std::printf("grid written to %s%s\n", printableText(args.output).c_str(),
-      endsWith(args.output, ".cgns") ? "" : args.ascii ? " (ASCII)" : " (binary)");
+      endsWith(args.output, ".cgns") || endsWith(args.output, ".vtm") ? "" : args.ascii ? " (ASCII)" : " (binary)");
   }
   catch (const std::exception& error)
   {

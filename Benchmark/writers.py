@@ -8,7 +8,8 @@
    The Python command line (`python3 -m blockforge`, which also measures the quality of
    every cell) is shown too. Medians of the runs, interleaved, every run into a fresh case.
 2. Every format at the same size: wall time of the native command line (whole process)
-   and bytes written, beside blockMesh's polyMesh; .vtm through the Python command line.
+   and bytes written, beside blockMesh's polyMesh; .vtm through both command lines (the
+   native one writes the points only, the Python one adds the quality arrays).
 3. Cross-check (not timed): checkMesh on BlockForge's case ("Mesh OK"), the same number of
    points, faces and internal faces as blockMesh's.
 
@@ -98,6 +99,7 @@ def main():
             result = timed(native + ["-o", str(target)] + list(extra))
             written = target.parent if output.endswith(".foam") else target
             size = folder_bytes(written / "constant" / "polyMesh") if output.endswith(".foam") \
+                else folder_bytes(target.parent) if output.endswith(".vtm") \
                 else folder_bytes(target) + (folder_bytes(target.with_suffix(".nmf"))
                                              if output.endswith(".xyz") else 0)
             return result[0], result[1], size
@@ -124,7 +126,8 @@ def main():
                    ("OpenFOAM polyMesh, ASCII", "formats/foam_ascii/c.foam", ("--ascii",)),
                    ("Plot3D .xyz + .nmf, binary", "formats/grid_bin.xyz", ()),
                    ("Plot3D .xyz + .nmf, ASCII", "formats/grid_ascii.xyz", ("--ascii",)),
-                   ("CGNS (HDF5)", "formats/grid.cgns", ())]
+                   ("CGNS (HDF5)", "formats/grid.cgns", ()),
+                   ("VTK .vtm (points only, raw binary)", "formats/vtm/grid.vtm", ())]
         format_rows = []
         for label, output, extra in formats:
             runs = [run_native(output, extra) for _ in range(args.runs)]

@@ -292,12 +292,6 @@ void writeSystemFilesIfAbsent(const std::string& caseDir)
     "relaxationFactors { equations { U 0.9; \".*\" 0.9; } }\n");
 }
 
-std::string folderOf(const std::string& path)
-{
-  const std::size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? std::string(".") : path.substr(0, slash == 0 ? 1 : slash);
-}
-
 /// The case folder with its NAME.foam and system/ files, and the staged polyMesh folder.
 std::unique_ptr<StagedOutput> prepareCase(const std::string& foamFile)
 {

@@ -25,6 +25,7 @@ std::string reason(int error)
 {
   return std::strerror(error);
 }
+} // namespace
 
 std::string folderOf(const std::string& path)
 {
@@ -37,7 +38,6 @@ std::string nameOf(const std::string& path)
   const std::size_t slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
-} // namespace
 
 CheckedFile::CheckedFile(const std::string& path)
   : Path(path)
@@ -178,6 +178,7 @@ namespace
 {
 const char* const StagingSuffix = ".staging";
 
+
 bool processAlive(long pid)
 {
   if (pid == static_cast<long>(::getpid()))
@@ -188,29 +189,28 @@ bool processAlive(long pid)
 }
 } // namespace
 
-void removeStaleStaging(const std::string& target)
+std::vector<std::string> staleEntries(
+  const std::string& folder, const std::string& prefix, const std::string& suffix)
 {
-  const std::string folder = folderOf(target);
-  const std::string prefix = "." + nameOf(target) + ".";
+  std::vector<std::string> stale;
   DIR* directory = ::opendir(folder.c_str());
   if (!directory)
   {
-    return;
+    return stale;
   }
-  std::vector<std::string> stale;
   while (dirent* entry = ::readdir(directory))
   {
-    // .NAME.<pid>-<hex token>.staging, as blockforge.output names them too.
     const std::string name = entry->d_name;
-    const std::size_t suffix = std::strlen(StagingSuffix);
-    if (name.size() <= prefix.size() + suffix || name.compare(0, prefix.size(), prefix) != 0 ||
-      name.compare(name.size() - suffix, suffix, StagingSuffix) != 0)
+    if (name.size() <= prefix.size() + suffix.size() ||
+      name.compare(0, prefix.size(), prefix) != 0 ||
+      name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
     {
       continue;
     }
-    const std::string middle = name.substr(prefix.size(), name.size() - prefix.size() - suffix);
+    const std::string middle =
+      name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
     const std::size_t dash = middle.find('-');
-    if (dash == std::string::npos || dash == 0 ||
+    if (dash == std::string::npos || dash == 0 || dash + 1 == middle.size() ||
       middle.find_first_not_of("0123456789") != dash ||
       middle.find_first_not_of("0123456789abcdef", dash + 1) != std::string::npos)
     {
@@ -222,7 +222,14 @@ void removeStaleStaging(const std::string& target)
     }
   }
   ::closedir(directory);
-  for (const std::string& path : stale)
+  return stale;
+}
+
+void removeStaleStaging(const std::string& target)
+{
+  // .NAME.<pid>-<hex token>.staging, as blockforge.output names them too.
+  for (const std::string& path :
+    staleEntries(folderOf(target), "." + nameOf(target) + ".", StagingSuffix))
   {
     removeTree(path);
   }

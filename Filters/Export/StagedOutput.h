@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <vector>
 
 namespace blockforge
 {
@@ -127,6 +128,15 @@ private:
 
 /// Removes the staging entries of `target` left by processes that no longer run.
 void removeStaleStaging(const std::string& target);
+
+/// The folder of `path` ("." for a bare name) and its last component.
+std::string folderOf(const std::string& path);
+std::string nameOf(const std::string& path);
+
+/// The entries of `folder` named PREFIX<pid>-<hex token>SUFFIX whose process no longer
+/// runs (this process's own count as stale), as full paths.
+std::vector<std::string> staleEntries(
+  const std::string& folder, const std::string& prefix, const std::string& suffix);
 
 /// mkdir -p; throws std::runtime_error naming the folder that could not be made.
 void makeDirectories(const std::string& path);

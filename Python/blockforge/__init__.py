@@ -95,7 +95,8 @@ OBJECTIVES = {"min-angle": 0, "non-orthogonality": 1, "min-angle-and-size-ratio"
 
 def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_file=None,
                   timings=None, allow_inverted_cells=False, warnings=None,
-                  maximum_memory=0.0, optimize=True, objective="min-angle"):
+                  maximum_memory=0.0, optimize=True, objective="min-angle",
+                  maximum_evaluations=400):
     """:func:`mesh_template`; with a dict *timings*, also records the seconds of each
     stage under "read" (only with an input file), "template", "optimize" (unless
     *optimize* is false) and "mesh + quality"; with a list *warnings*, collects the stages'
@@ -129,6 +130,7 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
         optimizer.SetDensityMultiplier(float(density_multiplier))
         optimizer.SetMaximumMemory(float(maximum_memory))
         optimizer.SetObjective(OBJECTIVES[objective])
+        optimizer.SetMaximumEvaluations(int(maximum_evaluations))
         optimizer.SetInputConnection(template.GetOutputPort())
         stages.append(("optimize", optimizer))
         model = optimizer
@@ -175,7 +177,7 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
 
 def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None,
                   allow_inverted_cells=False, maximum_memory=0.0, optimize=True,
-                  objective="min-angle"):
+                  objective="min-angle", maximum_evaluations=400):
     """Applies a template, optimizes its control points, meshes it and measures the grid.
 
     Without *input_file* the pipeline is vtkBlockTemplateSource -> vtkBlockOptimizer ->
@@ -203,6 +205,8 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
     :param objective: what the optimizer improves (a key of :data:`OBJECTIVES`):
         "min-angle" (default, the smallest element angle), "non-orthogonality" (OpenFOAM's
         largest non-orthogonality) or "min-angle-and-size-ratio"
+    :param maximum_evaluations: the optimizer's trial budget (vtkBlockOptimizer's
+        MaximumEvaluations, 1 to 1000000; default 400)
     :returns: the vtkGridQuality algorithm after its update (port 0: the grid with the
         quality arrays; port 1: MinAngle class table; port 2: statistics table)
     :raises RuntimeError: when a stage (reader, template, mesher or quality) reports an
@@ -213,4 +217,4 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
     return _run_pipeline(template_file, parameters, density_multiplier, input_file,
                          allow_inverted_cells=allow_inverted_cells,
                          maximum_memory=maximum_memory, optimize=optimize,
-                         objective=objective)
+                         objective=objective, maximum_evaluations=maximum_evaluations)

@@ -1,6 +1,6 @@
 """Command line: ``python3 -m blockforge TEMPLATE [-i POINTS] [-o grid.vtm] [-p NAME=EXPR ...]
 [-d DENSITY] [-m GB] [--ascii] [--compress] [--allow-inverted-cells] [--no-optimize]
-[--objective NAME]``.
+[--objective NAME] [--max-evaluations N]``.
 
 Applies a template (to the point data of -i, read by the TurboPointSetsReader, for a
 template with inputs), optimizes its control points (the BlockOptimizer; --no-optimize
@@ -28,6 +28,17 @@ def _parse_parameter(text):
     if not sep or not name.strip():
         raise argparse.ArgumentTypeError(f"expected NAME=EXPRESSION, got '{printable(text)}'")
     return name.strip(), value.strip()
+
+
+def _parse_evaluations(text):
+    try:
+        count = int(text)
+    except ValueError:
+        count = 0
+    if not 1 <= count <= 1000000:
+        raise argparse.ArgumentTypeError(
+            f"needs a whole number from 1 to 1000000, got '{printable(text)}'")
+    return count
 
 
 def optimizer_lines(quality):
@@ -116,6 +127,9 @@ def main(argv=None):
     parser.add_argument("--objective", choices=sorted(blockforge.OBJECTIVES), default="min-angle",
                         help="what the optimizer improves (default min-angle: the smallest "
                              "element angle; non-orthogonality: OpenFOAM's largest)")
+    parser.add_argument("--max-evaluations", type=_parse_evaluations, default=400, metavar="N",
+                        help="the optimizer's trial budget (vtkBlockOptimizer's "
+                             "MaximumEvaluations; default 400, 1 to 1000000)")
     parser.add_argument("--no-optimize", action="store_true",
                         help="mesh the template's vertices as placed (default: the "
                              "BlockOptimizer moves the control points first)")
@@ -134,7 +148,8 @@ def main(argv=None):
                                            args.input, timings, args.allow_inverted_cells,
                                            warnings, args.max_memory,
                                            optimize=not args.no_optimize,
-                                           objective=args.objective)
+                                           objective=args.objective,
+                                           maximum_evaluations=args.max_evaluations)
     except (RuntimeError, MemoryError) as error:
         print(f"error: {printable(error) if str(error) else 'out of memory'}", file=sys.stderr)
         return 1

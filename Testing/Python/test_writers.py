@@ -6,6 +6,7 @@ and keep an older one."""
 import filecmp
 import json
 import os
+import re
 import resource
 import shutil
 import signal
@@ -237,8 +238,7 @@ class ErrorsTest(unittest.TestCase):
         if CLI:
             commands.append(("native", [CLI]))
         cases = [(label, command, output) for label, command in commands
-                 for output in ("case/c.foam", "grid.xyz", "grid.cgns") +
-                 (("grid.vtm",) if label == "python" else ())]
+                 for output in ("case/c.foam", "grid.xyz", "grid.cgns", "grid.vtm")]
         script = NO_SPACE_SCRIPT.format(disk=repr(os.path.join(folder, "disk")),
                                         cases=repr(cases), template=repr(CYLINDER))
         run = subprocess.run(["unshare", "-rm", sys.executable, "-c", script],
@@ -266,8 +266,7 @@ class ErrorsTest(unittest.TestCase):
         if CLI:
             commands.append(("native", [CLI]))
         for label, command in commands:
-            for output in ("case/c.foam", "grid.xyz", "grid.cgns") + (
-                    ("grid.vtm",) if label == "python" else ()):
+            for output in ("case/c.foam", "grid.xyz", "grid.cgns", "grid.vtm"):
                 with self.subTest(command=label, output=output):
                     target = os.path.join(folder, label, output)
                     small = subprocess.run(command + [CYLINDER, "-d", "0.5", "-o", target],
@@ -348,6 +347,81 @@ class NativeCommandLineTest(unittest.TestCase):
                              capture_output=True, text=True)
         self.assertEqual(run.returncode, 2)
         self.assertIn("--objective must be", run.stderr)
+
+    def test_vtm_same_blocks_names_points_as_python(self):
+        """The native .vtm (written without VTK) reads back with vtkXMLMultiBlockDataReader
+        as the Python command line's .vtm: the same blocks in the same order, the same
+        names, bit-identical points; pieces raw binary in a fresh NAME.pieces-ID/ folder;
+        writing again replaces the older pieces folder; --compress is refused clearly."""
+        from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataReader
+
+        folder = bftest.output_path("native_vtm")
+        shutil.rmtree(folder, ignore_errors=True)
+        cases = {"cylinder": [CYLINDER, "-d", "0.5"],
+                 "axial_oh": [AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "n_span=8"]}
+        for case, arguments in cases.items():
+            grids = {}
+            for label, command in (("python", [sys.executable, "-m", "blockforge"]),
+                                   ("native", [CLI])):
+                path = os.path.join(folder, case, label, "grid.vtm")
+                # pieces a killed run left (its process is gone) are removed by the next run
+                os.makedirs(os.path.join(folder, case, label, "grid.pieces-999999999-0badf00d"))
+                for _ in range(2):  # the second run replaces the first one's pieces
+                    run = subprocess.run(command + arguments + ["--no-optimize", "-o", path],
+                                         capture_output=True, text=True)
+                    self.assertEqual(run.returncode, 0, run.stderr)
+                entries = os.listdir(os.path.dirname(path))
+                self.assertEqual(len(entries), 2, entries)
+                pieces = next(e for e in entries if e != "grid.vtm")
+                self.assertRegex(pieces, r"^grid\.pieces-\d+-[0-9a-f]+$")
+                reader = vtkXMLMultiBlockDataReader()
+                reader.SetFileName(path)
+                reader.Update()
+                grids[label] = [(name, block.GetExtent(), bftest.points(block))
+                                for name, block in bftest.named_leaves(reader.GetOutput())]
+            self.assertGreater(len(grids["native"]), 3, case)
+            self.assertEqual(len(grids["native"]), len(grids["python"]), case)
+            for (name, dims, xyz), (py_name, py_dims, py_xyz) in zip(grids["native"],
+                                                                     grids["python"]):
+                self.assertEqual(name, py_name, case)
+                self.assertEqual(dims, py_dims, (case, name))
+                self.assertEqual(xyz.dtype, np.float64)
+                self.assertEqual(xyz.tobytes(), py_xyz.tobytes(), (case, name))
+        run = subprocess.run([CLI, CYLINDER, "--compress", "-o", os.path.join(folder, "z.vtm")],
+                             capture_output=True, text=True)
+        self.assertEqual(run.returncode, 2)
+        self.assertIn("--compress", run.stderr)
+        self.assertFalse(os.path.exists(os.path.join(folder, "z.vtm")))
+        blocker = os.path.join(folder, "a_file")
+        open(blocker, "w").close()
+        run = subprocess.run([CLI, CYLINDER, "-o", os.path.join(blocker, "grid.vtm")],
+                             capture_output=True, text=True)
+        self.assertEqual(run.returncode, 1)
+        self.assertIn("a_file", run.stderr)
+
+    def test_max_evaluations(self):
+        """--max-evaluations N: both command lines take the optimizer's trial budget and
+        write the same bytes; a budget that is not a positive whole number is refused."""
+        folder = bftest.output_path("max_evaluations")
+        shutil.rmtree(folder, ignore_errors=True)
+        arguments = [AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "n_span=8"]
+        for label, command in (("python", [sys.executable, "-m", "blockforge"]),
+                               ("native", [CLI])):
+            run = subprocess.run(command + arguments + ["--max-evaluations", "12", "-o",
+                                 os.path.join(folder, label, "grid.xyz")],
+                                 capture_output=True, text=True)
+            self.assertEqual(run.returncode, 0, run.stderr)
+            self.assertIn("optimizer: smallest element angle", run.stdout)
+            self.assertLessEqual(int(re.search(r"(\d+) evaluations", run.stdout).group(1)), 12)
+            for bad in ("0", "-3", "2.5", "many"):
+                run = subprocess.run(command + [CYLINDER, "--max-evaluations", bad, "-o",
+                                     os.path.join(folder, "bad.xyz")],
+                                     capture_output=True, text=True)
+                self.assertEqual(run.returncode, 2, (label, bad))
+                self.assertIn("--max-evaluations", run.stderr)
+                self.assertIn("whole number from 1 to 1000000", run.stderr)
+        self.assertTrue(filecmp.cmp(os.path.join(folder, "python", "grid.xyz"),
+                                    os.path.join(folder, "native", "grid.xyz"), shallow=False))
 
     def test_errors_name_the_problem(self):
         run = subprocess.run([CLI, os.path.join(SOURCE, "Testing", "Data", "bad_syntax.yaml"),
