@@ -178,7 +178,6 @@ namespace
 {
 const char* const StagingSuffix = ".staging";
 
-
 bool processAlive(long pid)
 {
   if (pid == static_cast<long>(::getpid()))
@@ -247,7 +246,8 @@ StagedOutput::StagedOutput(const std::string& target, Kind kind)
   char token[32];
   std::snprintf(token, sizeof(token), "%ld-%08llx", static_cast<long>(::getpid()),
     static_cast<unsigned long long>(generator() & 0xffffffffULL));
-  Staging = folderOf(target) + "/." + nameOf(target) + "." + token + StagingSuffix;
+  Token = token;
+  Staging = folderOf(target) + "/." + nameOf(target) + "." + Token + StagingSuffix;
   const int made = kind == Kind::Directory
     ? ::mkdir(Staging.c_str(), 0777)
     : ::open(Staging.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
@@ -365,6 +365,7 @@ void removeTree(const std::string& path)
   }
   ::unlink(path.c_str());
 }
+
 std::string writeFailureReason(const std::string& path, int error)
 {
   struct statvfs space;

@@ -118,10 +118,13 @@ public:
 
   /// The temporary path to write (the file, or the directory to fill).
   const std::string& path() const { return Staging; }
+  /// "<pid>-<hex>" of the staging name: companions of the output (the .vtm's pieces
+  /// folder) take it too, so stale ones are recognised the same way.
+  const std::string& token() const { return Token; }
   void publish();
 
 private:
-  std::string Target, Staging;
+  std::string Target, Staging, Token;
   Kind What;
   bool Published = false;
 };

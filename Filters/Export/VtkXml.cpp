@@ -21,7 +21,6 @@ namespace exporting
 namespace
 {
 const char* const PiecesMark = ".pieces-";
-const char* const StagingSuffix = ".staging";
 
 /// The target's name without its extension: the stem of the pieces folder's name.
 std::string stemOf(const std::string& name)
@@ -167,15 +166,11 @@ void writeVtkMultiBlock(const ExportGrid& grid, const std::string& path)
   StagedOutput staged(path, StagedOutput::Kind::Directory);
   const std::string folder = folderOf(path);
   const std::string stem = stemOf(nameOf(path));
-  // The staging folder is ".NAME.<pid>-<token>.staging": the pieces take its token, as
-  // blockforge.output's fresh companion names do.
-  const std::string stagingName = nameOf(staged.path());
-  const std::size_t tokenStart = nameOf(path).size() + 2;
-  const std::string token = stagingName.substr(
-    tokenStart, stagingName.size() - tokenStart - std::strlen(StagingSuffix));
+  // The pieces take the staging folder's token, as blockforge.output's fresh companion
+  // names do.
   const std::vector<std::string> referenced = referencedFolders(path);
   removeStalePieces(folder, stem, referenced);
-  const std::string pieces = stem + PiecesMark + token;
+  const std::string pieces = stem + PiecesMark + staged.token();
   const std::string stagedPieces = staged.path() + "/" + pieces;
   if (::mkdir(stagedPieces.c_str(), 0777) != 0)
   {

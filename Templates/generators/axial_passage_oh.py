@@ -284,7 +284,9 @@ def template_text():
         # each corner is searched on its own side only: from the edge towards side a (b)
         corners = (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+'))
         partners = {'a_f': 'b_f', 'b_f': 'a_f', 'a_r': 'b_r', 'b_r': 'a_r'}
-        near = lambda P: f'"(x - {P}.x)^2 + (y - {P}.y)^2 + (z - {P}.z)^2"'
+        # squared distance to vertex P, and as a quoted search objective
+        distance2 = lambda P: f'(x - {P}.x)^2 + (y - {P}.y)^2 + (z - {P}.z)^2'
+        near = lambda P: f'"{distance2(P)}"'
         for pass_ in ('h', 'q'):
             # h: the o_corner points and (g) their feet, for round_le/te; q: the corners before the
             # shear (at a sheared edge the unsheared one leans o_lean_shear)
@@ -304,13 +306,11 @@ def template_text():
             image = '-' if b[0] == 'b' else '+'
             far = f'o{e}_{l}.s {towards} dir_{l}*o_reach'
             cross = f'((axial - q{partner}_{l}.axial)*{e}_dy_{l} - rm_{l}*(theta - q{partner}_{l}.theta {image} pitch)*{e}_dx_{l})^2'
-            dq = f'(x - q{b}_{l}.x)^2 + (y - q{b}_{l}.y)^2 + (z - q{b}_{l}.z)^2'
-            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{min: "s{b}_{l} ? {cross} : {dq}", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{min: "s{b}_{l} ? {cross} : {distance2(f"q{b}_{l}")}", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
         for v, e, side, towards in corners:
             b = v[1:]  # the corner's foot on the blade
             # (nearest points by a search, not `project`: a search only places a helper once,
             # a projection would be redone at every step of the optimizer)
-            near = lambda P: f'"(x - {P}.x)^2 + (y - {P}.y)^2 + (z - {P}.z)^2"'
             w(f'  f{b}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"c{b}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
             # the foot kept o_tip (fraction of the loop) from the edge: at a sharp edge every
             # point of the O curve's arc round the tip projects onto the tip itself
@@ -319,9 +319,7 @@ def template_text():
             lim = f'max({off}, o_tip)' if towards == '+' else f'min({off}, -o_tip)'
             w(f'  k{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{lim}", fixed: true}}')
             w(f'  r{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"k{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
-            dr = f'(x - r{b}_{l}.x)^2 + (y - r{b}_{l}.y)^2 + (z - r{b}_{l}.z)^2'
-            dc = f'(x - c{b}_{l}.x)^2 + (y - c{b}_{l}.y)^2 + (z - c{b}_{l}.z)^2'
-            w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {dr} : {dc}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
+            w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {distance2(f"r{b}_{l}")} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
             w(f'  {b}_{l}: {{project: {v}_{l}, onto: blade_{l}}}')
         # a step along the O curve from the unsheared corner of a sheared edge towards the edge
         w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*probe : ob_f_{l}.s + dir_{l}*probe", fixed: true}}')
