@@ -7,6 +7,7 @@
  * Split from Quality.cpp, which keeps the grid pass over whole multiblock grids.
  */
 #include "Quality.h"
+#include "QualityInterfaces.h"
 #include "QualityKernels.h"
 
 #include <cmath>
@@ -48,20 +49,15 @@ double smallestMinAngle(const double* xyz, int ni, int nj, int nk)
   // hexFaceAngles' minAngle is angleFromCosine(largest corner cosine) for a cell without
   // collapsed edges: the largest cosine over the block gives the smallest of those angles.
   double largestCosine = -1.0, smallestCollapsed = 180.0;
-  bool anyCell = false;
-  const auto node = [&](int i, int j, int k) {
-    return load(xyz + 3 * (i + static_cast<std::size_t>(ni) * (j + static_cast<std::size_t>(nj) * k)));
-  };
-  for (int k = 0; k + 1 < nk; ++k)
+  const BlockView block(StructuredBlock{ xyz, ni, nj, nk });
+  for (int k = 0; k < block.ck; ++k)
   {
-    for (int j = 0; j + 1 < nj; ++j)
+    for (int j = 0; j < block.cj; ++j)
     {
-      for (int i = 0; i + 1 < ni; ++i)
+      for (int i = 0; i < block.ci; ++i)
       {
-        const P3 c[8] = { node(i, j, k), node(i + 1, j, k), node(i + 1, j + 1, k),
-          node(i, j + 1, k), node(i, j, k + 1), node(i + 1, j, k + 1),
-          node(i + 1, j + 1, k + 1), node(i, j + 1, k + 1) };
-        anyCell = true;
+        P3 c[8];
+        block.cellCorners(i, j, k, c);
         // As evaluateCellShape: edge vectors, lengths, the corners' cosines.
         P3 e[12];
         double length2[12], inverseLength[12];
@@ -88,7 +84,8 @@ double smallestMinAngle(const double* xyz, int ni, int nj, int nk)
       }
     }
   }
-  return anyCell ? std::min(angleFromCosine(largestCosine), smallestCollapsed) : 180.0;
+  return block.cellCount > 0 ? std::min(angleFromCosine(largestCosine), smallestCollapsed)
+                             : 180.0;
 }
 
 double hexScaledJacobian(const std::array<Vec3, 8>& corners)
