@@ -96,7 +96,7 @@ OBJECTIVES = {"min-angle": 0, "non-orthogonality": 1, "min-angle-and-size-ratio"
 def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_file=None,
                   timings=None, allow_inverted_cells=False, warnings=None,
                   maximum_memory=0.0, optimize=True, objective="min-angle",
-                  maximum_evaluations=400):
+                  maximum_evaluations=None):
     """:func:`mesh_template`; with a dict *timings*, also records the seconds of each
     stage under "read" (only with an input file), "template", "optimize" (unless
     *optimize* is false) and "mesh + quality"; with a list *warnings*, collects the stages'
@@ -130,7 +130,8 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
         optimizer.SetDensityMultiplier(float(density_multiplier))
         optimizer.SetMaximumMemory(float(maximum_memory))
         optimizer.SetObjective(OBJECTIVES[objective])
-        optimizer.SetMaximumEvaluations(int(maximum_evaluations))
+        if maximum_evaluations is not None:
+            optimizer.SetMaximumEvaluations(int(maximum_evaluations))
         optimizer.SetInputConnection(template.GetOutputPort())
         stages.append(("optimize", optimizer))
         model = optimizer
@@ -177,7 +178,7 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
 
 def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None,
                   allow_inverted_cells=False, maximum_memory=0.0, optimize=True,
-                  objective="min-angle", maximum_evaluations=400):
+                  objective="min-angle", maximum_evaluations=None):
     """Applies a template, optimizes its control points, meshes it and measures the grid.
 
     Without *input_file* the pipeline is vtkBlockTemplateSource -> vtkBlockOptimizer ->
@@ -206,7 +207,7 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
         "min-angle" (default, the smallest element angle), "non-orthogonality" (OpenFOAM's
         largest non-orthogonality) or "min-angle-and-size-ratio"
     :param maximum_evaluations: the optimizer's trial budget (vtkBlockOptimizer's
-        MaximumEvaluations, 1 to 1000000; default 400)
+        MaximumEvaluations, 1 to 1000000; default None: the optimizer's own, 400)
     :returns: the vtkGridQuality algorithm after its update (port 0: the grid with the
         quality arrays; port 1: MinAngle class table; port 2: statistics table)
     :raises RuntimeError: when a stage (reader, template, mesher or quality) reports an

@@ -127,7 +127,7 @@ def main(argv=None):
     parser.add_argument("--objective", choices=sorted(blockforge.OBJECTIVES), default="min-angle",
                         help="what the optimizer improves (default min-angle: the smallest "
                              "element angle; non-orthogonality: OpenFOAM's largest)")
-    parser.add_argument("--max-evaluations", type=_parse_evaluations, default=400, metavar="N",
+    parser.add_argument("--max-evaluations", type=_parse_evaluations, default=None, metavar="N",
                         help="the optimizer's trial budget (vtkBlockOptimizer's "
                              "MaximumEvaluations; default 400, 1 to 1000000)")
     parser.add_argument("--no-optimize", action="store_true",
