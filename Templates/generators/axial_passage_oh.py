@@ -108,6 +108,7 @@ parameters:
   o_shear: 0deg           # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg lifts the optimized distributor and Rotor 37 above 40 deg with 700 optimizer trials)
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
+  bisect_step: 0.005      # at a sheared edge the H lines bisect the blade direction and the O curve's at the unsheared corner, measured over this step along it (fraction of the loop)
   o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
   o_fan: 30               # ... where the edge block's outer chord is at most this many times its blade chord (sharper edges keep corners and feet on the tip: a fan)
   probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
@@ -245,7 +246,7 @@ def template_text():
         for e, f, ta, ua, base, sign in (('le', 'f', '-', 'sb_f', 'slope_in', '-'), ('te', 'r', '+', 'sb_r', 'slope_out', '')):
             U = lambda q: f'({ua}_{l} ? oa_{f}_{l}.{q} : ob_{f}_{l}.{q})'   # the unsheared corner
             x0 = f'(w{e}_{l}.axial - {U("axial")})'
-            y0 = f'rm_{l}*(w{e}_{l}.theta - {U("theta")})'
+            y0 = f'(rm_{l}*(w{e}_{l}.theta - {U("theta")}))'
             w(f'  {e}_bx_{l}: "{x0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_tx_{l}"      # bisector at a sheared edge')
             w(f'  {e}_by_{l}: "{y0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_ty_{l}"')
             w(f'  {base}_x_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
@@ -291,7 +292,7 @@ def template_text():
             # h: the o_corner points and (g) their feet, for round_le/te; q: the corners before the
             # shear (at a sheared edge the unsheared one leans o_lean_shear)
             for v, e, side, towards in corners:
-                c = 'o_corner' if pass_ == 'h' else f'(s{partners[v[1:]]}_{l} ? o_lean_shear : o_corner)'
+                c = 'o_corner' if pass_ == 'h' else f'(s{partners[v[1:]]}_{l} && {e}_shear_{l} ? o_lean_shear : o_corner)'
                 dx = f'(cos({c})*{e}_ux_{l} {side} sin({c})*{e}_vx_{l})'
                 dy = f'(cos({c})*{e}_uy_{l} {side} sin({c})*{e}_vy_{l})'
                 far = f'o{e}_{l}.s {towards} dir_{l}*o_window'
@@ -305,8 +306,9 @@ def template_text():
             partner = partners[b]
             image = '-' if b[0] == 'b' else '+'
             far = f'o{e}_{l}.s {towards} dir_{l}*o_reach'
+            near_end = f'(s{b}_{l} ? h{b}_{l}.s : o{e}_{l}.s)'   # a sheared corner at least as far from the edge as the o_corner point
             cross = f'((axial - q{partner}_{l}.axial)*{e}_dy_{l} - rm_{l}*(theta - q{partner}_{l}.theta {image} pitch)*{e}_dx_{l})^2'
-            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{min: "s{b}_{l} ? {cross} : {distance2(f"q{b}_{l}")}", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{min: "s{b}_{l} ? {cross} : {distance2(f"q{b}_{l}")}", within: ["min({near_end}, {far})", "max({near_end}, {far})"]}}, fixed: true}}')
         for v, e, side, towards in corners:
             b = v[1:]  # the corner's foot on the blade
             # (nearest points by a search, not `project`: a search only places a helper once,
@@ -322,8 +324,8 @@ def template_text():
             w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {distance2(f"r{b}_{l}")} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
             w(f'  {b}_{l}: {{project: {v}_{l}, onto: blade_{l}}}')
         # a step along the O curve from the unsheared corner of a sheared edge towards the edge
-        w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*probe : ob_f_{l}.s + dir_{l}*probe", fixed: true}}')
-        w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*probe : ob_r_{l}.s - dir_{l}*probe", fixed: true}}')
+        w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*bisect_step : ob_f_{l}.s + dir_{l}*bisect_step", fixed: true}}')
+        w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*bisect_step : ob_r_{l}.s - dir_{l}*bisect_step", fixed: true}}')
         # the sides' mid-points (where the periodic line's middle point lo_m looks across): half-way
         # along each side, between the corners' feet where the corners are sheared
         ga = f'dir_{l}*(fa_r_{l}.s - fa_f_{l}.s)'
