@@ -71,11 +71,14 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   from the edge; the mid-passage points follow (lo_f/lo_r half-way across, lo_m between
 #   the sides' mid-points), and the H lines up- or downstream of a sheared edge all leave
 #   along the bisector of the O curve's directions towards the edge at its two corners.
+#   On a layer that needs little shear the moved corner still sits at least as far from the
+#   partner as the two o_corner points are apart (along the O curve), so the block round
+#   the edge keeps the width it has unsheared (a sliver there got concave cells).
 #   Only at round edges (round_le/te: the O arc between the o_corner points at most o_fan
 #   times the blade arc between their feet): the edge block of a sharp edge is a fan on its
-#   tip, which a corner moved along one side folds. Off by default (o_shear 0); at 45deg the distributor's trailing edge and
-#   Rotor 37's edges are sheared; the compressor (sharp) and the turbine (stagger below
-#   45 deg) are not.
+#   tip, which a corner moved along one side folds. At the default 45deg the distributor's
+#   trailing edge and Rotor 37's edges are sheared; the compressor (sharp) and the turbine
+#   (stagger below 45 deg) are not (o_shear 0: no edge is).
 # - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
@@ -105,7 +108,7 @@ parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
-  o_shear: 0deg           # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg lifts the optimized distributor and Rotor 37 above 40 deg with 700 optimizer trials)
+  o_shear: 45deg          # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg: the optimized distributor and Rotor 37 reach 49 and 45 deg)
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   bisect_step: 0.005      # at a sheared edge the H lines bisect the blade direction and the O curve's at the unsheared corner, measured over this step along it (fraction of the loop)
@@ -241,7 +244,9 @@ def template_text():
         # At a sheared edge the unsheared corner sits o_lean_shear from the edge (its normal
         # leaning that far from the camber direction), and every H line up- or downstream
         # leaves along the bisector of the O curve's directions towards the edge at the two
-        # corners (at the unsheared one: towards w_le/w_te, probe along the O curve): the
+        # corners (at the unsheared one: towards w_le/w_te, bisect_step along the O curve, its
+        # direction there: a longer chord round a thin edge turns back along the other side and
+        # tilts the lines across the wake, twisting U_M/D_M between hub and shroud): the
         # block round the edge (U_M, D_M) gets about half their angle at each.
         for e, f, ta, ua, base, sign in (('le', 'f', '-', 'sb_f', 'slope_in', '-'), ('te', 'r', '+', 'sb_r', 'slope_out', '')):
             U = lambda q: f'({ua}_{l} ? oa_{f}_{l}.{q} : ob_{f}_{l}.{q})'   # the unsheared corner
@@ -292,7 +297,7 @@ def template_text():
             # h: the o_corner points and (g) their feet, for round_le/te; q: the corners before the
             # shear (at a sheared edge the unsheared one leans o_lean_shear)
             for v, e, side, towards in corners:
-                c = 'o_corner' if pass_ == 'h' else f'(s{partners[v[1:]]}_{l} && {e}_shear_{l} ? o_lean_shear : o_corner)'
+                c = 'o_corner' if pass_ == 'h' else f'(s{partners[v[1:]]}_{l} ? o_lean_shear : o_corner)'
                 dx = f'(cos({c})*{e}_ux_{l} {side} sin({c})*{e}_vx_{l})'
                 dy = f'(cos({c})*{e}_uy_{l} {side} sin({c})*{e}_vy_{l})'
                 far = f'o{e}_{l}.s {towards} dir_{l}*o_window'
@@ -300,13 +305,15 @@ def template_text():
                 if pass_ == 'h':
                     w(f'  g{v[1:]}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"h{v[1:]}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
         # the sheared corner: where the line along the sheared direction through its partner's
-        # image one pitch across (side b's partner one pitch up, side a's one down) meets the O curve
+        # image one pitch across (side b's partner one pitch up, side a's one down) meets the O curve,
         for v, e, side, towards in corners:
             b = v[1:]  # the corner's foot on the blade
             partner = partners[b]
             image = '-' if b[0] == 'b' else '+'
             far = f'o{e}_{l}.s {towards} dir_{l}*o_reach'
-            near_end = f'(s{b}_{l} ? h{b}_{l}.s : o{e}_{l}.s)'   # a sheared corner at least as far from the edge as the o_corner point
+            # searched from the partner plus the o_corner points' span (a layer that needs little
+            # shear keeps the unsheared width round the edge) out to o_reach from the edge
+            near_end = f'(s{b}_{l} ? q{partner}_{l}.s + h{b}_{l}.s - h{partner}_{l}.s : o{e}_{l}.s)'
             cross = f'((axial - q{partner}_{l}.axial)*{e}_dy_{l} - rm_{l}*(theta - q{partner}_{l}.theta {image} pitch)*{e}_dx_{l})^2'
             w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{min: "s{b}_{l} ? {cross} : {distance2(f"q{b}_{l}")}", within: ["min({near_end}, {far})", "max({near_end}, {far})"]}}, fixed: true}}')
         for v, e, side, towards in corners:
