@@ -84,9 +84,10 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 # Grading (Templates/README.md, laws `match`, `ends`, `project_from`), so that neighbour cells
 # across the block interfaces differ little at every density:
 # - the O-grid: geometric k_o away from the blade (its outer cell is what the H blocks start
-#   with); the blade sides `ends`, their end cells side_end times their mean cell (a
-#   number, not an expression of the corners: the optimizer's live model keeps laws as the
-#   template gave them); the O-grid's
+#   with); the blade sides `ends`, their end cells side_end times their mean cell, or
+#   side_fan next to a sharp edge's fan (o_fan), so that they shrink towards the fan's cells
+#   (numbers per edge, not expressions of the corners: the optimizer's live model keeps laws
+#   as the template gave them); the O-grid's
 #   outer sides the normal offsets of the blade sides' nodes (project_from); the edge blocks'
 #   outer arcs `match` (cells of their neighbours at both ends, growing by o_match towards
 #   the middle), their blade arcs the normal feet of the outer arcs' nodes (project_from:
