@@ -71,11 +71,14 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   from the edge; the mid-passage points follow (lo_f/lo_r half-way across, lo_m between
 #   the sides' mid-points), and the H lines up- or downstream of a sheared edge all leave
 #   along the bisector of the O curve's directions towards the edge at its two corners.
+#   On a layer that needs little shear the moved corner still sits at least as far from the
+#   partner as the two o_corner points are apart (along the O curve), so the block round
+#   the edge keeps the width it has unsheared (a sliver there got concave cells).
 #   Only at round edges (round_le/te: the O arc between the o_corner points at most o_fan
 #   times the blade arc between their feet): the edge block of a sharp edge is a fan on its
-#   tip, which a corner moved along one side folds. Off by default (o_shear 0); at 45deg the distributor's trailing edge and
-#   Rotor 37's edges are sheared; the compressor (sharp) and the turbine (stagger below
-#   45 deg) are not.
+#   tip, which a corner moved along one side folds. At the default 45deg the distributor's
+#   trailing edge and Rotor 37's edges are sheared; the compressor (sharp) and the turbine
+#   (stagger below 45 deg) are not (o_shear 0: no edge is).
 # - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
@@ -106,9 +109,10 @@ parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
-  o_shear: 0deg           # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg lifts the optimized distributor and Rotor 37 above 40 deg with 700 optimizer trials)
+  o_shear: 45deg          # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg: the optimized distributor and Rotor 37 reach 49 and 45 deg)
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
+  bisect_step: 0.005      # at a sheared edge the H lines bisect the blade direction and the O curve's at the unsheared corner, measured over this step along it (fraction of the loop)
   o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
   o_fan: 30               # ... where the edge block's outer chord is at most this many times its blade chord (sharper edges keep corners and feet on the tip: a fan)
   probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
@@ -243,12 +247,14 @@ def template_text():
         # At a sheared edge the unsheared corner sits o_lean_shear from the edge (its normal
         # leaning that far from the camber direction), and every H line up- or downstream
         # leaves along the bisector of the O curve's directions towards the edge at the two
-        # corners (at the unsheared one: towards w_le/w_te, probe along the O curve): the
+        # corners (at the unsheared one: towards w_le/w_te, bisect_step along the O curve, its
+        # direction there: a longer chord round a thin edge turns back along the other side and
+        # tilts the lines across the wake, twisting U_M/D_M between hub and shroud): the
         # block round the edge (U_M, D_M) gets about half their angle at each.
         for e, f, ta, ua, base, sign in (('le', 'f', '-', 'sb_f', 'slope_in', '-'), ('te', 'r', '+', 'sb_r', 'slope_out', '')):
             U = lambda q: f'({ua}_{l} ? oa_{f}_{l}.{q} : ob_{f}_{l}.{q})'   # the unsheared corner
             x0 = f'(w{e}_{l}.axial - {U("axial")})'
-            y0 = f'rm_{l}*(w{e}_{l}.theta - {U("theta")})'
+            y0 = f'(rm_{l}*(w{e}_{l}.theta - {U("theta")}))'
             w(f'  {e}_bx_{l}: "{x0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_tx_{l}"      # bisector at a sheared edge')
             w(f'  {e}_by_{l}: "{y0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_ty_{l}"')
             w(f'  {base}_x_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
@@ -302,14 +308,17 @@ def template_text():
                 if pass_ == 'h':
                     w(f'  g{v[1:]}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"h{v[1:]}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
         # the sheared corner: where the line along the sheared direction through its partner's
-        # image one pitch across (side b's partner one pitch up, side a's one down) meets the O curve
+        # image one pitch across (side b's partner one pitch up, side a's one down) meets the O curve,
         for v, e, side, towards in corners:
             b = v[1:]  # the corner's foot on the blade
             partner = partners[b]
             image = '-' if b[0] == 'b' else '+'
             far = f'o{e}_{l}.s {towards} dir_{l}*o_reach'
+            # searched from the partner plus the o_corner points' span (a layer that needs little
+            # shear keeps the unsheared width round the edge) out to o_reach from the edge
+            near_end = f'(s{b}_{l} ? q{partner}_{l}.s + h{b}_{l}.s - h{partner}_{l}.s : o{e}_{l}.s)'
             cross = f'((axial - q{partner}_{l}.axial)*{e}_dy_{l} - rm_{l}*(theta - q{partner}_{l}.theta {image} pitch)*{e}_dx_{l})^2'
-            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{min: "s{b}_{l} ? {cross} : {distance2(f"q{b}_{l}")}", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{min: "s{b}_{l} ? {cross} : {distance2(f"q{b}_{l}")}", within: ["min({near_end}, {far})", "max({near_end}, {far})"]}}, fixed: true}}')
         for v, e, side, towards in corners:
             b = v[1:]  # the corner's foot on the blade
             # (nearest points by a search, not `project`: a search only places a helper once,
@@ -325,8 +334,8 @@ def template_text():
             w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {distance2(f"r{b}_{l}")} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
             w(f'  {b}_{l}: {{project: {v}_{l}, onto: blade_{l}}}')
         # a step along the O curve from the unsheared corner of a sheared edge towards the edge
-        w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*probe : ob_f_{l}.s + dir_{l}*probe", fixed: true}}')
-        w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*probe : ob_r_{l}.s - dir_{l}*probe", fixed: true}}')
+        w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*bisect_step : ob_f_{l}.s + dir_{l}*bisect_step", fixed: true}}')
+        w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*bisect_step : ob_r_{l}.s - dir_{l}*bisect_step", fixed: true}}')
         # the sides' mid-points (where the periodic line's middle point lo_m looks across): half-way
         # along each side, between the corners' feet where the corners are sheared
         ga = f'dir_{l}*(fa_r_{l}.s - fa_f_{l}.s)'
