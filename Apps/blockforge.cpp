@@ -68,7 +68,7 @@ const char* const Usage =
   "  --objective NAME        what the optimizer improves: min-angle (default, the\n"
   "                          smallest element angle), non-orthogonality (OpenFOAM's\n"
   "                          largest) or min-angle-and-size-ratio\n"
-  "  --max-evaluations N     the optimizer's trial budget (default 400, 1 to 1000000)\n"
+  "  --max-evaluations N     the optimizer's trial budget (default 700, 1 to 1000000)\n"
   "The grid is written under a temporary name and moved into place: a failure leaves no\n"
   "partial grid and keeps an older one. Exit status 1 with a message on any error.\n";
 

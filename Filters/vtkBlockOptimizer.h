@@ -68,7 +68,7 @@ public:
   ///@}
 
   ///@{
-  /// Largest number of grid evaluations of the automatic run (default 400; 700 for axial_passage_oh with o_shear 45deg); the compass
+  /// Largest number of grid evaluations of the automatic run (default 700; a run that stops gaining ends at 400, see SearchSettings::stallAfter); the compass
   /// search counts the trials it leaves out because they cannot gain as evaluations.
   vtkSetClampMacro(MaximumEvaluations, int, 1, 1000000);
   vtkGetMacro(MaximumEvaluations, int);
@@ -164,7 +164,7 @@ protected:
 
   int Objective = MIN_ANGLE;
   int Algorithm = COMPASS;
-  int MaximumEvaluations = 400;
+  int MaximumEvaluations = 700;
   double Tolerance = 1.0e-3;
   double DensityMultiplier = 1.0;
   double MaximumMemory = 0.0;

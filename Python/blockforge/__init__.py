@@ -207,7 +207,7 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
         "min-angle" (default, the smallest element angle), "non-orthogonality" (OpenFOAM's
         largest non-orthogonality) or "min-angle-and-size-ratio"
     :param maximum_evaluations: the optimizer's trial budget (vtkBlockOptimizer's
-        MaximumEvaluations, 1 to 1000000; default None: the optimizer's own, 400)
+        MaximumEvaluations, 1 to 1000000; default None: the optimizer's own, 700)
     :returns: the vtkGridQuality algorithm after its update (port 0: the grid with the
         quality arrays; port 1: MinAngle class table; port 2: statistics table)
     :raises RuntimeError: when a stage (reader, template, mesher or quality) reports an

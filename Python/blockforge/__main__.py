@@ -129,7 +129,7 @@ def main(argv=None):
                              "element angle; non-orthogonality: OpenFOAM's largest)")
     parser.add_argument("--max-evaluations", type=_parse_evaluations, default=None, metavar="N",
                         help="the optimizer's trial budget (vtkBlockOptimizer's "
-                             "MaximumEvaluations; default 400, 1 to 1000000)")
+                             "MaximumEvaluations; default 700, 1 to 1000000)")
     parser.add_argument("--no-optimize", action="store_true",
                         help="mesh the template's vertices as placed (default: the "
                              "BlockOptimizer moves the control points first)")

@@ -71,11 +71,14 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   from the edge; the mid-passage points follow (lo_f/lo_r half-way across, lo_m between
 #   the sides' mid-points), and the H lines up- or downstream of a sheared edge all leave
 #   along the bisector of the O curve's directions towards the edge at its two corners.
+#   On a layer that needs little shear the moved corner still sits at least as far from the
+#   partner as the two o_corner points are apart (along the O curve), so the block round
+#   the edge keeps the width it has unsheared (a sliver there got concave cells).
 #   Only at round edges (round_le/te: the O arc between the o_corner points at most o_fan
 #   times the blade arc between their feet): the edge block of a sharp edge is a fan on its
-#   tip, which a corner moved along one side folds. Off by default (o_shear 0); at 45deg the distributor's trailing edge and
-#   Rotor 37's edges are sheared; the compressor (sharp) and the turbine (stagger below
-#   45 deg) are not.
+#   tip, which a corner moved along one side folds. At the default 45deg the distributor's
+#   trailing edge and Rotor 37's edges are sheared; the compressor (sharp) and the turbine
+#   (stagger below 45 deg) are not (o_shear 0: no edge is).
 # - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
@@ -84,9 +87,10 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 # Grading (Templates/README.md, laws `match`, `ends`, `project_from`), so that neighbour cells
 # across the block interfaces differ little at every density:
 # - the O-grid: geometric k_o away from the blade (its outer cell is what the H blocks start
-#   with); the blade sides `ends`, their end cells side_end times their mean cell (a
-#   number, not an expression of the corners: the optimizer's live model keeps laws as the
-#   template gave them); the O-grid's
+#   with); the blade sides `ends`, their end cells side_end times their mean cell, or
+#   side_fan next to a sharp edge's fan (o_fan), so that they shrink towards the fan's cells
+#   (numbers per edge, not expressions of the corners: the optimizer's live model keeps laws
+#   as the template gave them); the O-grid's
 #   outer sides the normal offsets of the blade sides' nodes (project_from); the edge blocks'
 #   outer arcs `match` (cells of their neighbours at both ends, growing by o_match towards
 #   the middle), their blade arcs the normal feet of the outer arcs' nodes (project_from:
@@ -105,9 +109,10 @@ parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
-  o_shear: 0deg           # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg lifts the optimized distributor and Rotor 37 above 40 deg with 700 optimizer trials)
+  o_shear: 45deg          # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg: the optimized distributor and Rotor 37 reach 49 and 45 deg)
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
+  bisect_step: 0.005      # at a sheared edge the H lines bisect the blade direction and the O curve's at the unsheared corner, measured over this step along it (fraction of the loop)
   o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
   o_fan: 30               # ... where the edge block's outer chord is at most this many times its blade chord (sharper edges keep corners and feet on the tip: a fan)
   probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
@@ -126,20 +131,21 @@ parameters:
   n_span: 12              # cells from hub to shroud
   k_o: 1.15               # expansion ratio away from the blade in the O-grid
   k_span: 1.05            # expansion ratio away from hub and shroud (two-sided)
-  side_end: 0.35          # blade sides (and the periodic lines beside them): end cells this fraction of their mean cell, towards the edge blocks' cells
+  side_end: 0.35          # blade sides (and the periodic lines beside them): end cells this fraction of their mean cell, towards the edge blocks' cells ...
+  side_fan: 0.03          # ... the same at a sharp edge whose edge block is a fan on the tip (o_fan)
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
 """
 
 FOOTER = """blocks:
   O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_le_h}, E5: {project_from: ol_le_s}}}}
-  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [side_end, side_end]}, E3: {project_from: bl_a_h}, E5: {ends: [side_end, side_end]}, E7: {project_from: bl_a_s}}}}
+  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_le_h, se_te_h]}, E3: {project_from: bl_a_h}, E5: {ends: [se_le_s, se_te_s]}, E7: {project_from: bl_a_s}}}}
   O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
-  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [side_end, side_end]}, E3: {project_from: bl_b_h}, E5: {ends: [side_end, side_end]}, E7: {project_from: bl_b_s}}}}
+  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_te_h, se_le_h]}, E3: {project_from: bl_b_h}, E5: {ends: [se_te_s, se_le_s]}, E7: {project_from: bl_b_s}}}}
   U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
-  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {project_from: bl_a_h}, E4: {ends: [side_end, side_end]}, E6: {project_from: bl_a_s}, E8: {ends: [side_end, side_end]}}}}
-  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {ends: [side_end, side_end]}, E4: {project_from: bl_b_h}, E6: {ends: [side_end, side_end]}, E8: {project_from: bl_b_s}}}}
+  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {project_from: bl_a_h}, E4: {ends: [se_le_h, se_te_h]}, E6: {project_from: bl_a_s}, E8: {ends: [se_le_s, se_te_s]}}}}
+  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {ends: [se_le_h, se_te_h]}, E4: {project_from: bl_b_h}, E6: {ends: [se_le_s, se_te_s]}, E8: {project_from: bl_b_s}}}}
   D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
@@ -200,6 +206,7 @@ def template_text():
             outer = f'sqrt((r{a}_{l}.axial - r{b}_{l}.axial)^2 + (rm_{l}*(r{a}_{l}.theta - r{b}_{l}.theta))^2)'
             inner = f'sqrt((k{a}_{l}.axial - k{b}_{l}.axial)^2 + (rm_{l}*(k{a}_{l}.theta - k{b}_{l}.theta))^2)'
             w(f'  off_{e}_{l}: "{outer} <= o_fan*{inner}"')
+            w(f'  se_{e}_{l}: "off_{e}_{l} ? side_end : side_fan"      # the blade sides\' relative end cells at this edge')
         # H lines upstream / downstream: slope d(r theta)/d(axial distance from the O-grid)
         w(f'  slope_in_{l}: "tan(follow_le*atan2(le_uy_{l}, -le_ux_{l}))"')
         w(f'  slope_out_{l}: "tan(follow_te*atan2(te_uy_{l}, te_ux_{l}))"')
@@ -240,12 +247,14 @@ def template_text():
         # At a sheared edge the unsheared corner sits o_lean_shear from the edge (its normal
         # leaning that far from the camber direction), and every H line up- or downstream
         # leaves along the bisector of the O curve's directions towards the edge at the two
-        # corners (at the unsheared one: towards w_le/w_te, probe along the O curve): the
+        # corners (at the unsheared one: towards w_le/w_te, bisect_step along the O curve, its
+        # direction there: a longer chord round a thin edge turns back along the other side and
+        # tilts the lines across the wake, twisting U_M/D_M between hub and shroud): the
         # block round the edge (U_M, D_M) gets about half their angle at each.
         for e, f, ta, ua, base, sign in (('le', 'f', '-', 'sb_f', 'slope_in', '-'), ('te', 'r', '+', 'sb_r', 'slope_out', '')):
             U = lambda q: f'({ua}_{l} ? oa_{f}_{l}.{q} : ob_{f}_{l}.{q})'   # the unsheared corner
             x0 = f'(w{e}_{l}.axial - {U("axial")})'
-            y0 = f'rm_{l}*(w{e}_{l}.theta - {U("theta")})'
+            y0 = f'(rm_{l}*(w{e}_{l}.theta - {U("theta")}))'
             w(f'  {e}_bx_{l}: "{x0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_tx_{l}"      # bisector at a sheared edge')
             w(f'  {e}_by_{l}: "{y0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_ty_{l}"')
             w(f'  {base}_x_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
@@ -299,14 +308,17 @@ def template_text():
                 if pass_ == 'h':
                     w(f'  g{v[1:]}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"h{v[1:]}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
         # the sheared corner: where the line along the sheared direction through its partner's
-        # image one pitch across (side b's partner one pitch up, side a's one down) meets the O curve
+        # image one pitch across (side b's partner one pitch up, side a's one down) meets the O curve,
         for v, e, side, towards in corners:
             b = v[1:]  # the corner's foot on the blade
             partner = partners[b]
             image = '-' if b[0] == 'b' else '+'
             far = f'o{e}_{l}.s {towards} dir_{l}*o_reach'
+            # searched from the partner plus the o_corner points' span (a layer that needs little
+            # shear keeps the unsheared width round the edge) out to o_reach from the edge
+            near_end = f'(s{b}_{l} ? q{partner}_{l}.s + h{b}_{l}.s - h{partner}_{l}.s : o{e}_{l}.s)'
             cross = f'((axial - q{partner}_{l}.axial)*{e}_dy_{l} - rm_{l}*(theta - q{partner}_{l}.theta {image} pitch)*{e}_dx_{l})^2'
-            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{min: "s{b}_{l} ? {cross} : {distance2(f"q{b}_{l}")}", within: ["min(o{e}_{l}.s, {far})", "max(o{e}_{l}.s, {far})"]}}, fixed: true}}')
+            w(f'  c{b}_{l}: {{on_curve: o_{l}, at: {{min: "s{b}_{l} ? {cross} : {distance2(f"q{b}_{l}")}", within: ["min({near_end}, {far})", "max({near_end}, {far})"]}}, fixed: true}}')
         for v, e, side, towards in corners:
             b = v[1:]  # the corner's foot on the blade
             # (nearest points by a search, not `project`: a search only places a helper once,
@@ -322,8 +334,8 @@ def template_text():
             w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {distance2(f"r{b}_{l}")} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
             w(f'  {b}_{l}: {{project: {v}_{l}, onto: blade_{l}}}')
         # a step along the O curve from the unsheared corner of a sheared edge towards the edge
-        w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*probe : ob_f_{l}.s + dir_{l}*probe", fixed: true}}')
-        w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*probe : ob_r_{l}.s - dir_{l}*probe", fixed: true}}')
+        w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*bisect_step : ob_f_{l}.s + dir_{l}*bisect_step", fixed: true}}')
+        w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*bisect_step : ob_r_{l}.s - dir_{l}*bisect_step", fixed: true}}')
         # the sides' mid-points (where the periodic line's middle point lo_m looks across): half-way
         # along each side, between the corners' feet where the corners are sheared
         ga = f'dir_{l}*(fa_r_{l}.s - fa_f_{l}.s)'

@@ -493,28 +493,29 @@ TEST(OptimizerPassage, TrialsLeftOutChangeNoStep)
 }
 
 /**
- * Issue 9's target: axial_passage_oh with sheared O corners (o_shear 45deg, not yet the
- * template's default) on the distributor and on Rotor 37, the automatic run with a budget
- * of 700 trials and the stall rule: no element angle below 40 degrees (42.31 and 42.03
- * when written), no cell in MinAngle class 0-20 or 20-40, within 700 trials (a bound on
- * the time that does not depend on the machine). Without the shear the same run stays
- * at 34.7 and 31.8 degrees: the shear is what lifts it.
+ * Issue 9's target: axial_passage_oh at its defaults (sheared O corners, o_shear 45deg) on
+ * the distributor and on Rotor 37, the automatic run at its defaults (700 trials with the
+ * stall rule): no element angle below 40 degrees, aiming at 45 (49.05 and 44.89 when
+ * written), no cell in MinAngle class 0-20 or 20-40, within 700 trials (a bound on the
+ * time that does not depend on the machine). Without the shear (o_shear 0) the same run
+ * stays at 34.7 and 31.8 degrees: the shear is what lifts it.
  */
 TEST(OptimizerPassage, ShearedOGridReachesFortyDegrees)
 {
-  for (const char* machine : { "distributor", "rotor37/turbogrid" })
+  for (const auto& [machine, bound] :
+    { std::pair<const char*, double>{ "distributor", 48.5 }, { "rotor37/turbogrid", 44.5 } })
   {
     SCOPED_TRACE(machine);
     Loaded loaded;
     const model::TemplateInputs inputs = test::readTemplateInputs(
       std::string(BLOCKFORGE_SOURCE_DIR) + "/Data/" + machine + "/BladeGen.inf");
-    loaded.model = model::loadTemplate(test::templatePath("axial_passage_oh.yaml"),
-      { { "o_shear", "45deg" } }, &inputs, &loaded.geometry);
-    OptimizerSettings settings;
-    settings.search.maxEvaluations = 700;
+    loaded.model = model::loadTemplate(
+      test::templatePath("axial_passage_oh.yaml"), {}, &inputs, &loaded.geometry);
+    const OptimizerSettings settings;
+    EXPECT_EQ(settings.search.maxEvaluations, 700);
     const OptimizerResult result = optimizeModel(loaded.model, loaded.geometry, settings);
     EXPECT_TRUE(result.after.feasible);
-    EXPECT_GT(result.after.minAngle, 41.5);
+    EXPECT_GT(result.after.minAngle, bound);
     EXPECT_EQ(result.after.classes[0], 0);
     EXPECT_EQ(result.after.classes[1], 0);
     EXPECT_LE(result.search.evaluations + result.search.skipped, 700);

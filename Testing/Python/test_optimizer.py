@@ -66,7 +66,7 @@ class OptimizerProxyTest(unittest.TestCase):
         source = BlockTemplateSource(TemplateFile=SYMMETRIC)
         optimizer = BlockOptimizer(Input=source, Tolerance=1e-12)
         self.assertEqual(optimizer.Objective, "MinAngle")
-        self.assertEqual(optimizer.MaximumEvaluations, 400)
+        self.assertEqual(optimizer.MaximumEvaluations, 700)
         self.assertEqual(optimizer.Algorithm, "Compass")
         optimizer.UpdatePipeline()
         model = servermanager.Fetch(optimizer)

@@ -33,10 +33,10 @@ struct SearchSettings
   /// BOBYQA, with evaluations about 5 times cheaper (README, "The optimizer").
   SearchAlgorithm algorithm = SearchAlgorithm::Compass;
   /// Evaluations at most (compass: trials, evaluated or left out by a TrialFilter).
-  /// With axial_passage_oh's sheared O corners (o_shear) give 700: the compass search still
-  /// gains 1-2 degrees per 100 trials after 400 (Rotor 37 reaches 40 degrees after about 580
-  /// trials, the distributor after about 540; Benchmark/OPTIMIZER_LIMITS.md, section 7).
-  int maxEvaluations = 400;
+  /// 700: on axial_passage_oh's sheared O corners (its default o_shear) the compass search
+  /// still gains 1-3 degrees a pass after 400 trials (distributor 42.5 degrees at 400, 49.1
+  /// at 700; Rotor 37 44.3 and 44.9); runs that stop gaining end at stallAfter (below).
+  int maxEvaluations = 700;
   /// Compass: at this many trials the search goes on only when its last complete pass
   /// gained at least stallGain (degrees for the angle objectives), and then until a pass
   /// gains less: a case that has stopped gaining ends where a budget of stallAfter
