@@ -69,25 +69,42 @@ Vec3 SubCurve::derivative(double t, int order) const
   return Base->derivative(map(t), order) * (order == 1 ? scale : scale * scale);
 }
 
-std::vector<double> SubCurve::breakpoints() const
+namespace
 {
-  std::vector<double> base = Base->breakpoints();
-  base.insert(base.begin(), 0.0);
-  base.push_back(1.0);
-  const double low = std::min(U0, U1), high = std::max(U0, U1);
-  std::vector<double> inner;
-  const double firstTurn = Closed ? std::floor(low) : 0.0, lastTurn = Closed ? std::floor(high) : 0.0;
+/**
+ * Appends to `out` the parameters u in (0, 1) at which x = from + u (to - from) passes a
+ * value of `marks` or 0 or 1 (where a curve or surface may kink), or, when `closed`, one
+ * of those plus a whole number of turns (the seam, and the marks again past it).
+ */
+void addCrossings(std::vector<double> marks, double from, double to, bool closed,
+  std::vector<double>& out)
+{
+  if (from == to)
+  {
+    return;
+  }
+  marks.insert(marks.begin(), 0.0);
+  marks.push_back(1.0);
+  const double low = std::min(from, to), high = std::max(from, to);
+  const double firstTurn = closed ? std::floor(low) : 0.0, lastTurn = closed ? std::floor(high) : 0.0;
   for (double turn = firstTurn; turn <= lastTurn; turn += 1.0)
   {
-    for (const double b : base)
+    for (const double mark : marks)
     {
-      const double t = (turn + b - U0) / (U1 - U0);
-      if (t > 0.0 && t < 1.0)
+      const double u = (turn + mark - from) / (to - from);
+      if (u > 0.0 && u < 1.0)
       {
-        inner.push_back(t);
+        out.push_back(u);
       }
     }
   }
+}
+} // namespace
+
+std::vector<double> SubCurve::breakpoints() const
+{
+  std::vector<double> inner;
+  addCrossings(Base->breakpoints(), U0, U1, Closed, inner);
   std::sort(inner.begin(), inner.end());
   return inner;
 }
@@ -115,31 +132,8 @@ Eigen::Vector2d ParameterLineCurve::parameters(double u) const
 std::vector<double> ParameterLineCurve::breakpoints() const
 {
   std::vector<double> result;
-  for (const int k : { 0, 1 })
-  {
-    const double from = From[k], to = To[k];
-    if (from == to)
-    {
-      continue;
-    }
-    std::vector<double> across = TheSurface->breakpoints(k == 1);
-    across.insert(across.begin(), 0.0);
-    across.push_back(1.0);
-    const bool closed = k == 0 ? ClosedS : ClosedT;
-    const double low = std::min(from, to), high = std::max(from, to);
-    const double firstTurn = closed ? std::floor(low) : 0.0, lastTurn = closed ? std::floor(high) : 0.0;
-    for (double turn = firstTurn; turn <= lastTurn; turn += 1.0)
-    {
-      for (const double b : across)
-      {
-        const double u = (turn + b - from) / (to - from);
-        if (u > 0.0 && u < 1.0)
-        {
-          result.push_back(u);
-        }
-      }
-    }
-  }
+  addCrossings(TheSurface->breakpoints(false), From[0], To[0], ClosedS, result);
+  addCrossings(TheSurface->breakpoints(true), From[1], To[1], ClosedT, result);
   std::sort(result.begin(), result.end());
   return result;
 }
