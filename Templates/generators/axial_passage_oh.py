@@ -87,10 +87,11 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 # Grading (Templates/README.md, laws `match`, `ends`, `project_from`), so that neighbour cells
 # across the block interfaces differ little at every density:
 # - the O-grid: geometric k_o away from the blade (its outer cell is what the H blocks start
-#   with); the blade sides `ends`, their end cells side_end times their mean cell, or
-#   side_fan next to a sharp edge's fan (o_fan), so that they shrink towards the fan's cells
-#   (numbers per edge, not expressions of the corners: the optimizer's live model keeps laws
-#   as the template gave them); the O-grid's
+#   with); the blade sides `ends`, their end cells side_end times their mean cell, side_shear
+#   next to a sheared edge, or side_fan next to a sharp edge's fan (o_fan), so that they
+#   shrink towards the edge block's cells (numbers per edge, not expressions of the corners:
+#   the optimizer's live model keeps laws as the template gave them), `flat` side_flat so
+#   that their middle cells stay near their mean cell; the O-grid's
 #   outer sides the normal offsets of the blade sides' nodes (project_from); the edge blocks'
 #   outer arcs `match` (cells of their neighbours at both ends, growing by o_match towards
 #   the middle), their blade arcs the normal feet of the outer arcs' nodes (project_from:
@@ -133,7 +134,7 @@ parameters:
   k_span: 1.05            # expansion ratio away from hub and shroud (two-sided)
   side_end: 0.35          # blade sides (and the periodic lines beside them): end cells this fraction of their mean cell, towards the edge blocks' cells ...
   side_fan: 0.03          # ... the same at a sharp edge whose edge block is a fan on the tip (o_fan) ...
-  side_shear: 0.15        # ... and at a sheared edge (o_shear)
+  side_shear: 0.2         # ... and at a sheared edge (o_shear)
   side_flat: 3            # flatness of the sides' grading between its end cells (law `ends`, `flat`): their middle cells stay near the mean however small the ends
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
 """

@@ -39,8 +39,8 @@ using test::Pi;
  * axial_passage_oh grades its edge blocks' O-grid arcs and every H edge with `match`, the
  * blade sides towards the edge blocks (`ends`), the O-grid's outer sides and the edge
  * blocks' blade arcs as normal feet and offsets (`project_from`), the sides' end cells
- * 0.35 of their mean at round edges, 0.15 at sheared ones (o_shear), 0.03 next to a sharp
- * edge's fan: measured 8.5-22.9 on Rotor 37, 3.5-4.2 on the distributor, 9.0-50.1 on the
+ * 0.35 of their mean at round edges, 0.2 at sheared ones (o_shear), 0.03 next to a sharp
+ * edge's fan: measured 9.7-25.5 on Rotor 37, 4.0-4.5 on the distributor, 9.0-50.1 on the
  * turbine and 5.0-20.3 on the compressor (their sheared, capped and sharp edges' blocks
  * against the blade sides, growing with the density; with 0.35 everywhere 12.1-31.4,
  * 5.2-5.5, 9.0-50.1, 27-70; 28-570 before the grading). Its bound keeps it from getting
