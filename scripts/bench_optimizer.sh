@@ -25,35 +25,45 @@ cd "$root"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-# Median wall time of a whole process, in seconds.
-median_seconds() {
-  local times=() start end
-  for ((r = 0; r < repetitions; ++r)); do
-    start=$(date +%s.%N)
-    "$@" >/dev/null
-    end=$(date +%s.%N)
-    times+=("$(echo "$end - $start" | bc -l)")
-  done
-  printf '%s\n' "${times[@]}" | sort -g | awk '{v[NR] = $1} END {
+# Median of numbers, one a line.
+median() {
+  sort -g | awk '{v[NR] = $1} END {
     if (NR % 2) print v[(NR + 1) / 2]; else print (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
 }
 
+# Median wall time and median CPU time (user + system) of a whole process, in seconds: the
+# CPU time depends little on what else runs on the machine, the wall time does.
+median_seconds() {
+  local times=() cpus=() start end
+  for ((r = 0; r < repetitions; ++r)); do
+    start=$(date +%s.%N)
+    /usr/bin/time -f '%U %S' -o "$work/cpu" "$@" >/dev/null
+    end=$(date +%s.%N)
+    times+=("$(echo "$end - $start" | bc -l)")
+    cpus+=("$(awk '{print $1 + $2}' "$work/cpu")")
+  done
+  echo "$(printf '%s\n' "${times[@]}" | median) $(printf '%s\n' "${cpus[@]}" | median)"
+}
+
 process="$work/process.csv"
-echo "template,input,optimize_seconds,no_optimize_seconds" >"$process"
+echo "template,input,optimize_seconds,no_optimize_seconds,optimize_cpu_seconds" >"$process"
+load_before=$(cut -d' ' -f1-3 /proc/loadavg)
 for ((c = 0; c < ${#cases[@]}; c += 2)); do
   template=${cases[c]} input=${cases[c + 1]}
-  with=$(median_seconds "$build/bin/blockforge" "$template" -i "$input" -o "$work/grid.xyz")
-  without=$(median_seconds "$build/bin/blockforge" "$template" -i "$input" -o "$work/grid.xyz" \
-    --no-optimize)
+  read -r with with_cpu < <(median_seconds "$build/bin/blockforge" "$template" -i "$input" \
+    -o "$work/grid.xyz")
+  read -r without _ < <(median_seconds "$build/bin/blockforge" "$template" -i "$input" \
+    -o "$work/grid.xyz" --no-optimize)
   name=$(basename "$template" .yaml)
-  echo "$name,$input,$with,$without" >>"$process"
+  echo "$name,$input,$with,$without,$with_cpu" >>"$process"
 done
 
 {
   echo "# BlockOptimizer benchmark"
   echo
   echo "\`scripts/bench_optimizer.sh $*\` at commit $(git rev-parse --short HEAD), $(nproc) cores," \
-    "load average $(cut -d' ' -f1-3 /proc/loadavg), $(date -u +%Y-%m-%d)."
+    "load average $load_before before the command lines, $(cut -d' ' -f1-3 /proc/loadavg) at the end," \
+    "$(date -u +%Y-%m-%d)."
   echo "Classes: cells per MinAngle class 0-20 / 20-40 / 40-60 / 60-80 / 80-90 degrees."
   echo "In process (\`bench_optimizer\`): the automatic run alone, median of $repetitions."
   echo
@@ -61,13 +71,14 @@ done
     "${cases[@]}"
   echo
   echo "Whole process, the native command line \`blockforge TEMPLATE -i INPUT -o grid.xyz\`"
-  echo "(read, template, optimizer, mesh, Plot3D write), median of $repetitions:"
+  echo "(read, template, optimizer, mesh, Plot3D write), median of $repetitions, wall time (and CPU"
+  echo "time, user + system, with the optimizer):"
   echo
   echo "| case | with the optimizer | --no-optimize | the optimizer's share |"
   echo "|---|---|---|---|"
-  tail -n +2 "$process" | while IFS=, read -r name input with without; do
-    printf '| %s, %s | %.2f s | %.2f s | %.2f s |\n' "$name" "$input" "$with" "$without" \
-      "$(echo "$with - $without" | bc -l)"
+  tail -n +2 "$process" | while IFS=, read -r name input with without with_cpu; do
+    printf '| %s, %s | %.2f s (%.2f s) | %.2f s | %.2f s |\n' "$name" "$input" "$with" \
+      "$with_cpu" "$without" "$(echo "$with - $without" | bc -l)"
   done
   echo
   echo "Where the smallest angles are held, what was tried and what lifts them (the skewed"

@@ -671,6 +671,20 @@ inline Vec3 weightedSum(const double* weights, const Vec3* points, int degree)
 }
 } // namespace
 
+std::vector<double> BSplineCurve::breakpoints() const
+{
+  std::vector<double> inner;
+  for (std::size_t i = Degree + 1; i + Degree + 1 < Knots.size(); ++i)
+  {
+    if (Knots[i] > Knots[Degree] && Knots[i] < Knots[Knots.size() - 1 - Degree] &&
+      (inner.empty() || Knots[i] > inner.back()))
+    {
+      inner.push_back(Knots[i]);
+    }
+  }
+  return inner;
+}
+
 Vec3 BSplineCurve::point(double t) const
 {
   t = clampUnit(t);

@@ -76,6 +76,8 @@ public:
   Vec3 derivative(double t, int order = 1) const override;
   /// Point and derivatives up to `order`: out[0] = P(t), out[k] = d^k P / dt^k.
   void derivatives(double t, int order, Vec3* out) const;
+  /// The distinct interior knots.
+  std::vector<double> breakpoints() const override;
 
   int degree() const { return Degree; }
   const std::vector<double>& knots() const { return Knots; }

@@ -1,5 +1,7 @@
 #include "Carriers.h"
 
+#include "RootFinding.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -407,6 +409,11 @@ SurfaceOfRevolution::SurfaceOfRevolution(CurvePtr contour, const Vec3& axisPoint
   MeridionalProjector = std::make_shared<CurveProjector>(Meridional, 256);
 }
 
+std::vector<double> SurfaceOfRevolution::breakpoints(bool tDirection) const
+{
+  return tDirection ? std::vector<double>() : Contour->breakpoints();
+}
+
 Vec3 SurfaceOfRevolution::point(double s, double t) const
 {
   const double angle = AngleStart + t * (AngleEnd - AngleStart);
@@ -693,6 +700,21 @@ void GordonSurface::prepare()
       SBlendCoefficients.push_back(naturalCardinalSpline(SNodes, i));
     }
   }
+  // Breakpoints: the blend nodes and the ends. Not the knots of the curves: the sections
+  // of a blade each have their own (Rotor 37: 6 x 298), and a curve across the blade
+  // would be cut at all of them; where one matters, the arc-length table halves the piece.
+  for (const bool tDirection : { false, true })
+  {
+    std::vector<double> points{ 0.0, 1.0 };
+    if (TheBlending == Blending::Spline)
+    {
+      const std::vector<double>& nodes = tDirection ? TNodes : SNodes;
+      points.insert(points.end(), nodes.begin(), nodes.end());
+    }
+    std::sort(points.begin(), points.end());
+    points.erase(std::unique(points.begin(), points.end()), points.end());
+    (tDirection ? TBreakpoints : SBreakpoints) = std::move(points);
+  }
   // Same evaluation as in point(), so that C_j(s_i) - Q_ij vanishes exactly at s = s_i.
   NodePoints.clear();
   for (std::size_t j = 0; j < SCurves.size(); ++j)
@@ -938,6 +960,51 @@ Eigen::Vector2d SurfaceCurve::parameters(double u) const
 {
   const Vec3 q = ParameterCurve->point(u);
   return Eigen::Vector2d(q.x(), q.y());
+}
+
+std::vector<double> SurfaceCurve::breakpoints() const
+{
+  std::vector<double> ends = ParameterCurve->breakpoints();
+  ends.insert(ends.begin(), 0.0);
+  ends.push_back(1.0);
+  std::vector<double> result(ends.begin() + 1, ends.end() - 1);
+  for (const bool tDirection : { false, true })
+  {
+    const std::vector<double> across = TheSurface->breakpoints(tDirection);
+    if (across.empty())
+    {
+      continue;
+    }
+    const int k = tDirection ? 1 : 0;
+    Vec3 previous = ParameterCurve->point(ends[0]);
+    for (std::size_t span = 0; span + 1 < ends.size(); ++span)
+    {
+      const Vec3 next = ParameterCurve->point(ends[span + 1]);
+      const double low = std::min(previous[k], next[k]), high = std::max(previous[k], next[k]);
+      for (auto at = std::upper_bound(across.begin(), across.end(), low);
+           at != across.end() && *at < high; ++at)
+      {
+        const double value = *at;
+        NewtonStop stop;
+        stop.iterations = 60;
+        stop.stepTolerance = 1e-15;
+        const double sign = next[k] > previous[k] ? 1.0 : -1.0;
+        Vec3 jet[2];
+        const double u = newtonInBracket(
+          [&](double x) {
+            ParameterCurve->derivatives(x, 1, jet);
+            return sign * (jet[0][k] - value);
+          },
+          [&](double) { return sign * jet[1][k]; }, ends[span], ends[span + 1],
+          ends[span] + (value - previous[k]) / (next[k] - previous[k]) * (ends[span + 1] - ends[span]),
+          stop);
+        result.push_back(u);
+      }
+      previous = next;
+    }
+  }
+  std::sort(result.begin(), result.end());
+  return result;
 }
 
 Vec3 SurfaceCurve::point(double u) const

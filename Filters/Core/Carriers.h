@@ -45,6 +45,8 @@ public:
   void firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3& Pt) const override;
   void crossPoints(double s, double sPlus, double sMinus, double t, double tPlus, double tMinus,
     Vec3 out[5]) const override;
+  /// The contour's breakpoints in s; none in t.
+  std::vector<double> breakpoints(bool tDirection) const override;
 
   const Vec3& axisPoint() const { return AxisPoint; }
   const Vec3& axisDirection() const { return AxisDirection; } ///< unit vector
@@ -149,6 +151,12 @@ public:
     Vec3 out[5]) const override;
   /// Same as point() (which extrapolates too); kept as the explicit name for callers.
   Vec3 extendedPoint(double s, double t) const { return point(s, t); }
+  /// The nodes of this direction's spline blends, with 0 and 1 (where the surface
+  /// continues past its curves).
+  std::vector<double> breakpoints(bool tDirection) const override
+  {
+    return tDirection ? TBreakpoints : SBreakpoints;
+  }
 
   Blending blending() const { return TheBlending; }
   const std::vector<CurvePtr>& sCurves() const { return SCurves; } ///< sections
@@ -171,6 +179,7 @@ private:
   std::vector<Vec3> NodePoints;
   // Curves that are B-splines get point and derivatives from one basis evaluation.
   std::vector<const BSplineCurve*> SSplines, TSplines;
+  std::vector<double> SBreakpoints, TBreakpoints;
   void prepare();
 };
 
@@ -188,6 +197,10 @@ public:
   SurfaceCurve(SurfacePtr surface, std::vector<Eigen::Vector2d> parameterPoints);
   Vec3 point(double u) const override;
   Vec3 derivative(double u, int order = 1) const override;
+  /// The knots of the curve in (s, t) and the parameters at which it crosses the
+  /// surface's breakpoints (found span by span of the curve in (s, t) where its ends
+  /// straddle one; a crossing inside a span that turns back is not found).
+  std::vector<double> breakpoints() const override;
   /// (s, t) on the surface at curve parameter u.
   Eigen::Vector2d parameters(double u) const;
   const SurfacePtr& surface() const { return TheSurface; }

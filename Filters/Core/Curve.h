@@ -8,6 +8,7 @@
 #include "Types.h"
 
 #include <memory>
+#include <vector>
 
 namespace blockforge
 {
@@ -36,6 +37,12 @@ public:
     out[1] = derivative(t, 1);
     out[2] = derivative(t, 2);
   }
+  /**
+   * Parameters in (0, 1), increasing, at which a derivative of the curve may jump (the
+   * interior knots of a B-spline). Arc-length tables end pieces there (ArcLength.h): a
+   * quadrature rule across a kink of the speed converges slowly. None by default.
+   */
+  virtual std::vector<double> breakpoints() const { return {}; }
 };
 
 using CurvePtr = std::shared_ptr<const Curve>;

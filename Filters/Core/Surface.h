@@ -45,6 +45,16 @@ public:
     out[3] = point(s, tPlus);
     out[4] = point(s, tMinus);
   }
+  /**
+   * Values of s (or of t, with `tDirection`) at which a derivative of the surface may
+   * jump (knots of its curves, nodes of its blends), increasing: a curve on the surface
+   * ends its arc-length pieces where it crosses them (ArcLength.h). None by default.
+   */
+  virtual std::vector<double> breakpoints(bool tDirection) const
+  {
+    (void)tDirection;
+    return {};
+  }
 };
 
 using SurfacePtr = std::shared_ptr<const Surface>;

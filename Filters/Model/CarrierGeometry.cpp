@@ -69,6 +69,29 @@ Vec3 SubCurve::derivative(double t, int order) const
   return Base->derivative(map(t), order) * (order == 1 ? scale : scale * scale);
 }
 
+std::vector<double> SubCurve::breakpoints() const
+{
+  std::vector<double> base = Base->breakpoints();
+  base.insert(base.begin(), 0.0);
+  base.push_back(1.0);
+  const double low = std::min(U0, U1), high = std::max(U0, U1);
+  std::vector<double> inner;
+  const double firstTurn = Closed ? std::floor(low) : 0.0, lastTurn = Closed ? std::floor(high) : 0.0;
+  for (double turn = firstTurn; turn <= lastTurn; turn += 1.0)
+  {
+    for (const double b : base)
+    {
+      const double t = (turn + b - U0) / (U1 - U0);
+      if (t > 0.0 && t < 1.0)
+      {
+        inner.push_back(t);
+      }
+    }
+  }
+  std::sort(inner.begin(), inner.end());
+  return inner;
+}
+
 // ------------------------------------------------------------- ParameterLineCurve
 ParameterLineCurve::ParameterLineCurve(SurfacePtr surface, const Eigen::Vector2d& from,
   const Eigen::Vector2d& to, bool closedS, bool closedT, bool extendT)
@@ -87,6 +110,38 @@ Eigen::Vector2d ParameterLineCurve::parameters(double u) const
   st[0] = ClosedS ? wrapUnit(st[0]) : clampUnit(st[0]);
   st[1] = ClosedT ? wrapUnit(st[1]) : ExtendT ? std::max(-1.0, std::min(2.0, st[1])) : clampUnit(st[1]);
   return st;
+}
+
+std::vector<double> ParameterLineCurve::breakpoints() const
+{
+  std::vector<double> result;
+  for (const int k : { 0, 1 })
+  {
+    const double from = From[k], to = To[k];
+    if (from == to)
+    {
+      continue;
+    }
+    std::vector<double> across = TheSurface->breakpoints(k == 1);
+    across.insert(across.begin(), 0.0);
+    across.push_back(1.0);
+    const bool closed = k == 0 ? ClosedS : ClosedT;
+    const double low = std::min(from, to), high = std::max(from, to);
+    const double firstTurn = closed ? std::floor(low) : 0.0, lastTurn = closed ? std::floor(high) : 0.0;
+    for (double turn = firstTurn; turn <= lastTurn; turn += 1.0)
+    {
+      for (const double b : across)
+      {
+        const double u = (turn + b - from) / (to - from);
+        if (u > 0.0 && u < 1.0)
+        {
+          result.push_back(u);
+        }
+      }
+    }
+  }
+  std::sort(result.begin(), result.end());
+  return result;
 }
 
 Vec3 ParameterLineCurve::point(double u) const
@@ -118,6 +173,17 @@ CarrierGeometry::CarrierGeometry(const BlockModel& model)
   {
     build(model, i);
   }
+}
+
+std::shared_ptr<const ArcLength> CarrierGeometry::lengthTable(int index) const
+{
+  const Entry& entry = Entries.at(index);
+  std::lock_guard<std::mutex> lock(entry.length->lock);
+  if (!entry.length->table)
+  {
+    entry.length->table = std::make_shared<ArcLength>(entry.curve);
+  }
+  return entry.length->table;
 }
 
 void CarrierGeometry::build(const BlockModel& model, int index)

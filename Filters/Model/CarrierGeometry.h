@@ -38,6 +38,9 @@ public:
   SubCurve(CurvePtr curve, double u0, double u1, bool closed);
   Vec3 point(double t) const override;
   Vec3 derivative(double t, int order = 1) const override;
+  /// The base's breakpoints and its ends (the seam of a closed curve, the clamps of an
+  /// open one) inside the piece, on the piece's parameter.
+  std::vector<double> breakpoints() const override;
 
 private:
   CurvePtr Base;
@@ -56,6 +59,8 @@ public:
   Vec3 point(double u) const override;
   Vec3 derivative(double u, int order = 1) const override;
   Eigen::Vector2d parameters(double u) const;
+  /// Where the line crosses the surface's breakpoints (and, wrapping, its seams).
+  std::vector<double> breakpoints() const override;
 
 private:
   SurfacePtr TheSurface;
@@ -114,6 +119,12 @@ public:
     double& distance) const;
   /// Diagonal of the bounding box of a sample of the carrier.
   double size(int index) const { return Entries.at(index).size; }
+  /**
+   * The arc-length table of curve carrier `index` (ArcLength.h), made on first use, kept
+   * with the carrier (and shared by copies of this geometry) until the carrier is built
+   * again: an edge on the carrier measures its length and places its nodes from it.
+   */
+  std::shared_ptr<const ArcLength> lengthTable(int index) const;
 
 private:
   struct Entry
@@ -127,6 +138,12 @@ private:
     double size = 1.0;
     mutable std::shared_ptr<CurveProjector> curveProjector;
     mutable std::shared_ptr<SurfaceProjector> surfaceProjector;
+    struct LengthSlot
+    {
+      std::mutex lock;
+      std::shared_ptr<const ArcLength> table;
+    };
+    std::shared_ptr<LengthSlot> length = std::make_shared<LengthSlot>();
   };
   void buildEntry(const BlockModel& model, int index, int depth);
   void refineExtended(const Entry& entry, const Vec3& p, double& s, double& t, double& distance) const;

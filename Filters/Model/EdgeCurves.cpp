@@ -45,30 +45,28 @@ public:
     const Vec3 base = sign * Base->derivative(Reversed ? 1.0 - t : t, order);
     return order == 1 ? Vec3(base + EndShift - StartShift) : base;
   }
+  std::vector<double> breakpoints() const override
+  {
+    std::vector<double> points = Base->breakpoints();
+    if (Reversed)
+    {
+      std::reverse(points.begin(), points.end());
+      for (double& b : points)
+      {
+        b = 1.0 - b;
+      }
+    }
+    return points;
+  }
 
 private:
   CurvePtr Base;
   Vec3 StartShift, EndShift;
   bool Reversed;
 };
-
-/// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.
-/// Whether a follow edge takes its shape from `edge` (its arc-length table then keeps the
-/// sampled derivatives, which the follower's table reuses).
-bool isFollowed(const BlockModel& model, const Edge& edge)
-{
-  const int self = static_cast<int>(&edge - model.edges.data());
-  for (const Edge& other : model.edges)
-  {
-    if (other.kind == Edge::Kind::Follow && other.source == self)
-    {
-      return true;
-    }
-  }
-  return false;
-}
 } // namespace
 
+/// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.
 double carrierTolerance(const CarrierGeometry& geometry, int carrier, double size)
 {
   return 1e-9 * std::max(size, geometry.size(carrier));
@@ -142,7 +140,9 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       }
       named.curve = std::make_shared<SubCurve>(
         geometry.curve(edge.carrier), u0, u1, geometry.closedS(edge.carrier));
-      named.lengthTable = std::make_shared<ArcLength>(named.curve, 512, isFollowed(model, edge));
+      // from the carrier's table: the carrier stays while the edge's ends move
+      named.lengthTable = std::make_shared<ArcLength>(
+        geometry.lengthTable(edge.carrier), u0, u1, geometry.closedS(edge.carrier));
       named.length = named.lengthTable->totalLength();
       break;
     }
@@ -169,7 +169,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       named.curve = std::make_shared<ParameterLineCurve>(geometry.surface(edge.carrier), a, b,
         geometry.closedS(edge.carrier), geometry.closedT(edge.carrier),
         geometry.extendsT(edge.carrier));
-      named.lengthTable = std::make_shared<ArcLength>(named.curve, 512, isFollowed(model, edge));
+      named.lengthTable = std::make_shared<ArcLength>(named.curve);
       named.length = named.lengthTable->totalLength();
       break;
     }
@@ -240,11 +240,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       named.curve = reversed
         ? std::make_shared<FollowCurve>(base.curve, start - sourceEnd, end - sourceStart, true)
         : std::make_shared<FollowCurve>(base.curve, start - sourceStart, end - sourceEnd, false);
-      const bool shared = !reversed && base.lengthTable && base.lengthTable->keepsDerivatives();
-      named.lengthTable = shared
-        ? std::make_shared<ArcLength>(
-            named.curve, *base.lengthTable, Vec3(start - sourceStart), Vec3(end - sourceEnd))
-        : std::make_shared<ArcLength>(named.curve);
+      named.lengthTable = std::make_shared<ArcLength>(named.curve);
       named.length = named.lengthTable->totalLength();
       break;
     }
@@ -274,7 +270,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       points.push_back(end);
       named.curve = std::make_shared<BSplineCurve>(
         BSplineCurve::interpolate(points, 3, ParameterMethod::ChordLength));
-      named.lengthTable = std::make_shared<ArcLength>(named.curve, 512, isFollowed(model, edge));
+      named.lengthTable = std::make_shared<ArcLength>(named.curve);
       named.length = named.lengthTable->totalLength();
       break;
     }

@@ -488,10 +488,15 @@ void ProjectionCache::project(
 {
   Key key{ carrier, {} };
   std::memcpy(key.bits.data(), p.data(), sizeof(key.bits));
+  const std::size_t slot = carrier < 0 ? 0 : static_cast<std::size_t>(carrier) + 1;
   {
     std::lock_guard<std::mutex> guard(Lock);
-    const auto found = Known.find(key);
-    if (found != Known.end())
+    if (slot >= Known.size())
+    {
+      Known.resize(slot + 1);
+    }
+    const auto found = Known[slot].find(key);
+    if (found != Known[slot].end())
     {
       s = found->second[0];
       t = found->second[1];
@@ -509,27 +514,34 @@ void ProjectionCache::project(
     *distance = away;
   }
   std::lock_guard<std::mutex> guard(Lock);
-  if (Known.size() > 1000000)
+  if (Count > 1000000)
   {
-    Known.clear(); // bounded: a long optimisation must not grow it without end
+    // bounded: a long optimisation must not grow it without end
+    Known.clear();
+    Known.resize(slot + 1);
+    Count = 0;
   }
-  Known.emplace(key, std::array<double, 3>{ s, t, away });
+  Count += Known[slot].emplace(key, std::array<double, 3>{ s, t, away }).second ? 1 : 0;
 }
 
 void ProjectionCache::clear()
 {
   std::lock_guard<std::mutex> guard(Lock);
   Known.clear();
+  Count = 0;
 }
 
 void ProjectionCache::clear(const std::vector<char>& changed)
 {
   std::lock_guard<std::mutex> guard(Lock);
-  for (auto entry = Known.begin(); entry != Known.end();)
+  for (std::size_t slot = 0; slot < Known.size(); ++slot)
   {
-    const int carrier = entry->first.carrier;
-    const bool stale = carrier < 0 || carrier >= static_cast<int>(changed.size()) || changed[carrier];
-    entry = stale ? Known.erase(entry) : std::next(entry);
+    const bool stale = slot == 0 || slot > changed.size() || changed[slot - 1];
+    if (stale && !Known[slot].empty())
+    {
+      Count -= Known[slot].size();
+      Known[slot] = Projections();
+    }
   }
 }
 

@@ -290,7 +290,12 @@ private:
   {
     std::size_t operator()(const Key& key) const;
   };
-  std::unordered_map<Key, std::array<double, 3>, KeyHash> Known; // s, t, distance
+  using Projections = std::unordered_map<Key, std::array<double, 3>, KeyHash>; // s, t, distance
+  /// By carrier (slot 0: negative indices, slot c + 1: carrier c), so forgetting the
+  /// projections onto a redrawn carrier does not walk those onto the others (an
+  /// optimizer's run redraws a surface curve at most trials).
+  std::vector<Projections> Known;
+  std::size_t Count = 0; ///< projections remembered in all slots
   std::mutex Lock;
 };
 

@@ -394,7 +394,7 @@ double TemplateReader::curveParameterQuery(const MapEntry& at, int curve, const 
     {
       fail(length->line, entityText, "the length fraction must be in [0, 1]");
     }
-    return ArcLength(Geometry.curve(curve)).parameterAtFraction(fraction);
+    return Geometry.lengthTable(curve)->parameterAtFraction(fraction);
   }
   const MapEntry& extreme = minimum ? *minimum : *maximum;
   const bool closed = Geometry.closedS(curve);

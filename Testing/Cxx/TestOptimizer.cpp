@@ -492,6 +492,50 @@ TEST(OptimizerPassage, TrialsLeftOutChangeNoStep)
   EXPECT_EQ(filtered.bestMeasures.minAngle, all.bestMeasures.minAngle);
 }
 
+TEST(OptimizerPassage, RejectedTrialsPutBackGiveTheSameSearch)
+{
+  // A trial the compass search does not take is put back (ControlProblem::reject: the mesh
+  // plan's undo, the angles measured before it, the laws of skewed edges) instead of being
+  // moved back by the next evaluation: every evaluation, the steps and the result the same,
+  // bit for bit, on the O-grid with its distribution skews (laws the plan does not keep; without putting
+  // those back the distributor's search differs within these 300 evaluations).
+  Loaded loaded = loadPassage("axial_passage_oh", "distributor");
+  SearchSettings settings;
+  settings.maxEvaluations = 300;
+  const OptimizerSettings defaults;
+  auto run = [&](bool putBack, std::vector<std::vector<double>>* grid) {
+    ControlProblem problem(
+      loaded.model, loaded.geometry, 1.0, ObjectiveSettings{}, {}, defaults.maximumSkew);
+    const SearchResult result = search(problem.start(), problem.low(), problem.high(),
+      ObjectiveKind::MinAngle, [&](const std::vector<double>& x) { return problem.evaluate(x); },
+      settings, {}, {}, putBack ? RejectFunction([&] { problem.reject(); }) : RejectFunction());
+    *grid = problem.gridAt(result.best);
+    return result;
+  };
+  std::vector<std::vector<double>> movedBack, putBack;
+  const SearchResult plain = run(false, &movedBack), undone = run(true, &putBack);
+  ASSERT_EQ(plain.history.size(), undone.history.size());
+  int rejected = 0;
+  double value = plain.history.front().objective;
+  for (std::size_t n = 0; n < plain.history.size(); ++n)
+  {
+    EXPECT_TRUE(test::sameBits(plain.history[n].objective, undone.history[n].objective)) << n;
+    rejected += n > 0 && !(plain.history[n].objective < value) ? 1 : 0;
+    value = std::min(value, plain.history[n].objective);
+  }
+  EXPECT_GT(rejected, 50); // trials put back
+  EXPECT_EQ(plain.best, undone.best);
+  EXPECT_EQ(movedBack, putBack);
+  ControlProblem skews(
+    loaded.model, loaded.geometry, 1.0, ObjectiveSettings{}, {}, defaults.maximumSkew);
+  int skewVariables = 0;
+  for (const ControlVariable& variable : skews.variables())
+  {
+    skewVariables += variable.component == ControlVariable::SkewComponent ? 1 : 0;
+  }
+  EXPECT_GT(skewVariables, 0);
+}
+
 /**
  * Issue 9's target: axial_passage_oh at its defaults (sheared O corners, o_shear 45deg) on
  * the distributor and on Rotor 37, the automatic run at its defaults (700 trials with the

@@ -529,7 +529,7 @@ TEST(ArcLength, InterpolatedCurveInverseRoundTrip)
     points.emplace_back(std::cos(u), std::sin(2 * u), 0.3 * u);
   }
   auto curve = std::make_shared<BSplineCurve>(BSplineCurve::interpolate(points, 3));
-  const ArcLength length(curve, 16);
+  const ArcLength length(curve);
   for (int i = 0; i <= 40; ++i)
   {
     const double f = i / 40.0;

@@ -167,10 +167,15 @@ struct ControlProblem::Impl
   /// evaluation; empty where a block changed since (an evaluation measures only those).
   std::vector<std::unique_ptr<BlockAngles>> Angles;
   std::vector<double> SizeRatios;
+  /// The angles and size ratios forgetUpdated() took off the blocks the last update
+  /// recomputed, as they were before it (what reject() puts back with the plan's undo).
+  std::vector<std::pair<int, std::unique_ptr<BlockAngles>>> AnglesBefore;
+  std::vector<double> SizeRatiosBefore;
 
   /// Forgets the measured angles of the blocks the last plan update recomputed.
   void forgetUpdated()
   {
+    AnglesBefore.clear();
     if (!Plan)
     {
       Angles.clear();
@@ -178,9 +183,10 @@ struct ControlProblem::Impl
     }
     Angles.resize(Plan->blockCount());
     SizeRatios.resize(Plan->blockCount(), 1.0);
+    SizeRatiosBefore = SizeRatios;
     for (int b : Plan->updatedBlocks())
     {
-      Angles[b].reset();
+      AnglesBefore.emplace_back(b, std::move(Angles[b]));
     }
   }
 
@@ -298,6 +304,13 @@ struct ControlProblem::Impl
   std::unique_ptr<model::MeshPlan> Plan;
   std::vector<double> Current;
   bool Unplaced = false; ///< a placement failed: the next one places every vertex
+  /// The configuration before the last place(), and whether that place() updated the
+  /// plan from it (so the plan's undo() puts it back).
+  std::vector<double> Previous;
+  bool Undoable = false;
+  /// The skew variables the last place() changed (their laws live in the model, which the
+  /// plan's undo does not put back).
+  std::vector<std::size_t> LastSkewed;
 
   /// Moves the plan to configuration x (only the parameters that changed) and updates it.
   model::Feasibility place(const std::vector<double>& x)
@@ -315,6 +328,8 @@ struct ControlProblem::Impl
     std::vector<int> moved;
     std::vector<std::size_t> skewed;
     LastMoved.clear();
+    Undoable = false;
+    Previous = Current;
     for (std::size_t i = 0; i < Variables.size(); ++i)
     {
       if (x[i] != Current[i])
@@ -330,6 +345,7 @@ struct ControlProblem::Impl
       }
     }
     Current = x;
+    LastSkewed = skewed;
     // Skewed distributions: new laws on their edges, whose ends the update then recomputes
     // (they do not move).
     std::vector<int> recomputed;
@@ -368,6 +384,7 @@ struct ControlProblem::Impl
         applied.push_back(v);
       }
     }
+    Undoable = true;
     return Plan->update(applied);
   }
 };
@@ -948,6 +965,31 @@ bool ControlProblem::mayGain(std::size_t variable, const GridMeasures& current) 
     }
   }
   return false;
+}
+
+void ControlProblem::reject()
+{
+  if (!P->Undoable || !P->Plan || !P->Plan->undo())
+  {
+    return;
+  }
+  P->Undoable = false;
+  P->Current = P->Previous;
+  P->LastMoved.clear();
+  if (!P->LastSkewed.empty())
+  {
+    // the laws of the skewed edges as they were (the grids are back already)
+    std::vector<int> ends;
+    P->applySkews(P->Plan->model(), P->Current, P->LastSkewed, ends);
+  }
+  // the blocks put back have the angles measured before the trial (or none: measured
+  // when next needed)
+  for (auto& [block, angles] : P->AnglesBefore)
+  {
+    P->Angles[block] = std::move(angles);
+  }
+  P->AnglesBefore.clear();
+  P->SizeRatios = P->SizeRatiosBefore;
 }
 
 BlockModel ControlProblem::modelAt(const std::vector<double>& x)

@@ -124,6 +124,14 @@ public:
    * true for other objectives and for a variable not yet moved in a feasible evaluation.
    */
   bool mayGain(std::size_t variable, const GridMeasures& current) const;
+  /**
+   * Puts the grid back to the configuration before the last evaluate() (a trial the search
+   * did not take) with the mesh plan's undo and the angles measured there, instead of
+   * moving back at the next evaluation: that one then recomputes only what its own move
+   * changes. Evaluations and grids stay the same, bit for bit. Does nothing when the last
+   * evaluation did not update the plan (its placement failed) or was already put back.
+   */
+  void reject();
   /// The model at configuration x (vertices, carrier edges and surface curves moved).
   model::BlockModel modelAt(const std::vector<double>& x);
   /// The vertices placed at configuration x (placement rules only: no edge, curve or

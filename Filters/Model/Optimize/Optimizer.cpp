@@ -122,7 +122,8 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
     progress,
     [&](std::size_t variable, const GridMeasures& current) {
       return problem.mayGain(variable, current);
-    });
+    },
+    [&] { problem.reject(); });
   result.after = result.search.bestMeasures;
   if (settings.moves.empty())
   {

@@ -116,11 +116,13 @@ struct SearchState
  * 1e-7 of its range, when a pass that took steps gained less than `tolerance`, at
  * `stallAfter` trials when the last complete pass gained less than `stallGain`, and after
  * that at the end of a pass that gained less than `stallGain`.
- * A trial `mayGain` rules out is counted as a failed one without being evaluated.
+ * A trial `mayGain` rules out is counted as a failed one without being evaluated; after
+ * an evaluated trial that fails, `reject` (when given) lets the evaluator step back.
  */
 void compassSearch(SearchState& state, const std::vector<double>& start,
   const std::vector<double>& low, const std::vector<double>& high,
-  const SearchSettings& settings, const TrialFilter& mayGain, SearchResult& result)
+  const SearchSettings& settings, const TrialFilter& mayGain, const RejectFunction& reject,
+  SearchResult& result)
 {
   const std::size_t n = start.size();
   std::vector<double> x = start, step(n), direction(n, 1.0);
@@ -198,6 +200,10 @@ void compassSearch(SearchState& state, const std::vector<double>& start,
           moved = true;
           break;
         }
+        if (reject)
+        {
+          reject();
+        }
       }
       if (!improved)
       {
@@ -235,7 +241,8 @@ double nloptObjective(unsigned n, const double* u, double* gradient, void* data)
 
 SearchResult search(const std::vector<double>& start, const std::vector<double>& low,
   const std::vector<double>& high, ObjectiveKind kind, const EvaluateFunction& evaluate,
-  const SearchSettings& settings, const ProgressFunction& progress, const TrialFilter& mayGain)
+  const SearchSettings& settings, const ProgressFunction& progress, const TrialFilter& mayGain,
+  const RejectFunction& reject)
 {
   const std::size_t n = start.size();
   if (low.size() != n || high.size() != n)
@@ -284,7 +291,7 @@ SearchResult search(const std::vector<double>& start, const std::vector<double>&
   }
   if (settings.algorithm == SearchAlgorithm::Compass)
   {
-    compassSearch(state, start, low, high, settings, mayGain, result);
+    compassSearch(state, start, low, high, settings, mayGain, reject, result);
     result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - state.begin).count();
     return result;

@@ -84,6 +84,10 @@ using ProgressFunction = std::function<void(double)>;
 /// `current` may lower the objective; false only when it certainly cannot (the trial
 /// is then counted as failed without evaluating it).
 using TrialFilter = std::function<bool(std::size_t variable, const GridMeasures& current)>;
+/// Called after an evaluated compass trial that the search does not take: the evaluator
+/// may put its state back to the configuration before that trial (the next trial then
+/// starts from there), as long as its evaluations stay the same, bit for bit.
+using RejectFunction = std::function<void()>;
 
 /**
  * Minimises the objective of `evaluate` over low <= x <= high from `start` (inside the
@@ -94,6 +98,6 @@ using TrialFilter = std::function<bool(std::size_t variable, const GridMeasures&
 SearchResult search(const std::vector<double>& start, const std::vector<double>& low,
   const std::vector<double>& high, ObjectiveKind kind, const EvaluateFunction& evaluate,
   const SearchSettings& settings, const ProgressFunction& progress = {},
-  const TrialFilter& mayGain = {});
+  const TrialFilter& mayGain = {}, const RejectFunction& reject = {});
 } // namespace optimize
 } // namespace blockforge
