@@ -319,9 +319,16 @@ std::vector<double> firstCell(const DistributionLaw& law, int nodeCount, double 
  * edge (the sum grows with beta). The ends are then exactly first and last times the
  * mean, and neighbour cells differ by a smooth factor. With too few cells to fill the edge
  * that way (1 or 2, or ends too large for the count) the shape is scaled to fit instead.
+ * flatness k != 1: the bump is beta (1 - |2 xi - 1|^(2k)) (k = 1 is the same function,
+ * kept in its own arithmetic so that default grids keep their bits).
  */
-std::vector<double> endSizes(double first, double last, int nodeCount)
+std::vector<double> endSizes(double first, double last, int nodeCount, double flatness = 1.0)
 {
+  if (!(flatness >= 1.0) || !std::isfinite(flatness))
+  {
+    throw GeometryError("ends distribution: the flatness of the bump must be a number of "
+                        "at least 1");
+  }
   if (!(first > 0.0) || !(last > 0.0) || !std::isfinite(first) || !std::isfinite(last))
   {
     throw GeometryError("ends distribution: the end cell sizes (relative to the mean cell) "
@@ -337,8 +344,10 @@ std::vector<double> endSizes(double first, double last, int nodeCount)
     for (int i = 0; i < cells; ++i)
     {
       const double xi = cells > 1 ? static_cast<double>(i) / (cells - 1) : 0.5;
-      h[i] = std::exp((1.0 - xi) * std::log(first) + xi * std::log(last) +
-        4.0 * beta * xi * (1.0 - xi));
+      const double bump = flatness == 1.0
+        ? 4.0 * beta * xi * (1.0 - xi)
+        : beta * (1.0 - std::pow(std::abs(2.0 * xi - 1.0), 2.0 * flatness));
+      h[i] = std::exp((1.0 - xi) * std::log(first) + xi * std::log(last) + bump);
     }
     return h;
   };
@@ -554,7 +563,7 @@ std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
     case DistributionLaw::Kind::FirstCell:
       return firstCell(law, nodeCount, edgeLength);
     case DistributionLaw::Kind::Ends:
-      return endSizes(law.firstCellSize, law.lastCellSize, nodeCount);
+      return endSizes(law.firstCellSize, law.lastCellSize, nodeCount, law.endsFlatness);
     case DistributionLaw::Kind::Match:
       return matchedNodes(law.firstCellSize, law.lastCellSize, edgeLength, nodeCount,
         law.expansionRatio);

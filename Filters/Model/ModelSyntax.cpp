@@ -265,7 +265,8 @@ namespace
 {
 const char* const LawSyntax =
   "uniform, {geometric: k}, {two_sided: k}, {first_cell: h, ratio: r}, "
-  "{ends: [a, b]}, match, {match: r}, {match: r, lean: angle}, {project_from: edge} or "
+  "{ends: [a, b]}, {ends: [a, b], flat: k}, match, {match: r}, {match: r, lean: angle}, "
+  "{project_from: edge} or "
   "{project_from: edge, fade: k} (or fade: [k_first, k_last])";
 }
 
@@ -297,7 +298,7 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
   const std::vector<MapEntry> entries = mapEntries(node, here, entityText, what, reporter);
   checkKeys(entries,
     { "geometric", "two_sided", "first_cell", "ratio", "ends", "match", "lean", "project_from",
-      "fade" },
+      "fade", "flat" },
     entityText, reporter);
   const MapEntry* fade = findEntry(entries, "fade");
   if (const MapEntry* project = findEntry(entries, "project_from"))
@@ -374,13 +375,25 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
   {
     reporter.fail(lean->line, entityText, what + ": 'lean' belongs to the law match");
   }
+  const MapEntry* flat = findEntry(entries, "flat");
   if (const MapEntry* ends = findEntry(entries, "ends"))
   {
-    if (entries.size() != 1 || !ends->value.IsSequence() || ends->value.size() != 2)
+    if (entries.size() != (flat ? 2u : 1u) || !ends->value.IsSequence() ||
+      ends->value.size() != 2)
     {
       reporter.fail(ends->line, entityText,
-        what + ": expected {ends: [a, b]}: the first and last cells a and b times the mean "
-               "cell of the edge");
+        what + ": expected {ends: [a, b]} or {ends: [a, b], flat: k}: the first and last "
+               "cells a and b times the mean cell of the edge");
+    }
+    if (flat)
+    {
+      law.endsFlatness = number(flat->value, flat->line, what + " flat");
+      if (!(law.endsFlatness >= 1.0) || !std::isfinite(law.endsFlatness))
+      {
+        reporter.fail(flat->line, entityText,
+          what + ": the flatness of an ends law's bump must be at least 1 (1: the default "
+                 "bump), got " + formatNumber(law.endsFlatness));
+      }
     }
     law.kind = DistributionLaw::Kind::Ends;
     law.firstCellSize = number(ends->value[0], ends->line, what + " ends a");
@@ -393,6 +406,10 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
           formatNumber(law.firstCellSize) + " and " + formatNumber(law.lastCellSize));
     }
     return law;
+  }
+  if (flat)
+  {
+    reporter.fail(flat->line, entityText, what + ": 'flat' belongs to the law ends");
   }
   const MapEntry* geometric = findEntry(entries, "geometric");
   const MapEntry* twoSided = findEntry(entries, "two_sided");
@@ -462,7 +479,12 @@ void emitLaw(YAML::Emitter& out, const DistributionLaw& law, const BlockModel& m
     case DistributionLaw::Kind::Ends:
       out << YAML::Flow << YAML::BeginMap << YAML::Key << "ends" << YAML::Value
           << YAML::Flow << YAML::BeginSeq << formatNumber(law.firstCellSize)
-          << formatNumber(law.lastCellSize) << YAML::EndSeq << YAML::EndMap;
+          << formatNumber(law.lastCellSize) << YAML::EndSeq;
+      if (law.endsFlatness != 1.0)
+      {
+        out << YAML::Key << "flat" << YAML::Value << formatNumber(law.endsFlatness);
+      }
+      out << YAML::EndMap;
       return;
     case DistributionLaw::Kind::Match:
       // the end cells are the mesher's, from the neighbour edges: only the ratio is the law's

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 
 using namespace blockforge;
 
@@ -293,6 +295,82 @@ TEST(Distribution, ImpossibleLawsThrow)
     EXPECT_NE(message.find("first cell size"), std::string::npos) << message;
     EXPECT_NE(message.find("edge length"), std::string::npos) << message;
   }
+}
+
+/**
+ * `{ends: [a, b], flat: k}`: the bump that fills the edge is 1 - |2 xi - 1|^(2k). The cells
+ * are the analytic shape (log-linear ends times exp(beta bump), beta solved here by its own
+ * bisection) within 1e-12; k = 1 is the default law bit for bit; a flatter bump keeps the
+ * middle cells nearer the mean cell with small ends (ends 0.1 on 16 cells: the largest cell
+ * 2.09 times the mean with k = 1, 1.51 with k = 2, 1.35 with k = 3).
+ */
+TEST(Distribution, FlatEndsKeepTheMiddleCellsNearTheMean)
+{
+  DistributionLaw ends;
+  ends.kind = DistributionLaw::Kind::Ends;
+  ends.firstCellSize = 0.1;
+  ends.lastCellSize = 0.1;
+  const int cells = 16;
+  const auto largest = [&](const std::vector<double>& s) {
+    double big = 0.0;
+    for (int i = 0; i < cells; ++i)
+    {
+      big = std::max(big, (s[i + 1] - s[i]) * cells);
+    }
+    return big;
+  };
+  const std::vector<double> round = distributeNodes(ends, cells + 1);
+  DistributionLaw one = ends;
+  one.endsFlatness = 1.0;
+  EXPECT_EQ(distributeNodes(one, cells + 1), round); // k = 1: the default, same bits
+  EXPECT_NEAR(largest(round), 2.092, 1e-3);
+  for (const double k : { 2.0, 3.0 })
+  {
+    DistributionLaw flat = ends;
+    flat.endsFlatness = k;
+    flat.lastCellSize = 0.3;
+    const std::vector<double> s = distributeNodes(flat, cells + 1);
+    // the analytic shape: sizes exp((1 - xi) ln a + xi ln b + beta (1 - |2 xi - 1|^(2k)))
+    const auto sizes = [&](double beta) {
+      std::vector<double> h(cells);
+      double sum = 0.0;
+      for (int i = 0; i < cells; ++i)
+      {
+        const double xi = static_cast<double>(i) / (cells - 1);
+        h[i] = std::exp((1.0 - xi) * std::log(0.1) + xi * std::log(0.3) +
+          beta * (1.0 - std::pow(std::abs(2.0 * xi - 1.0), 2.0 * k)));
+        sum += h[i];
+      }
+      for (double& v : h)
+      {
+        v /= sum;
+      }
+      return std::make_pair(h, sum / cells);
+    };
+    double low = -60.0, high = 60.0;
+    for (int step = 0; step < 200; ++step)
+    {
+      const double mid = 0.5 * (low + high);
+      (sizes(mid).second < 1.0 ? low : high) = mid;
+    }
+    const std::vector<double> h = sizes(0.5 * (low + high)).first;
+    for (int i = 0; i < cells; ++i)
+    {
+      EXPECT_NEAR(s[i + 1] - s[i], h[i], 1e-12) << "k " << k << " cell " << i;
+    }
+    EXPECT_NEAR((s[1] - s[0]) * cells, 0.1, 1e-9);
+    EXPECT_NEAR((s[cells] - s[cells - 1]) * cells, 0.3, 1e-9);
+    // mirrored by reversedLaw
+    const std::vector<double> r = distributeNodes(reversedLaw(flat), cells + 1);
+    for (int i = 0; i <= cells; ++i)
+    {
+      EXPECT_NEAR(r[i], 1.0 - s[cells - i], 1e-14);
+    }
+    flat.lastCellSize = 0.1;
+    EXPECT_NEAR(largest(distributeNodes(flat, cells + 1)), k == 2.0 ? 1.514 : 1.349, 1e-3);
+  }
+  ends.endsFlatness = 0.5;
+  EXPECT_THROW(distributeNodes(ends, cells + 1), GeometryError);
 }
 
 TEST(Distribution, EndsGiveTheEndCellsRelativeToTheMeanAtEveryCount)

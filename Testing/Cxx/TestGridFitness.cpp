@@ -38,11 +38,13 @@ using test::Pi;
  * are short along the axis once they are smaller than the edge's radius).
  * axial_passage_oh grades its edge blocks' O-grid arcs and every H edge with `match`, the
  * blade sides towards the edge blocks (`ends`), the O-grid's outer sides and the edge
- * blocks' blade arcs as normal feet and offsets (`project_from`): measured 8.6-10.8 on
- * Rotor 37, 6.3-7.9 on the distributor, 9.0-50.1 on the turbine and 5.0-20.3 on the
- * compressor (their capped and sharp edges' blocks against the blade sides, growing with
- * the density; the compressor's sides end in cells side_fan = 0.03 of their mean next to
- * its fans, 24-70 with 0.35; 28-570 before). Its bound keeps it from getting worse.
+ * blocks' blade arcs as normal feet and offsets (`project_from`), the sides' end cells
+ * 0.35 of their mean at round edges, 0.2 at sheared ones (o_shear), 0.03 next to a sharp
+ * edge's fan: measured 9.7-25.5 on Rotor 37, 4.0-4.5 on the distributor, 9.0-50.1 on the
+ * turbine and 5.0-20.3 on the compressor (their sheared, capped and sharp edges' blocks
+ * against the blade sides, growing with the density; with 0.35 everywhere 12.1-31.4,
+ * 5.2-5.5, 9.0-50.1, 27-70; 28-570 before the grading). Its bound keeps it from getting
+ * worse.
  */
 double maxNeighbourRatio(const std::string& templateName)
 {

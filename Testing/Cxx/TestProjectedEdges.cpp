@@ -436,3 +436,21 @@ TEST(ProjectedEdges, FadeMovesTheNodesNearAnEndOffTheNormalTowardsIt)
   EXPECT_TRUE(contains(errorOf(quarterRing("{geometric: 1.2, fade: 3}", "uniform")),
     "'fade' belongs to the law project_from"));
 }
+
+/**
+ * The `ends` law's `flat` option (Distribution.h, endsFlatness) on this file's quarter
+ * ring: it travels in the model document, and a flatness below 1 or `flat` on another law
+ * is an error naming it.
+ */
+TEST(ProjectedEdges, FlatEndsTravelInTheModelDocument)
+{
+  const BlockModel model =
+    parseTemplate(quarterRing("{ends: [0.25, 0.5], flat: 3}", "{project_from: in#}"), "ring.yaml");
+  const std::string document = writeModelDocument(model);
+  EXPECT_TRUE(contains(document, "{ends: [0.25, 0.5], flat: 3}")) << document;
+  EXPECT_EQ(readModelDocument(document).blocks[0].laws, model.blocks[0].laws);
+  EXPECT_TRUE(contains(errorOf(quarterRing("{ends: [0.1, 0.3], flat: 0.5}", "uniform")),
+    "must be at least 1"));
+  EXPECT_TRUE(contains(errorOf(quarterRing("{geometric: 1.2, flat: 2}", "uniform")),
+    "'flat' belongs to the law ends"));
+}
