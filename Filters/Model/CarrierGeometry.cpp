@@ -4,6 +4,7 @@
 #include "Errors.h"
 
 #include "../Core/BSpline.h"
+#include "../Core/Parallel.h"
 
 #include <Eigen/Geometry>
 
@@ -178,6 +179,20 @@ std::shared_ptr<const ArcLength> CarrierGeometry::lengthTable(int index) const
     entry.length->table = std::make_shared<ArcLength>(entry.curve);
   }
   return entry.length->table;
+}
+
+void CarrierGeometry::prepareLengthTables(const std::vector<int>& indices) const
+{
+  forEachChunk(static_cast<long>(indices.size()), [&](long k) {
+    try
+    {
+      lengthTable(indices[k]);
+    }
+    catch (const std::exception&)
+    {
+      // left unmade: lengthTable() throws again where an entity uses it
+    }
+  });
 }
 
 void CarrierGeometry::build(const BlockModel& model, int index)

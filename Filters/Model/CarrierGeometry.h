@@ -125,6 +125,14 @@ public:
    * again: an edge on the carrier measures its length and places its nodes from it.
    */
   std::shared_ptr<const ArcLength> lengthTable(int index) const;
+  /**
+   * Makes the length tables of the curve carriers `indices` that are not made yet, as
+   * independent chunks of work (on threads when a runner is installed, Parallel.h): each
+   * table depends on its carrier only, so the tables are the same for any thread count.
+   * A table that fails is left unmade, so its error comes from lengthTable() where it is
+   * used, naming that entity.
+   */
+  void prepareLengthTables(const std::vector<int>& indices) const;
 
 private:
   struct Entry

@@ -329,6 +329,20 @@ std::vector<NamedCurve> buildNamedCurves(const BlockModel& model, const CarrierG
 {
   std::vector<NamedCurve> curves;
   const double size = modelSize(model);
+  // the carriers' length tables are independent of each other: make them at once
+  std::vector<int> tabulated;
+  for (const Edge& edge : model.edges)
+  {
+    if (edge.kind == Edge::Kind::OnCurve && edge.carrier >= 0 &&
+      edge.carrier < static_cast<int>(model.carriers.size()) && geometry.curve(edge.carrier) &&
+      !geometry.isSurface(edge.carrier))
+    {
+      tabulated.push_back(edge.carrier);
+    }
+  }
+  std::sort(tabulated.begin(), tabulated.end());
+  tabulated.erase(std::unique(tabulated.begin(), tabulated.end()), tabulated.end());
+  geometry.prepareLengthTables(tabulated);
   for (const Edge& edge : model.edges)
   {
     try
