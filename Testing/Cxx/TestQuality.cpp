@@ -515,7 +515,9 @@ TEST(Quality, CollapsedCellScaledJacobianInGridPass)
 TEST(Quality, SmallestMinAngleOfABlockIsTheSmallestOfItsCells)
 {
   // Randomly perturbed and sheared blocks, one with a face collapsed onto a line (wedge
-  // cells): smallestMinAngle gives the smallest hexFaceAngles minAngle bit for bit.
+  // cells next to regular ones: the faces they share count through the regular cells),
+  // one so small that inverse lengths could overflow (measured cell by cell then):
+  // smallestMinAngle gives the smallest hexFaceAngles minAngle bit for bit.
   std::mt19937 random(7);
   std::uniform_real_distribution<double> jitter(-0.2, 0.2);
   const Grid perturbed = makeGrid(7, 5, 4, [&](int i, int j, int k) {
@@ -525,7 +527,12 @@ TEST(Quality, SmallestMinAngleOfABlockIsTheSmallestOfItsCells)
     makeGrid(4, 3, 3, [](int i, int j, int k) { return Vec3(i, i * (j - 1.0) * 0.5, k); });
   const Grid sheared =
     makeGrid(3, 3, 3, [](int i, int j, int k) { return Vec3(i + std::tan(0.4) * k, j, k); });
-  for (const Grid* g : { &perturbed, &wedge, &sheared })
+  Grid tiny = perturbed;
+  for (double& x : tiny.xyz)
+  {
+    x *= 1e-150;
+  }
+  for (const Grid* g : { &perturbed, &wedge, &sheared, static_cast<const Grid*>(&tiny) })
   {
     double smallest = 180.0;
     for (int k = 0; k + 1 < g->nk; ++k)
