@@ -103,6 +103,18 @@ void revolutionParametersAt(const BlockModel& model, const CarrierGeometry& geom
   }
 }
 
+namespace
+{
+/// Expressions placements evaluated, for every scope: the value of an expression is a
+/// function of its text and its constants' values alone (ExpressionMemo), whichever
+/// model they come from.
+detail::ExpressionMemo& placementMemo()
+{
+  static detail::ExpressionMemo memo;
+  return memo;
+}
+} // namespace
+
 /// The template's expression scope, evaluating definitions when first used and vertex
 /// queries from the current positions: the same values and the same operations as when
 /// the template was read, so the same bits for the same positions.
@@ -111,6 +123,7 @@ struct PlacementScope::Impl
   explicit Impl(const BlockModel& model)
     : Model(model)
   {
+    Evaluator.Memo = &placementMemo();
     for (const auto& value : model.expressionScope.values)
     {
       Evaluator.defineQuery(value.first, value.second);

@@ -6,14 +6,19 @@
 #pragma once
 
 #include "Errors.h"
+#include "ModelSyntax.h"
 
 #include <muParser.h>
 
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <map>
+#include <mutex>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace blockforge
@@ -28,6 +33,74 @@ constexpr double Pi = 3.14159265358979323846;
 struct ExpressionError
 {
   std::string message;
+};
+
+/**
+ * Values of expressions already evaluated, by their text and the values of the named
+ * constants in it. muParser reads an expression into byte code with the constants' values
+ * folded in, the same byte code for the same text and values, so a remembered value is
+ * the same bits as evaluating again; reading is most of the cost (tens of thousands of
+ * instructions for a line of a template). A placement after a move evaluates the
+ * template's expressions again, most with nothing in them moved. Shared by threads
+ * (serialised); the last few values of every text are kept, and all are forgotten past
+ * a bound (a long optimisation must not grow it without end).
+ */
+class ExpressionMemo
+{
+public:
+  bool find(const std::string& text, const std::vector<double>& constants, double& value)
+  {
+    std::lock_guard<std::mutex> guard(Lock);
+    const auto found = Known.find(text);
+    if (found == Known.end())
+    {
+      return false;
+    }
+    for (const Entry& entry : found->second.entries)
+    {
+      if (entry.used && sameBits(entry.constants, constants))
+      {
+        value = entry.value;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  void remember(const std::string& text, const std::vector<double>& constants, double value)
+  {
+    std::lock_guard<std::mutex> guard(Lock);
+    if (Known.size() > 100000)
+    {
+      Known.clear();
+    }
+    Slots& slots = Known[text];
+    Entry& entry = slots.entries[slots.next];
+    slots.next = (slots.next + 1) % slots.entries.size();
+    entry.used = true;
+    entry.constants = constants;
+    entry.value = value;
+  }
+
+private:
+  static bool sameBits(const std::vector<double>& a, const std::vector<double>& b)
+  {
+    return a.size() == b.size() &&
+      (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+  }
+  struct Entry
+  {
+    bool used = false;
+    std::vector<double> constants;
+    double value = 0.0;
+  };
+  struct Slots
+  {
+    std::array<Entry, 4> entries;
+    std::size_t next = 0;
+  };
+  std::mutex Lock;
+  std::unordered_map<std::string, Slots> Known;
 };
 
 /**
@@ -51,6 +124,8 @@ public:
   std::function<void(const std::string& name, const std::string& attribute)> OnReference;
   /// Names that are not available, with the reason (shown instead of "unknown name").
   std::map<std::string, std::string> Unavailable;
+  /// Values already evaluated (none: every expression is read); see ExpressionMemo.
+  ExpressionMemo* Memo = nullptr;
 
   /// Defines a query value such as `le_hub.radius` (not listed among the parameters).
   void defineQuery(const std::string& name, double value)
@@ -109,8 +184,15 @@ public:
   double evaluate(const std::string& expression)
   {
     const std::string expanded = prepare(expression);
-    const std::string readAs = expanded != expression ? " (read as '" + expanded + "')" : "";
+    std::vector<double> constants;
+    std::string key;
+    const bool memo = Memo && constantsIn(expanded, constants, key);
     double value = 0.0;
+    if (memo && Memo->find(key, constants, value))
+    {
+      return value;
+    }
+    const std::string readAs = expanded != expression ? " (read as '" + expanded + "')" : "";
     try
     {
       Parser.SetExpr(expanded);
@@ -167,7 +249,68 @@ public:
       throw ExpressionError{ "'" + expression + "'" + readAs + " evaluates to " +
         (std::isnan(value) ? std::string("NaN") : std::string(value > 0 ? "inf" : "-inf")) };
     }
+    if (memo)
+    {
+      Memo->remember(key, constants, value);
+    }
     return value;
+  }
+
+  /**
+   * The values of the constants muParser reads in `expanded`, in order: every run of name
+   * characters (muParser looks a token up among the constants first) that is one; `key`
+   * is the text with which runs those are. False (not to be remembered) when a name is
+   * neither a constant nor a function called, nor a number: a variable, or an unknown
+   * name (an error, never remembered).
+   */
+  bool constantsIn(const std::string& expanded, std::vector<double>& constants, std::string& key) const
+  {
+    key = expanded;
+    key += '\0';
+    const auto& defined = Parser.GetConst();
+    auto isNameChar = [](char c) {
+      return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+        c == '_' || c == '.';
+    };
+    const std::size_t n = expanded.size();
+    std::size_t i = 0;
+    while (i < n)
+    {
+      if (!isNameChar(expanded[i]))
+      {
+        ++i;
+        continue;
+      }
+      std::size_t j = i;
+      while (j < n && isNameChar(expanded[j]))
+      {
+        ++j;
+      }
+      const std::string token = expanded.substr(i, j - i);
+      const auto found = defined.find(token);
+      key += found != defined.end() ? 'c' : 'n';
+      if (found != defined.end())
+      {
+        constants.push_back(found->second);
+      }
+      else
+      {
+        const char first = expanded[i];
+        std::size_t next = j;
+        while (next < n && (expanded[next] == ' ' || expanded[next] == '\t'))
+        {
+          ++next;
+        }
+        const bool number = (first >= '0' && first <= '9') || first == '.';
+        const bool called = next < n && expanded[next] == '(';
+        if (!number && !called)
+        {
+          return false;
+        }
+      }
+      i = j;
+    }
+    return true;
   }
 
   /**

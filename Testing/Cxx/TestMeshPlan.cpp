@@ -7,6 +7,7 @@
 #include <cstdio>
 #include "ModelDocument.h"
 #include "Placement.h"
+#include "TemplateExpressions.h"
 #include "TestHelpers.h"
 #include "TestTurboInputs.h"
 
@@ -378,6 +379,33 @@ TEST(Placement, ManualMovesThroughTheDocumentFollowAsTheTemplateWould)
   for (std::size_t b = 0; b < grid.xyz.size(); ++b)
   {
     EXPECT_TRUE(test::sameBits(grid.xyz[b], reference.xyz[b])) << model.blocks[b].name;
+  }
+}
+
+TEST(Placement, RememberedExpressionsTakeTheCurrentConstants)
+{
+  // Placements remember values by the expression and its constants' values: a constant
+  // that changed gives the new value, the same values give the bits of a fresh reading,
+  // and what fails (an unknown name) fails every time.
+  detail::ExpressionMemo memo;
+  auto evaluate = [&](double a, double b, const std::string& text, bool remember) {
+    detail::ExpressionEvaluator evaluator;
+    evaluator.Memo = remember ? &memo : nullptr;
+    evaluator.defineQuery("oa.s", a);
+    evaluator.define("b", b);
+    return evaluator.evaluate(text);
+  };
+  const std::string text = "oa.s/3 + sin(b)*2deg - min(b, 0.25)";
+  const double fresh = evaluate(0.1, 0.7, text, false);
+  EXPECT_EQ(evaluate(0.1, 0.7, text, true), fresh);
+  EXPECT_EQ(evaluate(0.1, 0.7, text, true), fresh); // remembered
+  EXPECT_EQ(evaluate(0.1, 0.2, text, true), evaluate(0.1, 0.2, text, false));
+  EXPECT_NE(evaluate(0.1, 0.2, text, true), fresh);
+  EXPECT_EQ(evaluate(0.3, 0.7, text, true), evaluate(0.3, 0.7, text, false));
+  EXPECT_EQ(evaluate(0.1, 0.7, text, true), fresh);
+  for (int round = 0; round < 2; ++round)
+  {
+    EXPECT_THROW(evaluate(0.1, 0.7, "oa.s + c", true), detail::ExpressionError);
   }
 }
 
