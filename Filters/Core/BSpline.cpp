@@ -444,6 +444,18 @@ void basisDerivatives(int span, double t, int degree, int order,
   {
     basisDerivativesOf<3>(span, t, degree, order, knots, ders);
   }
+  else if (degree == 2 && order == 1)
+  {
+    basisDerivativesOf<2, 1>(span, t, degree, order, knots, ders); // curves through 3 points
+  }
+  else if (degree == 2 && order == 2)
+  {
+    basisDerivativesOf<2, 2>(span, t, degree, order, knots, ders);
+  }
+  else if (degree == 1 && order == 1)
+  {
+    basisDerivativesOf<1, 1>(span, t, degree, order, knots, ders); // lines in (s, t)
+  }
   else
   {
     basisDerivativesOf<0>(span, t, degree, order, knots, ders);
@@ -690,7 +702,16 @@ Vec3 BSplineCurve::point(double t) const
   t = clampUnit(t);
   const int span = this->span(t);
   double basis[MaxBasis];
-  bspline::basisFunctions(span, t, Degree, Knots, basis);
+  if (Degree == 3 && t > Knots[3] && t < Knots[ControlPoints.size()])
+  {
+    // strictly inside the end knots no end value is exact (exactEndBasis): the cubic
+    // directly, as basisFunctions() would compute it (most evaluations of a template)
+    bspline::basisFunctionsOf<3>(span, t, Degree, Knots, basis);
+  }
+  else
+  {
+    bspline::basisFunctions(span, t, Degree, Knots, basis);
+  }
   const Vec3* points = &ControlPoints[span - Degree];
   return Degree == 3 ? weightedSum<3>(basis, points, Degree) : weightedSum<0>(basis, points, Degree);
 }
