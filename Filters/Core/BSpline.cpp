@@ -716,6 +716,29 @@ Vec3 BSplineCurve::point(double t) const
   return Degree == 3 ? weightedSum<3>(basis, points, Degree) : weightedSum<0>(basis, points, Degree);
 }
 
+void BSplineCurve::points(const double t[3], Vec3 out[3]) const
+{
+  const double last = Knots[ControlPoints.size()];
+  int span = -1;
+  for (int k = 0; k < 3; ++k)
+  {
+    const double x = clampUnit(t[k]);
+    if (Degree != 3 || !(x > Knots[3] && x < last))
+    {
+      out[k] = point(t[k]);
+      continue;
+    }
+    // inside, the one span k with Knots[k] <= x < Knots[k + 1] (span()'s answer)
+    if (span < 0 || !(Knots[span] <= x && x < Knots[span + 1]))
+    {
+      span = this->span(x);
+    }
+    double basis[MaxBasis];
+    bspline::basisFunctionsOf<3>(span, x, Degree, Knots, basis);
+    out[k] = weightedSum<3>(basis, &ControlPoints[span - Degree], Degree);
+  }
+}
+
 Vec3 BSplineCurve::derivative(double t, int order) const
 {
   if (order <= 0)

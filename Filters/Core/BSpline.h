@@ -73,6 +73,9 @@ public:
     const std::vector<double>& parameters, int degree = 3);
 
   Vec3 point(double t) const override;
+  /// point() at three parameters (a point and its neighbours in a finite difference), the
+  /// same bits, with the span looked up once where they share it.
+  void points(const double t[3], Vec3 out[3]) const;
   Vec3 derivative(double t, int order = 1) const override;
   /// Point and derivatives up to `order`: out[0] = P(t), out[k] = d^k P / dt^k.
   void derivatives(double t, int order, Vec3* out) const;

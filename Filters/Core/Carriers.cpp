@@ -876,10 +876,20 @@ void GordonSurface::crossPoints(double s, double sPlus, double sMinus, double t,
   {
     out[k].setZero();
   }
+  const bool inside = sAt[0] >= 0.0 && sAt[0] <= 1.0 && sAt[1] >= 0.0 && sAt[1] <= 1.0 &&
+    sAt[2] >= 0.0 && sAt[2] <= 1.0;
   for (int j = 0; j < n; ++j)
   {
     Vec3 bracket[3];
     bool have[3] = { false, false, false };
+    // A B-spline section inside [0, 1]: its three points at once (extendedCurvePoint is
+    // its point() there; one not needed below is computed and left).
+    Vec3 section[3];
+    const bool together = inside && SSplines[j];
+    if (together)
+    {
+      SSplines[j]->points(sAt, section);
+    }
     for (int k = 0; k < 5; ++k)
     {
       const int si = at[k][0];
@@ -890,7 +900,7 @@ void GordonSurface::crossPoints(double s, double sPlus, double sMinus, double t,
       }
       if (!have[si])
       {
-        bracket[si] = extendedCurvePoint(*SCurves[j], sAt[si]);
+        bracket[si] = together ? section[si] : extendedCurvePoint(*SCurves[j], sAt[si]);
         for (int i = 0; i < m; ++i)
         {
           bracket[si] -= a[si].value(i) * NodePoints[i + j * m];

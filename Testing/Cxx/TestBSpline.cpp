@@ -711,3 +711,37 @@ TEST(CoonsPatch, OpenBoundaryThrows)
   EXPECT_THROW(CoonsPatch(line(c00, c10), nullptr, line(c01, c11), line(c00, c01)),
     GeometryError);
 }
+
+TEST(BSplineCurve, ThreePointsAtOnceArePointsBitForBit)
+{
+  // points() (a finite difference's three points, the span looked up once) gives point()'s
+  // bits: inside a span, across a knot, at and beyond the ends, cubic and quadratic.
+  std::vector<Vec3> through;
+  for (int k = 0; k < 9; ++k)
+  {
+    through.emplace_back(std::cos(0.4 * k), std::sin(0.7 * k), 0.1 * k * k);
+  }
+  const BSplineCurve cubic = BSplineCurve::interpolate(through, 3);
+  const BSplineCurve quadratic =
+    BSplineCurve::interpolate({ through[0], through[3], through[8] }, 3); // degree 2
+  const double knot = cubic.knots()[5];
+  for (const BSplineCurve* curve : { &cubic, &quadratic })
+  {
+    for (const double s : { 0.0, 1e-7, 0.3, knot, std::nextafter(knot, 0.0), 0.999999, 1.0 })
+    {
+      for (const double h : { 1e-6, 0.2 })
+      {
+        const double t[3] = { s, s + h, s - h };
+        Vec3 out[3];
+        curve->points(t, out);
+        for (int k = 0; k < 3; ++k)
+        {
+          const Vec3 expected = curve->point(t[k]);
+          EXPECT_EQ(out[k].x(), expected.x()) << s << " " << h << " " << k;
+          EXPECT_EQ(out[k].y(), expected.y());
+          EXPECT_EQ(out[k].z(), expected.z());
+        }
+      }
+    }
+  }
+}
