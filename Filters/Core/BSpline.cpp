@@ -346,7 +346,7 @@ namespace
  * carriers are most of the evaluations of a template); the operations and their order
  * are the same, so are the results, bit for bit.
  */
-template <int FixedDegree, int FixedOrder = 0>
+template <int FixedDegree, int FixedOrder = 0, bool Inside = false>
 void basisDerivativesOf(int span, double t, int degree, int order,
   const std::vector<double>& knots, double* ders)
 {
@@ -424,8 +424,12 @@ void basisDerivativesOf(int span, double t, int degree, int order,
   {
     std::fill(ders + k * width, ders + (k + 1) * width, 0.0);
   }
-  // Same exact end values as basisFunctions(), so point and derivatives agree bit for bit.
-  exactEndBasis(span, t, degree, knots, ders);
+  // Same exact end values as basisFunctions(), so point and derivatives agree bit for bit
+  // (none strictly inside the end knots: Inside says the caller knows t is there).
+  if (!Inside)
+  {
+    exactEndBasis(span, t, degree, knots, ders);
+  }
 }
 } // namespace
 
@@ -760,7 +764,19 @@ void BSplineCurve::derivatives(double t, int order, Vec3* out) const
   const int span = this->span(t);
   const int computed = std::min(order, Degree);
   double ders[MaxBasis * MaxBasis];
-  bspline::basisDerivatives(span, t, Degree, computed, Knots, ders);
+  if (Degree == 3 && computed == 1 && t > Knots[3] && t < Knots[ControlPoints.size()])
+  {
+    // strictly inside the end knots (no exact end values): the unrolled cubic directly
+    bspline::basisDerivativesOf<3, 1, true>(span, t, Degree, computed, Knots, ders);
+  }
+  else if (Degree == 3 && computed == 2 && t > Knots[3] && t < Knots[ControlPoints.size()])
+  {
+    bspline::basisDerivativesOf<3, 2, true>(span, t, Degree, computed, Knots, ders);
+  }
+  else
+  {
+    bspline::basisDerivatives(span, t, Degree, computed, Knots, ders);
+  }
   const int width = Degree + 1;
   const Vec3* points = &ControlPoints[span - Degree];
   for (int k = 0; k <= computed; ++k)

@@ -503,7 +503,19 @@ Vec3 SurfaceOfRevolution::point(double s, double t) const
 void SurfaceOfRevolution::crossPoints(double s, double sPlus, double sMinus, double t,
   double tPlus, double tMinus, Vec3 out[5]) const
 {
-  const Vec3 contour[3] = { Contour->point(s), Contour->point(sPlus), Contour->point(sMinus) };
+  Vec3 contour[3];
+  const double along[3] = { s, sPlus, sMinus };
+  if (ContourSpline)
+  {
+    ContourSpline->points(along, contour); // point()'s bits, the span looked up once
+  }
+  else
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      contour[k] = Contour->point(along[k]);
+    }
+  }
   double angle[3], cs[3], sn[3];
   const double at[3] = { t, tPlus, tMinus };
   for (int k = 0; k < 3; ++k)

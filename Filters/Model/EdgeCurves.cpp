@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace blockforge
 {
@@ -27,12 +28,15 @@ namespace
 class FollowCurve : public Curve
 {
 public:
-  /// `reversed`: the follow edge runs from the base's end to its start.
-  FollowCurve(CurvePtr base, const Vec3& startShift, const Vec3& endShift, bool reversed)
+  /// `reversed`: the follow edge runs from the base's end to its start. `samples`: first
+  /// derivatives of the base already taken (its length table's), or null.
+  FollowCurve(CurvePtr base, const Vec3& startShift, const Vec3& endShift, bool reversed,
+    std::shared_ptr<const DerivativeSamples> samples = nullptr)
     : Base(std::move(base))
     , StartShift(startShift)
     , EndShift(endShift)
     , Reversed(reversed)
+    , Samples(std::move(samples))
   {
   }
   Vec3 point(double t) const override
@@ -42,6 +46,17 @@ public:
   Vec3 derivative(double t, int order = 1) const override
   {
     const double sign = Reversed && order % 2 == 1 ? -1.0 : 1.0;
+    if (order == 1 && !Reversed && Samples)
+    {
+      // the base's derivative taken at this very parameter: the same bits
+      std::uint64_t bits = 0;
+      std::memcpy(&bits, &t, sizeof(bits));
+      const auto found = Samples->find(bits);
+      if (found != Samples->end())
+      {
+        return Vec3(sign * found->second + EndShift - StartShift);
+      }
+    }
     const Vec3 base = sign * Base->derivative(Reversed ? 1.0 - t : t, order);
     return order == 1 ? Vec3(base + EndShift - StartShift) : base;
   }
@@ -63,7 +78,71 @@ private:
   CurvePtr Base;
   Vec3 StartShift, EndShift;
   bool Reversed;
+  std::shared_ptr<const DerivativeSamples> Samples;
 };
+
+/// A curve as it is, recording the first derivatives taken while `recording` (a length
+/// table being built); afterwards it only passes calls on.
+class RecordingCurve : public Curve
+{
+public:
+  explicit RecordingCurve(CurvePtr curve)
+    : TheCurve(std::move(curve))
+  {
+  }
+  Vec3 point(double t) const override { return TheCurve->point(t); }
+  Vec3 derivative(double t, int order = 1) const override
+  {
+    const Vec3 value = TheCurve->derivative(t, order);
+    if (order == 1 && Recorded)
+    {
+      std::uint64_t bits = 0;
+      std::memcpy(&bits, &t, sizeof(bits));
+      Recorded->emplace(bits, value);
+    }
+    return value;
+  }
+  void jet(double t, Vec3 out[3]) const override { TheCurve->jet(t, out); }
+  std::vector<double> breakpoints() const override { return TheCurve->breakpoints(); }
+  /// The derivatives recorded; recording stops (the curve is then used on threads).
+  std::shared_ptr<const DerivativeSamples> stop() const
+  {
+    std::shared_ptr<const DerivativeSamples> samples = std::move(Recorded);
+    Recorded.reset();
+    return samples;
+  }
+
+private:
+  CurvePtr TheCurve;
+  mutable std::shared_ptr<DerivativeSamples> Recorded = std::make_shared<DerivativeSamples>();
+};
+
+/// Whether a follow edge follows named edge `index` (its table's derivatives are kept).
+bool followed(const BlockModel& model, int index)
+{
+  for (const Edge& edge : model.edges)
+  {
+    if (edge.kind == Edge::Kind::Follow && edge.source == index)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+/// The length table of `named.curve`, keeping its derivatives when a follow edge follows it.
+void buildLengthTable(const BlockModel& model, const Edge& edge, NamedCurve& named)
+{
+  const int index = static_cast<int>(&edge - model.edges.data());
+  if (index < 0 || index >= static_cast<int>(model.edges.size()) || !followed(model, index))
+  {
+    named.lengthTable = std::make_shared<ArcLength>(named.curve);
+    return;
+  }
+  const auto recording = std::make_shared<RecordingCurve>(named.curve);
+  named.lengthTable = std::make_shared<ArcLength>(recording);
+  named.samples = recording->stop();
+}
 } // namespace
 
 /// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.
@@ -169,7 +248,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       named.curve = std::make_shared<ParameterLineCurve>(geometry.surface(edge.carrier), a, b,
         geometry.closedS(edge.carrier), geometry.closedT(edge.carrier),
         geometry.extendsT(edge.carrier));
-      named.lengthTable = std::make_shared<ArcLength>(named.curve);
+      buildLengthTable(model, edge, named);
       named.length = named.lengthTable->totalLength();
       break;
     }
@@ -239,7 +318,8 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
         (start - sourceStart).norm() + (end - sourceEnd).norm();
       named.curve = reversed
         ? std::make_shared<FollowCurve>(base.curve, start - sourceEnd, end - sourceStart, true)
-        : std::make_shared<FollowCurve>(base.curve, start - sourceStart, end - sourceEnd, false);
+        : std::make_shared<FollowCurve>(
+            base.curve, start - sourceStart, end - sourceEnd, false, base.samples);
       named.lengthTable = std::make_shared<ArcLength>(named.curve);
       named.length = named.lengthTable->totalLength();
       break;
@@ -270,7 +350,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       points.push_back(end);
       named.curve = std::make_shared<BSplineCurve>(
         BSplineCurve::interpolate(points, 3, ParameterMethod::ChordLength));
-      named.lengthTable = std::make_shared<ArcLength>(named.curve);
+      buildLengthTable(model, edge, named);
       named.length = named.lengthTable->totalLength();
       break;
     }

@@ -44,13 +44,23 @@ inline std::string blockEntity(const BlockModel& model, int block)
 // -------------------------------------------------------------------- edge geometry
 /// The curve of a named edge in its own direction (from -> to), with what it takes to
 /// place nodes at arc-length fractions.
+/// A curve's first derivatives at parameters (by their bits), as derivative(t, 1) gave them.
+using DerivativeSamples = std::unordered_map<std::uint64_t, Vec3>;
+
 struct NamedCurve
 {
   CurvePtr curve;
+  /// The first derivatives its length table took, kept when a follow edge follows it: the
+  /// follow edge's table takes its speeds at the same parameters, mostly (FollowCurve).
+  std::shared_ptr<const DerivativeSamples> samples;
   /// Curves on carriers, splines and follow edges (arcs and lines are arc-length already).
   std::shared_ptr<const ArcLength> lengthTable;
   double length = 0.0;
   int projectOnto = -1; ///< Project: the nodes of the straight line are projected onto it
+  /// The projector onto `curve`, made when an edge first takes nodes projected onto it
+  /// (project_from) and kept while the curve is: the same projector, the same bits, and
+  /// a move that leaves the curve does not sample it again. Serial use (edge grading).
+  mutable std::shared_ptr<const CurveProjector> projector;
 };
 
 /// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.

@@ -206,8 +206,17 @@ void projectEdgeParameters(const BlockModel& model, const std::vector<NamedCurve
   const Vec3& start = model.vertices[edge.a].position;
   const Vec3& end = model.vertices[edge.b].position;
   const bool curveReversed = named && model.edges[edge.named].from != edge.a;
-  const CurvePtr curve = named ? named->curve : std::make_shared<LineCurve>(start, end);
-  const CurveProjector projector(curve);
+  std::shared_ptr<const CurveProjector> kept = named ? named->projector : nullptr;
+  if (!kept)
+  {
+    kept = std::make_shared<const CurveProjector>(
+      named ? named->curve : std::make_shared<LineCurve>(start, end));
+    if (named)
+    {
+      named->projector = kept;
+    }
+  }
+  const CurveProjector& projector = *kept;
   const bool crossed = runsAgainst(model, edge, source);
   std::vector<double> params(n, 0.0);
   params[n - 1] = 1.0;
