@@ -877,6 +877,64 @@ void GordonSurface::crossPoints(double s, double sPlus, double sMinus, double t,
   const int m = static_cast<int>(SNodes.size());
   const double sAt[3] = { s, sPlus, sMinus };
   const double tAt[3] = { t, tPlus, tMinus };
+  const bool inside = sAt[0] >= 0.0 && sAt[0] <= 1.0 && sAt[1] >= 0.0 && sAt[1] <= 1.0 &&
+    sAt[2] >= 0.0 && sAt[2] <= 1.0;
+  if (m == 0 && inside && TheBlending == Blending::Spline && n <= StackNodes)
+  {
+    // A loft of sections (a blade) at s inside [0, 1]: the sums below in the same order
+    // (section j's three points, each t's blends), the node interval of t found once for
+    // the three t when they share it (locateInterval's answer, the interval holding t).
+    double blend[3][StackNodes];
+    int interval = -1;
+    for (int q = 0; q < 3; ++q)
+    {
+      const double x = tAt[q];
+      if (!(q > 0 && interval >= 0 && interval < n - 1 && TNodes[interval] <= x &&
+            x < TNodes[interval + 1]))
+      {
+        interval = locateInterval(TNodes, x);
+      }
+      for (int j = 0; j < n; ++j)
+      {
+        blend[q][j] = splineValue(TNodes, TBlendCoefficients[j], j, interval, x);
+      }
+    }
+    for (int k = 0; k < 5; ++k)
+    {
+      out[k].setZero();
+    }
+    for (int j = 0; j < n; ++j)
+    {
+      Vec3 section[3];
+      if (SSplines[j])
+      {
+        SSplines[j]->points(sAt, section);
+      }
+      else
+      {
+        for (int q = 0; q < 3; ++q)
+        {
+          section[q] = SCurves[j]->point(sAt[q]); // extendedCurvePoint inside [0, 1]
+        }
+      }
+      const double b0 = blend[0][j], b1 = blend[1][j], b2 = blend[2][j];
+      if (b0 != 0.0)
+      {
+        out[0] += b0 * section[0];
+        out[1] += b0 * section[1];
+        out[2] += b0 * section[2];
+      }
+      if (b1 != 0.0)
+      {
+        out[3] += b1 * section[0];
+      }
+      if (b2 != 0.0)
+      {
+        out[4] += b2 * section[0];
+      }
+    }
+    return;
+  }
   const BlendValues b[3] = { { TheBlending, TNodes, TBlendCoefficients, t },
     { TheBlending, TNodes, TBlendCoefficients, tPlus },
     { TheBlending, TNodes, TBlendCoefficients, tMinus } };
@@ -888,8 +946,6 @@ void GordonSurface::crossPoints(double s, double sPlus, double sMinus, double t,
   {
     out[k].setZero();
   }
-  const bool inside = sAt[0] >= 0.0 && sAt[0] <= 1.0 && sAt[1] >= 0.0 && sAt[1] <= 1.0 &&
-    sAt[2] >= 0.0 && sAt[2] <= 1.0;
   for (int j = 0; j < n; ++j)
   {
     Vec3 bracket[3];

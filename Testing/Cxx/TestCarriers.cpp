@@ -1431,3 +1431,48 @@ TEST(OffsetOnSurface, OpenCurveCalledClosedIsAnError)
     EXPECT_TRUE(std::abs(r - 1.1) < 1e-12 || std::abs(r - 0.9) < 1e-12) << r;
   }
 }
+
+TEST(GordonSurface, CrossPointsArePointsBitForBit)
+{
+  // crossPoints() (a closest-point search's five points: the loft's shortcut and the
+  // general sums) gives point()'s bits: B-spline and straight sections, both blendings,
+  // inside, at section heights (blends exactly 0 and 1), at and beyond the ends.
+  std::vector<CurvePtr> sections;
+  const std::vector<double> heights = { 0.0, 0.25, 0.6, 1.0 };
+  for (std::size_t j = 0; j < heights.size(); ++j)
+  {
+    std::vector<Vec3> points;
+    for (int i = 0; i <= 12; ++i)
+    {
+      const double u = i / 12.0;
+      points.emplace_back(u - 0.5, 0.15 * std::sin(Pi * u) + 0.05 * static_cast<double>(j), heights[j]);
+    }
+    sections.push_back(std::make_shared<BSplineCurve>(BSplineCurve::interpolate(points)));
+  }
+  std::vector<std::shared_ptr<const GordonSurface>> surfaces;
+  for (auto blending : { GordonSurface::Blending::Lagrange, GordonSurface::Blending::Spline })
+  {
+    surfaces.push_back(std::make_shared<GordonSurface>(GordonSurface::fromSections(sections, heights, blending)));
+    surfaces.push_back(twistedBladeLoft(blending));
+  }
+  for (const auto& surface : surfaces)
+  {
+    for (const double s : { 0.0, 1e-7, 0.31, 0.5, 0.9999995, 1.0, -0.01 })
+    {
+      for (const double t : { 0.0, 0.25, 0.3, 0.41, 1.0, 1.02 })
+      {
+        const double h = 1e-6;
+        Vec3 out[5];
+        surface->crossPoints(s, s + h, s - h, t, t + h, t - h, out);
+        const Vec3 expected[5] = { surface->point(s, t), surface->point(s + h, t),
+          surface->point(s - h, t), surface->point(s, t + h), surface->point(s, t - h) };
+        for (int k = 0; k < 5; ++k)
+        {
+          EXPECT_TRUE(out[k].x() == expected[k].x() && out[k].y() == expected[k].y() &&
+            out[k].z() == expected[k].z())
+            << "s " << s << " t " << t << " point " << k;
+        }
+      }
+    }
+  }
+}
