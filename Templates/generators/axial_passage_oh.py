@@ -54,6 +54,12 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   lines normal to blade and O-grid), unless the edge block would still be a fan more than
 #   o_fan times wider outside than on the blade (a sharp wedge, whose edge block is left a
 #   fan on the tip: arc-length nodes on a short blade arc under a wide fan fold it).
+# - A trailing edge neither sharp nor sheared (the turbine's capped one): the feet stay o_back
+#   along the blade from the edge, the corners their normal offsets on the flanks, so that the
+#   edge block holds the whole fan round the tip or the cap's corners and meets the sides
+#   with cells on the flanks (corners on the fan make the edge block's first cells the feet of
+#   fanning cells, their blade width shrinking with the square of the density); the H lines
+#   at its corners leave downstream along the bisector, as at a sheared edge.
 # - H blocks: the periodic_low line runs mid-passage (between side a and the side b of the
 #   blade one pitch below) through the front, middle and rear O corners. Upstream and
 #   downstream the H lines leave the O-grid along the camber direction at the edges
@@ -116,6 +122,7 @@ parameters:
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   bisect_step: 0.005      # at a sheared edge the H lines bisect the blade direction and the O curve's at the unsheared corner, measured over this step along it (fraction of the loop)
+  o_back: 0.012           # at a trailing edge neither sharp nor sheared (round or capped) the corners' feet stay at least this far from the edge (fraction of the loop; the turbine's cap spans 0.007), the H lines downstream then leave along the bisector as at a sheared edge
   o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
   o_fan: 30               # ... where the edge block's outer chord is at most this many times its blade chord (sharper edges keep corners and feet on the tip: a fan)
   probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
@@ -268,7 +275,13 @@ def template_text():
             y0 = f'(rm_{l}*(w{e}_{l}.theta - {U("theta")}))'
             w(f'  {e}_bx_{l}: "{x0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_tx_{l}"      # bisector at a sheared edge')
             w(f'  {e}_by_{l}: "{y0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_ty_{l}"')
-            w(f'  {base}_x_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
+            # (and at a trailing edge whose corners o_back moved onto the flanks: lines
+            # straight down the camber would leave the O curve there at a small angle)
+            if e == 'te':
+                w(f'  {base}_x_{l}: "shear_{e} || off_{e}_{l} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
+                w(f'  {base}_lo_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
+            else:
+                w(f'  {base}_x_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
         # parameter gaps (in the dir sense) between consecutive O corners on the blade and the O curve
         def gap(name, a, b):
             x = f'dir_{l}*({b}_{l}.s - {a}_{l}.s)'
@@ -342,7 +355,16 @@ def template_text():
             lim = f'max({off}, o_tip)' if towards == '+' else f'min({off}, -o_tip)'
             w(f'  k{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{lim}", fixed: true}}')
             w(f'  r{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"k{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
-            w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {distance2(f"r{b}_{l}")} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
+            corner = distance2(f"r{b}_{l}")
+            if e == 'te':
+                # a trailing edge neither sharp nor sheared (round or capped): the feet at least
+                # o_back from the edge, so that the edge block holds the whole fan round the
+                # tip or round the cap's corners and meets the sides with cells on the flanks
+                limb = f'max({off}, o_back)' if towards == '+' else f'min({off}, -o_back)'
+                w(f'  kb{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{limb}", fixed: true}}')
+                w(f'  rb{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"kb{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
+                corner = f'(shear_{e} ? {corner} : {distance2(f"rb{b}_{l}")})'
+            w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {corner} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
             w(f'  {b}_{l}: {{project: {v}_{l}, onto: blade_{l}}}')
         # a step along the O curve from the unsheared corner of a sheared edge towards the edge
         w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*bisect_step : ob_f_{l}.s + dir_{l}*bisect_step", fixed: true}}')
@@ -364,8 +386,8 @@ def template_text():
         for v, src in (('lo_in', 'lo_f'), ('a_in', 'oa_f'), ('b_in', 'ob_f')):
             w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "{src}_{l}.theta + ({src}_{l}.axial - inlet_axial)*slope_in_x_{l}/rm_{l}"}}')
         w(f'  hi_in_{l}: {{periodic: lo_in_{l}}}')
-        for v, src in (('lo_out', 'lo_r'), ('a_out', 'oa_r'), ('b_out', 'ob_r')):
-            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*slope_out_x_{l}/rm_{l}"}}')
+        for v, src, slope in (('lo_out', 'lo_r', 'slope_out_lo'), ('a_out', 'oa_r', 'slope_out_x'), ('b_out', 'ob_r', 'slope_out_x')):
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*{slope}_{l}/rm_{l}"}}')
         w(f'  hi_out_{l}: {{periodic: lo_out_{l}}}')
     w('')
     w('edges:')
