@@ -279,7 +279,6 @@ def template_text():
             # straight down the camber would leave the O curve there at a small angle)
             if e == 'te':
                 w(f'  {base}_x_{l}: "shear_{e} || off_{e}_{l} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
-                w(f'  {base}_lo_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
             else:
                 w(f'  {base}_x_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
         # parameter gaps (in the dir sense) between consecutive O corners on the blade and the O curve
@@ -386,8 +385,8 @@ def template_text():
         for v, src in (('lo_in', 'lo_f'), ('a_in', 'oa_f'), ('b_in', 'ob_f')):
             w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "{src}_{l}.theta + ({src}_{l}.axial - inlet_axial)*slope_in_x_{l}/rm_{l}"}}')
         w(f'  hi_in_{l}: {{periodic: lo_in_{l}}}')
-        for v, src, slope in (('lo_out', 'lo_r', 'slope_out_lo'), ('a_out', 'oa_r', 'slope_out_x'), ('b_out', 'ob_r', 'slope_out_x')):
-            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*{slope}_{l}/rm_{l}"}}')
+        for v, src in (('lo_out', 'lo_r'), ('a_out', 'oa_r'), ('b_out', 'ob_r')):
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*slope_out_x_{l}/rm_{l}"}}')
         w(f'  hi_out_{l}: {{periodic: lo_out_{l}}}')
     w('')
     w('edges:')
