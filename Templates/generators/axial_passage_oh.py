@@ -54,6 +54,12 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   lines normal to blade and O-grid), unless the edge block would still be a fan more than
 #   o_fan times wider outside than on the blade (a sharp wedge, whose edge block is left a
 #   fan on the tip: arc-length nodes on a short blade arc under a wide fan fold it).
+# - A trailing edge neither sharp nor sheared (the turbine's capped one): the feet stay o_back
+#   along the blade from the edge, the corners their normal offsets on the flanks, so that the
+#   edge block holds the whole fan round the tip or the cap's corners and meets the sides
+#   with cells on the flanks (corners on the fan make the edge block's first cells the feet of
+#   fanning cells, their blade width shrinking with the square of the density); the H lines
+#   at its corners leave downstream along the bisector, as at a sheared edge.
 # - H blocks: the periodic_low line runs mid-passage (between side a and the side b of the
 #   blade one pitch below) through the front, middle and rear O corners. Upstream and
 #   downstream the H lines leave the O-grid along the camber direction at the edges
@@ -88,7 +94,9 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 # across the block interfaces differ little at every density:
 # - the O-grid: geometric k_o away from the blade (its outer cell is what the H blocks start
 #   with); the blade sides `ends`, their end cells side_end times their mean cell, side_shear
-#   next to a sheared edge, or side_fan next to a sharp edge's fan (o_fan), so that they
+#   next to a sheared edge on the side whose corner moves along the blade, side_tip on the
+#   other side (its corner stays on the tip, so its first cell shares the nose's fan with the
+#   edge block), or side_fan next to a sharp edge's fan (o_fan), so that they
 #   shrink towards the edge block's cells (numbers per edge, not expressions of the corners:
 #   the optimizer's live model keeps laws as the template gave them), `flat` side_flat so
 #   that their middle cells stay near their mean cell; the O-grid's
@@ -114,6 +122,7 @@ parameters:
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   bisect_step: 0.005      # at a sheared edge the H lines bisect the blade direction and the O curve's at the unsheared corner, measured over this step along it (fraction of the loop)
+  o_back: 0.012           # at a trailing edge neither sharp nor sheared (round or capped) the corners' feet stay at least this far from the edge (fraction of the loop; the turbine's cap spans 0.007), the H lines downstream then leave along the bisector as at a sheared edge
   o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
   o_fan: 30               # ... where the edge block's outer chord is at most this many times its blade chord (sharper edges keep corners and feet on the tip: a fan)
   probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
@@ -134,16 +143,17 @@ parameters:
   k_span: 1.05            # expansion ratio away from hub and shroud (two-sided)
   side_end: 0.35          # blade sides (and the periodic lines beside them): end cells this fraction of their mean cell, towards the edge blocks' cells ...
   side_fan: 0.03          # ... the same at a sharp edge whose edge block is a fan on the tip (o_fan) ...
-  side_shear: 0.2         # ... and at a sheared edge (o_shear)
+  side_shear: 0.2         # ... and at a sheared edge (o_shear), on the side whose corner moves along the blade ...
+  side_tip: 0.15          # ... and the other side's, whose corner stays at the edge tip (a fan shared with the edge block: smaller cells leave less of it to the side's first cell)
   side_flat: 3            # flatness of the sides' grading between its end cells (law `ends`, `flat`): their middle cells stay near the mean however small the ends
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
 """
 
 FOOTER = """blocks:
   O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_le_h}, E5: {project_from: ol_le_s}}}}
-  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_le_h, se_te_h], flat: side_flat}, E3: {project_from: bl_a_h}, E5: {ends: [se_le_s, se_te_s], flat: side_flat}, E7: {project_from: bl_a_s}}}}
+  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_le_a_h, se_te_a_h], flat: side_flat}, E3: {project_from: bl_a_h}, E5: {ends: [se_le_a_s, se_te_a_s], flat: side_flat}, E7: {project_from: bl_a_s}}}}
   O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
-  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_te_h, se_le_h], flat: side_flat}, E3: {project_from: bl_b_h}, E5: {ends: [se_te_s, se_le_s], flat: side_flat}, E7: {project_from: bl_b_s}}}}
+  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_te_b_h, se_le_b_h], flat: side_flat}, E3: {project_from: bl_b_h}, E5: {ends: [se_te_b_s, se_le_b_s], flat: side_flat}, E7: {project_from: bl_b_s}}}}
   U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
@@ -210,6 +220,11 @@ def template_text():
             inner = f'sqrt((k{a}_{l}.axial - k{b}_{l}.axial)^2 + (rm_{l}*(k{a}_{l}.theta - k{b}_{l}.theta))^2)'
             w(f'  off_{e}_{l}: "{outer} <= o_fan*{inner}"')
             w(f'  se_{e}_{l}: "off_{e}_{l} ? (shear_{e} ? side_shear : side_end) : side_fan"      # the blade sides\' relative end cells at this edge')
+            # per side: at a sheared edge the side whose corner stays at the tip (o_lean_shear)
+            # shares the nose's fan with the edge block, whose cells there are the feet of its
+            # outer arc's: side_tip; the periodic lines keep se_{e} (one law for lo and hi)
+            for sd, moved in (('a', f'sa_{"f" if e == "le" else "r"}_{l}'), ('b', f'sb_{"f" if e == "le" else "r"}_{l}')):
+                w(f'  se_{e}_{sd}_{l}: "off_{e}_{l} ? (shear_{e} ? ({moved} ? side_shear : side_tip) : side_end) : side_fan"      # side {sd}\'s relative end cell at this edge')
         # H lines upstream / downstream: slope d(r theta)/d(axial distance from the O-grid)
         w(f'  slope_in_{l}: "tan(follow_le*atan2(le_uy_{l}, -le_ux_{l}))"')
         w(f'  slope_out_{l}: "tan(follow_te*atan2(te_uy_{l}, te_ux_{l}))"')
@@ -260,7 +275,12 @@ def template_text():
             y0 = f'(rm_{l}*(w{e}_{l}.theta - {U("theta")}))'
             w(f'  {e}_bx_{l}: "{x0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_tx_{l}"      # bisector at a sheared edge')
             w(f'  {e}_by_{l}: "{y0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_ty_{l}"')
-            w(f'  {base}_x_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
+            # (and at a trailing edge whose corners o_back moved onto the flanks: lines
+            # straight down the camber would leave the O curve there at a small angle)
+            if e == 'te':
+                w(f'  {base}_x_{l}: "shear_{e} || off_{e}_{l} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
+            else:
+                w(f'  {base}_x_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
         # parameter gaps (in the dir sense) between consecutive O corners on the blade and the O curve
         def gap(name, a, b):
             x = f'dir_{l}*({b}_{l}.s - {a}_{l}.s)'
@@ -334,7 +354,16 @@ def template_text():
             lim = f'max({off}, o_tip)' if towards == '+' else f'min({off}, -o_tip)'
             w(f'  k{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{lim}", fixed: true}}')
             w(f'  r{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"k{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
-            w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {distance2(f"r{b}_{l}")} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
+            corner = distance2(f"r{b}_{l}")
+            if e == 'te':
+                # a trailing edge neither sharp nor sheared (round or capped): the feet at least
+                # o_back from the edge, so that the edge block holds the whole fan round the
+                # tip or round the cap's corners and meets the sides with cells on the flanks
+                limb = f'max({off}, o_back)' if towards == '+' else f'min({off}, -o_back)'
+                w(f'  kb{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{limb}", fixed: true}}')
+                w(f'  rb{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"kb{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
+                corner = f'(shear_{e} ? {corner} : {distance2(f"rb{b}_{l}")})'
+            w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {corner} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
             w(f'  {b}_{l}: {{project: {v}_{l}, onto: blade_{l}}}')
         # a step along the O curve from the unsheared corner of a sheared edge towards the edge
         w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*bisect_step : ob_f_{l}.s + dir_{l}*bisect_step", fixed: true}}')

@@ -39,16 +39,27 @@ using test::Pi;
  * axial_passage_oh grades its edge blocks' O-grid arcs and every H edge with `match`, the
  * blade sides towards the edge blocks (`ends`), the O-grid's outer sides and the edge
  * blocks' blade arcs as normal feet and offsets (`project_from`), the sides' end cells
- * 0.35 of their mean at round edges, 0.2 at sheared ones (o_shear), 0.03 next to a sharp
- * edge's fan: measured 9.7-25.5 on Rotor 37, 4.0-4.5 on the distributor, 9.0-50.1 on the
- * turbine and 5.0-20.3 on the compressor (their sheared, capped and sharp edges' blocks
- * against the blade sides, growing with the density; with 0.35 everywhere 12.1-31.4,
- * 5.2-5.5, 9.0-50.1, 27-70; 28-570 before the grading). Its bound keeps it from getting
- * worse.
+ * 0.35 of their mean at round edges; at sheared ones (o_shear) 0.2 on the side whose corner
+ * moves along the blade and 0.15 on the other side, whose corner stays on the tip
+ * (side_tip: its first cell shares the nose's fan with the edge block's); 0.03 next to a
+ * sharp edge's fan. At a trailing edge neither sharp nor sheared (the turbine's capped one)
+ * the O corners sit on the flanks (o_back), so the edge block holds the fans round the
+ * cap's corners. The largest ratio sits where an O corner's radial line starts on a fan (a
+ * thin nose, a sharp tip): the edge block's cell there is a fan cell, the feet of its outer
+ * cell, whose width on the blade shrinks with the square of the density, the side's only
+ * linearly. Measured (density 0.5-4, no optimizer): Rotor 37 8.5-22.9 and the distributor
+ * 3.5-4.2 (O_te against O_b, O_a against O_te; 9.7-25.5 and 4.0-4.5 with 0.2 on both
+ * sides), the turbine 3.3-3.7 (the downstream blocks; 8.9-50.1 with its corners on the
+ * cap's corners), the compressor 5.0-20.5 (its fans); 28-570 before the grading. The
+ * bounds, per machine, fail when the grading gets worse.
  */
-double maxNeighbourRatio(const std::string& templateName)
+double maxNeighbourRatio(const std::string& templateName, const std::string& machine)
 {
-  return templateName == "axial_passage_h" ? 1.5 : 51.0;
+  if (templateName == "axial_passage_h")
+    return 1.5;
+  static const std::map<std::string, double> oh = { { "rotor37", 23.5 }, { "distributor", 4.3 },
+    { "turbine", 3.8 }, { "compressor", 21.0 } };
+  return oh.at(machine);
 }
 
 struct Machine
@@ -307,7 +318,7 @@ void checkFitness(const std::string& templateName, const Machine& machine)
     const test::NeighbourRatio jump =
       test::neighbourSizeRatio(grid, model, cyl.axis, pitch, chord);
     EXPECT_GT(jump.pairs, 0u);
-    EXPECT_LE(jump.ratio, maxNeighbourRatio(templateName)) << jump.where;
+    EXPECT_LE(jump.ratio, maxNeighbourRatio(templateName, machine.name)) << jump.where;
 
     const double expansion = test::maxExpansionInBlocks(grid);
     std::printf("FITNESS %s %s density %.1f cells %lld MinAngle %lld %lld %lld %lld %lld "
