@@ -98,7 +98,8 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   other side (its corner stays on the tip, so its first cell shares the nose's fan with the
 #   edge block), or side_fan next to a sharp edge's fan (o_fan), so that they
 #   shrink towards the edge block's cells (numbers per edge, not expressions of the corners:
-#   the optimizer's live model keeps laws as the template gave them), `flat` side_flat so
+#   the optimizer's live model keeps laws as the template gave them), `flat` side_flat
+#   (side_flat_fan where a side ends at a sharp edge's fan) so
 #   that their middle cells stay near their mean cell; the O-grid's
 #   outer sides the normal offsets of the blade sides' nodes (project_from); the edge blocks'
 #   outer arcs `match` (cells of their neighbours at both ends, growing by o_match towards
@@ -145,20 +146,21 @@ parameters:
   side_fan: 0.03          # ... the same at a sharp edge whose edge block is a fan on the tip (o_fan) ...
   side_shear: 0.2         # ... and at a sheared edge (o_shear), on the side whose corner moves along the blade ...
   side_tip: 0.15          # ... and the other side's, whose corner stays at the edge tip (a fan shared with the edge block: smaller cells leave less of it to the side's first cell)
-  side_flat: 3            # flatness of the sides' grading between its end cells (law `ends`, `flat`): their middle cells stay near the mean however small the ends
+  side_flat: 3            # flatness of the sides' grading between its end cells (law `ends`, `flat`): their middle cells stay near the mean however small the ends ...
+  side_flat_fan: 2        # ... and of a side that ends at a sharp edge's fan (o_fan): flatter, its cells next to the fan's tiny end cells grow so fast that the optimizer stalls (compressor, density 4: 9.6 deg against 22.1)
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
 """
 
 FOOTER = """blocks:
   O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_le_h}, E5: {project_from: ol_le_s}}}}
-  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_le_a_h, se_te_a_h], flat: side_flat}, E3: {project_from: bl_a_h}, E5: {ends: [se_le_a_s, se_te_a_s], flat: side_flat}, E7: {project_from: bl_a_s}}}}
+  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_le_a_h, se_te_a_h], flat: sf_h}, E3: {project_from: bl_a_h}, E5: {ends: [se_le_a_s, se_te_a_s], flat: sf_s}, E7: {project_from: bl_a_s}}}}
   O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
-  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_te_b_h, se_le_b_h], flat: side_flat}, E3: {project_from: bl_b_h}, E5: {ends: [se_te_b_s, se_le_b_s], flat: side_flat}, E7: {project_from: bl_b_s}}}}
+  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_te_b_h, se_le_b_h], flat: sf_h}, E3: {project_from: bl_b_h}, E5: {ends: [se_te_b_s, se_le_b_s], flat: sf_s}, E7: {project_from: bl_b_s}}}}
   U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
-  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {project_from: bl_a_h}, E4: {ends: [se_le_h, se_te_h], flat: side_flat}, E6: {project_from: bl_a_s}, E8: {ends: [se_le_s, se_te_s], flat: side_flat}}}}
-  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {ends: [se_le_h, se_te_h], flat: side_flat}, E4: {project_from: bl_b_h}, E6: {ends: [se_le_s, se_te_s], flat: side_flat}, E8: {project_from: bl_b_s}}}}
+  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {project_from: bl_a_h}, E4: {ends: [se_le_h, se_te_h], flat: sf_h}, E6: {project_from: bl_a_s}, E8: {ends: [se_le_s, se_te_s], flat: sf_s}}}}
+  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {ends: [se_le_h, se_te_h], flat: sf_h}, E4: {project_from: bl_b_h}, E6: {ends: [se_le_s, se_te_s], flat: sf_s}, E8: {project_from: bl_b_s}}}}
   D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
@@ -225,6 +227,7 @@ def template_text():
             # outer arc's: side_tip; the periodic lines keep se_{e} (one law for lo and hi)
             for sd, moved in (('a', f'sa_{"f" if e == "le" else "r"}_{l}'), ('b', f'sb_{"f" if e == "le" else "r"}_{l}')):
                 w(f'  se_{e}_{sd}_{l}: "off_{e}_{l} ? (shear_{e} ? ({moved} ? side_shear : side_tip) : side_end) : side_fan"      # side {sd}\'s relative end cell at this edge')
+        w(f'  sf_{l}: "off_le_{l} && off_te_{l} ? side_flat : side_flat_fan"      # the blade sides\' flatness (law ends, flat): side_flat_fan where one ends at a fan')
         # H lines upstream / downstream: slope d(r theta)/d(axial distance from the O-grid)
         w(f'  slope_in_{l}: "tan(follow_le*atan2(le_uy_{l}, -le_ux_{l}))"')
         w(f'  slope_out_{l}: "tan(follow_te*atan2(te_uy_{l}, te_ux_{l}))"')
