@@ -157,7 +157,7 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.6))
     for axis, key, label in ((axes[0], "axial", "axial force on a vane F_z [N]"),
                              (axes[1], "torque", "torque about the axis M_z [N m]")):
         for name, marker in zip(series, "os^"):
@@ -169,10 +169,12 @@ def main():
         axis.set_xlabel("cells (one passage)")
         axis.set_ylabel(label)
         axis.grid(True, which="both", alpha=0.3)
-        axis.legend(loc="best", fontsize="small")
+    # One legend below both plots: inside either it hides the points of the coarse grids.
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(series), fontsize="small")
     fig.suptitle("Distributor passage, axial_passage_oh, simpleFoam k-omega SST "
                  f"({args.iterations} iterations)")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     Path(args.png).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.png, dpi=110)
 
