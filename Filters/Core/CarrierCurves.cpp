@@ -1,6 +1,6 @@
 // Curves made from carriers (Carriers.h): the blade's intersection with a surface of
-// revolution and offsets within a surface. Split from Carriers.cpp, which builds the
-// surfaces themselves.
+// revolution and offsets within a surface. The surfaces are in SurfaceOfRevolution.cpp
+// and GordonSurface.cpp, curves drawn in a surface's (s, t) in Carriers.cpp.
 #include "Carriers.h"
 #include "RootFinding.h"
 
