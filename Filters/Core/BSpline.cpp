@@ -706,7 +706,7 @@ Vec3 BSplineCurve::point(double t) const
   t = clampUnit(t);
   const int span = this->span(t);
   double basis[MaxBasis];
-  if (Degree == 3 && t > Knots[3] && t < Knots[ControlPoints.size()])
+  if (cubicInside(t))
   {
     // strictly inside the end knots no end value is exact (exactEndBasis): the cubic
     // directly, as basisFunctions() would compute it (most evaluations of a template)
@@ -722,12 +722,11 @@ Vec3 BSplineCurve::point(double t) const
 
 void BSplineCurve::points(const double t[3], Vec3 out[3]) const
 {
-  const double last = Knots[ControlPoints.size()];
   int span = -1;
   for (int k = 0; k < 3; ++k)
   {
     const double x = clampUnit(t[k]);
-    if (Degree != 3 || !(x > Knots[3] && x < last))
+    if (!cubicInside(x))
     {
       out[k] = point(t[k]);
       continue;
@@ -764,12 +763,12 @@ void BSplineCurve::derivatives(double t, int order, Vec3* out) const
   const int span = this->span(t);
   const int computed = std::min(order, Degree);
   double ders[MaxBasis * MaxBasis];
-  if (Degree == 3 && computed == 1 && t > Knots[3] && t < Knots[ControlPoints.size()])
+  if (computed == 1 && cubicInside(t))
   {
     // strictly inside the end knots (no exact end values): the unrolled cubic directly
     bspline::basisDerivativesOf<3, 1, true>(span, t, Degree, computed, Knots, ders);
   }
-  else if (Degree == 3 && computed == 2 && t > Knots[3] && t < Knots[ControlPoints.size()])
+  else if (computed == 2 && cubicInside(t))
   {
     bspline::basisDerivativesOf<3, 2, true>(span, t, Degree, computed, Knots, ders);
   }

@@ -91,6 +91,12 @@ public:
 private:
   /// findSpan(Degree, Knots, count, t), from SpanTable: the same result, faster.
   int span(double t) const;
+  /// A cubic strictly inside its end knots, where no basis value is an exact end value
+  /// (exactEndBasis): the cubic basis can be evaluated directly, the same bits.
+  bool cubicInside(double t) const
+  {
+    return Degree == 3 && t > Knots[3] && t < Knots[ControlPoints.size()];
+  }
   int Degree;
   std::vector<double> Knots;
   /// The span at the start of each of SpanTable.size() - 1 equal bins of

@@ -42,11 +42,11 @@ inline std::string blockEntity(const BlockModel& model, int block)
 }
 
 // -------------------------------------------------------------------- edge geometry
-/// The curve of a named edge in its own direction (from -> to), with what it takes to
-/// place nodes at arc-length fractions.
 /// A curve's first derivatives at parameters (by their bits), as derivative(t, 1) gave them.
 using DerivativeSamples = std::unordered_map<std::uint64_t, Vec3>;
 
+/// The curve of a named edge in its own direction (from -> to), with what it takes to
+/// place nodes at arc-length fractions.
 struct NamedCurve
 {
   CurvePtr curve;

@@ -280,10 +280,8 @@ def template_text():
             w(f'  {e}_by_{l}: "{y0}/sqrt({x0}^2 + {y0}^2) {ta} {e}_ty_{l}"')
             # (and at a trailing edge whose corners o_back moved onto the flanks: lines
             # straight down the camber would leave the O curve there at a small angle)
-            if e == 'te':
-                w(f'  {base}_x_{l}: "shear_{e} || off_{e}_{l} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
-            else:
-                w(f'  {base}_x_{l}: "shear_{e} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
+            bisect = f'shear_{e} || off_{e}_{l}' if e == 'te' else f'shear_{e}'
+            w(f'  {base}_x_{l}: "{bisect} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
         # parameter gaps (in the dir sense) between consecutive O corners on the blade and the O curve
         def gap(name, a, b):
             x = f'dir_{l}*({b}_{l}.s - {a}_{l}.s)'
