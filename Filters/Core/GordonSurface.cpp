@@ -91,11 +91,15 @@ int locateInterval(const std::vector<double>& nodes, double x)
   return static_cast<int>(std::upper_bound(nodes.begin(), nodes.end(), x) - nodes.begin()) - 1;
 }
 
-/// Lagrange polynomial L_i (paper eq. 5) and its first two derivatives at x. The factors
-/// (x - x_k) / (x_i - x_k) are exactly 1 at x = x_i and exactly 0 at the other nodes, so
-/// the surface passes through its curves bit for bit.
-void lagrangeJet(const std::vector<double>& nodes, int i, double x, double jet[3])
+/// Lagrange polynomial L_i (paper eq. 5) at x and, for Order 2, its first two
+/// derivatives (jet[0..Order]). The factors (x - x_k) / (x_i - x_k) are exactly 1 at
+/// x = x_i and exactly 0 at the other nodes, so the surface passes through its curves bit
+/// for bit. The value takes the same operations for either order (the same bits), so
+/// point() and derivatives() agree; Order 0 skips the derivatives' work.
+template <int Order>
+void lagrangeJet(const std::vector<double>& nodes, int i, double x, double jet[])
 {
+  static_assert(Order == 0 || Order == 2, "values, or values and two derivatives");
   double p = 1.0, p1 = 0.0, p2 = 0.0;
   const double xi = nodes[i];
   for (int k = 0; k < static_cast<int>(nodes.size()); ++k)
@@ -105,15 +109,22 @@ void lagrangeJet(const std::vector<double>& nodes, int i, double x, double jet[3
       continue;
     }
     const double d = xi - nodes[k];
-    const double q = (x - nodes[k]) / d, q1 = 1.0 / d;
-    // Product rule on (p, p', p'') * (q, q', 0); update from the highest order down.
-    p2 = p2 * q + 2.0 * p1 * q1;
-    p1 = p1 * q + p * q1;
+    const double q = (x - nodes[k]) / d;
+    if (Order == 2)
+    {
+      // Product rule on (p, p', p'') * (q, q', 0); update from the highest order down.
+      const double q1 = 1.0 / d;
+      p2 = p2 * q + 2.0 * p1 * q1;
+      p1 = p1 * q + p * q1;
+    }
     p = p * q;
   }
   jet[0] = p;
-  jet[1] = p1;
-  jet[2] = p2;
+  if (Order == 2)
+  {
+    jet[1] = p1;
+    jet[2] = p2;
+  }
 }
 
 /**
@@ -166,10 +177,14 @@ std::vector<double> naturalCardinalSpline(const std::vector<double>& x, int j)
   return coefficients;
 }
 
-/// Cardinal spline j at x in node interval k (from locateInterval), linear beyond the ends.
+/// Cardinal spline j at x in node interval k (from locateInterval), linear beyond the
+/// ends: jet[0..Order] = value and, for Order 2, its first two derivatives. The value takes
+/// the same operations for either order (the same bits).
+template <int Order>
 void splineJet(const std::vector<double>& nodes, const std::vector<double>& coefficients,
-  int j, int k, double x, double jet[3])
+  int j, int k, double x, double jet[])
 {
+  static_assert(Order == 0 || Order == 2, "values, or values and two derivatives");
   const int n = static_cast<int>(nodes.size());
   if (k < 0 || k >= n - 1)
   {
@@ -177,22 +192,35 @@ void splineJet(const std::vector<double>& nodes, const std::vector<double>& coef
     const double value = (left ? j == 0 : j == n - 1) ? 1.0 : 0.0;
     const double slope = left ? coefficients[1] : coefficients[4 * (n - 1)];
     jet[0] = value + slope * (x - (left ? nodes.front() : nodes.back()));
-    jet[1] = slope;
-    jet[2] = 0.0;
+    if (Order == 2)
+    {
+      jet[1] = slope;
+      jet[2] = 0.0;
+    }
     return;
   }
   const double* c = &coefficients[4 * k];
   const double h = x - nodes[k];
   jet[0] = c[0] + h * (c[1] + h * (c[2] + h * c[3]));
-  jet[1] = c[1] + h * (2.0 * c[2] + 3.0 * h * c[3]);
-  jet[2] = 2.0 * c[2] + 6.0 * h * c[3];
+  if (Order == 2)
+  {
+    jet[1] = c[1] + h * (2.0 * c[2] + 3.0 * h * c[3]);
+    jet[2] = 2.0 * c[2] + 6.0 * h * c[3];
+  }
 }
 
-/// One direction's blend functions bound to an evaluation point: the interval search is
-/// done once, the values of up to StackNodes functions are cached on the stack.
+/**
+ * One direction's blend functions bound to an evaluation point: the interval search is
+ * done once, the values of up to StackNodes functions are cached on the stack. Order 0
+ * keeps the values alone (point() and crossPoints(): a third of the cost), Order 2 the
+ * values and two derivatives (derivatives()); the values are the same bits in both.
+ */
+template <int Order>
 class BlendAt
 {
 public:
+  static constexpr int Width = Order + 1; ///< doubles per blend function
+
   BlendAt(GordonSurface::Blending blending, const std::vector<double>& nodes,
     const std::vector<std::vector<double>>& coefficients, double x)
     : Blending(blending)
@@ -206,19 +234,17 @@ public:
     {
       for (int i = 0; i < static_cast<int>(nodes.size()); ++i)
       {
-        compute(i, &Values[3 * i]);
+        compute(i, &Values[Width * i]);
       }
     }
   }
 
-  /// jet[0..2] = value, first and second derivative of blend i.
-  void jet(int i, double out[3]) const
+  /// out[0..Order] = value and (Order 2) first and second derivative of blend i.
+  void jet(int i, double out[]) const
   {
     if (Cached)
     {
-      out[0] = Values[3 * i];
-      out[1] = Values[3 * i + 1];
-      out[2] = Values[3 * i + 2];
+      std::copy_n(&Values[Width * i], Width, out);
     }
     else
     {
@@ -227,21 +253,25 @@ public:
   }
   double value(int i) const
   {
-    double out[3];
-    jet(i, out);
+    if (Cached)
+    {
+      return Values[Width * i];
+    }
+    double out[Width];
+    compute(i, out);
     return out[0];
   }
 
 private:
-  void compute(int i, double out[3]) const
+  void compute(int i, double out[]) const
   {
     if (Blending == GordonSurface::Blending::Lagrange)
     {
-      lagrangeJet(Nodes, i, X, out);
+      lagrangeJet<Order>(Nodes, i, X, out);
     }
     else
     {
-      splineJet(Nodes, Coefficients[i], i, Interval, X, out);
+      splineJet<Order>(Nodes, Coefficients[i], i, Interval, X, out);
     }
   }
 
@@ -251,82 +281,10 @@ private:
   double X;
   int Interval;
   bool Cached;
-  std::array<double, 3 * StackNodes> Values;
+  std::array<double, Width * StackNodes> Values;
 };
-
-/// Value of cardinal spline j at x in node interval k: splineJet's jet[0], the same
-/// operations (the same bits) without the derivatives.
-inline double splineValue(const std::vector<double>& nodes, const std::vector<double>& coefficients,
-  int j, int k, double x)
-{
-  const int n = static_cast<int>(nodes.size());
-  if (k < 0 || k >= n - 1)
-  {
-    const bool left = k < 0;
-    const double value = (left ? j == 0 : j == n - 1) ? 1.0 : 0.0;
-    const double slope = left ? coefficients[1] : coefficients[4 * (n - 1)];
-    return value + slope * (x - (left ? nodes.front() : nodes.back()));
-  }
-  const double* c = &coefficients[4 * k];
-  const double h = x - nodes[k];
-  return c[0] + h * (c[1] + h * (c[2] + h * c[3]));
-}
-
-/// Lagrange polynomial L_i at x: lagrangeJet's jet[0], the same bits.
-inline double lagrangeValue(const std::vector<double>& nodes, int i, double x)
-{
-  double p = 1.0;
-  const double xi = nodes[i];
-  for (int k = 0; k < static_cast<int>(nodes.size()); ++k)
-  {
-    if (k != i)
-    {
-      p = p * ((x - nodes[k]) / (xi - nodes[k]));
-    }
-  }
-  return p;
-}
-
-/// BlendAt's values alone (point() and crossPoints() need no derivatives): the same bits
-/// as BlendAt::value, at a third of the cost.
-class BlendValues
-{
-public:
-  BlendValues(GordonSurface::Blending blending, const std::vector<double>& nodes,
-    const std::vector<std::vector<double>>& coefficients, double x)
-    : Blending(blending)
-    , Nodes(nodes)
-    , Coefficients(coefficients)
-    , X(x)
-    , Interval(nodes.empty() ? 0 : locateInterval(nodes, x))
-    , Cached(static_cast<int>(nodes.size()) <= StackNodes)
-  {
-    if (Cached)
-    {
-      for (int i = 0; i < static_cast<int>(nodes.size()); ++i)
-      {
-        Values[i] = compute(i);
-      }
-    }
-  }
-  double value(int i) const { return Cached ? Values[i] : compute(i); }
-
-private:
-  double compute(int i) const
-  {
-    return Blending == GordonSurface::Blending::Lagrange
-      ? lagrangeValue(Nodes, i, X)
-      : splineValue(Nodes, Coefficients[i], i, Interval, X);
-  }
-
-  GordonSurface::Blending Blending;
-  const std::vector<double>& Nodes;
-  const std::vector<std::vector<double>>& Coefficients;
-  double X;
-  int Interval;
-  bool Cached;
-  std::array<double, StackNodes> Values;
-};
+using BlendValues = BlendAt<0>;
+using BlendJets = BlendAt<2>;
 } // namespace
 
 namespace
@@ -535,11 +493,11 @@ void GordonSurface::blend(bool tDirection, int index, double x, double jet[3]) c
   }
   if (TheBlending == Blending::Lagrange)
   {
-    lagrangeJet(nodes, index, x, jet);
+    lagrangeJet<2>(nodes, index, x, jet);
   }
   else
   {
-    splineJet(nodes, (tDirection ? TBlendCoefficients : SBlendCoefficients)[index], index,
+    splineJet<2>(nodes, (tDirection ? TBlendCoefficients : SBlendCoefficients)[index], index,
       locateInterval(nodes, x), x, jet);
   }
 }
@@ -609,7 +567,7 @@ void GordonSurface::crossPoints(double s, double sPlus, double sMinus, double t,
       }
       for (int j = 0; j < n; ++j)
       {
-        blend[q][j] = splineValue(TNodes, TBlendCoefficients[j], j, interval, x);
+        splineJet<0>(TNodes, TBlendCoefficients[j], j, interval, x, &blend[q][j]);
       }
     }
     for (int k = 0; k < 5; ++k)
@@ -717,8 +675,8 @@ void GordonSurface::derivatives(double s, double t, SurfaceDerivatives& out) con
 {
   const int n = static_cast<int>(TNodes.size());
   const int m = static_cast<int>(SNodes.size());
-  const BlendAt b(TheBlending, TNodes, TBlendCoefficients, t);
-  const BlendAt a(TheBlending, SNodes, SBlendCoefficients, s);
+  const BlendJets b(TheBlending, TNodes, TBlendCoefficients, t);
+  const BlendJets a(TheBlending, SNodes, SBlendCoefficients, s);
   out.P = out.Ps = out.Pt = out.Pss = out.Pst = out.Ptt = Vec3::Zero();
   Vec3 c[3];
   double bj[3], ai[3];
@@ -759,8 +717,8 @@ void GordonSurface::firstDerivatives(double s, double t, Vec3& P, Vec3& Ps, Vec3
 {
   const int n = static_cast<int>(TNodes.size());
   const int m = static_cast<int>(SNodes.size());
-  const BlendAt b(TheBlending, TNodes, TBlendCoefficients, t);
-  const BlendAt a(TheBlending, SNodes, SBlendCoefficients, s);
+  const BlendJets b(TheBlending, TNodes, TBlendCoefficients, t);
+  const BlendJets a(TheBlending, SNodes, SBlendCoefficients, s);
   P = Ps = Pt = Vec3::Zero();
   Vec3 c[3];
   double bj[3], ai[3];
