@@ -2,6 +2,7 @@
 // revolution and offsets within a surface. The surfaces are in SurfaceOfRevolution.cpp
 // and GordonSurface.cpp, curves drawn in a surface's (s, t) in Carriers.cpp.
 #include "Carriers.h"
+#include "CoreSupport.h"
 #include "RootFinding.h"
 
 #include <Eigen/Geometry>
@@ -14,16 +15,7 @@
 
 namespace blockforge
 {
-namespace
-{
-std::string format(double value)
-{
-  std::ostringstream s;
-  s.precision(10);
-  s << value;
-  return s.str();
-}
-} // namespace
+using core::format;
 
 // =======================================================================================
 namespace

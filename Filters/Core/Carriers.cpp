@@ -4,13 +4,7 @@
 
 #include "RootFinding.h"
 
-#include <Eigen/Geometry>
-
 #include <algorithm>
-#include <array>
-#include <cmath>
-#include <limits>
-#include <sstream>
 
 namespace blockforge
 {

@@ -1,37 +1,23 @@
 // Gordon surfaces (the blade): a transfinite blend of section curves and, for a network,
 // of cross curves. Split from Carriers.cpp by surface kind.
 #include "Carriers.h"
-
-#include "RootFinding.h"
-
-#include <Eigen/Geometry>
+#include "CoreSupport.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <sstream>
 
 namespace blockforge
 {
 namespace
 {
+using core::clampUnit;
+using core::format;
+
 /// Blend values per direction kept on the stack during one evaluation; networks with
 /// more nodes recompute them on the fly (still without allocating).
 constexpr int StackNodes = 64;
-
-std::string format(double value)
-{
-  std::ostringstream s;
-  s.precision(10);
-  s << value;
-  return s.str();
-}
-
-double clampUnit(double u)
-{
-  return u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
-}
 
 // ---------------------------------------------------------------------------------------
 // Curves continued beyond [0, 1] by their end tangent line. Carriers are extrapolated

@@ -1,42 +1,18 @@
 // Surfaces of revolution (hub and shroud): a meridional contour swept about the axis.
 // Split from Carriers.cpp by surface kind; GordonSurface.cpp holds the blade surface.
 #include "Carriers.h"
-
-#include "RootFinding.h"
+#include "CoreSupport.h"
 
 #include <Eigen/Geometry>
 
-#include <algorithm>
-#include <array>
 #include <cmath>
-#include <limits>
-#include <sstream>
 
 namespace blockforge
 {
 namespace
 {
-/// Blend values per direction kept on the stack during one evaluation; networks with
-/// more nodes recompute them on the fly (still without allocating).
-constexpr int StackNodes = 64;
-
-std::string format(double value)
-{
-  std::ostringstream s;
-  s.precision(10);
-  s << value;
-  return s.str();
-}
-
-bool isFinite(const Vec3& v)
-{
-  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
-}
-
-double clampUnit(double u)
-{
-  return u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
-}
+using core::format;
+using core::isFinite;
 
 // ---------------------------------------------------------------------------------------
 /// The contour in the meridional half-plane: (axial, radius, 0). Its closest point to a
