@@ -10,6 +10,7 @@
 
 #include <muParser.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -112,9 +113,7 @@ class ExpressionEvaluator
 public:
   ExpressionEvaluator()
   {
-    // '.' joins a vertex name and an attribute: le_hub.radius (format 2 queries).
-    Parser.DefineNameChars(
-      "0123456789_abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ.");
+    Parser.DefineNameChars(NameChars);
     Parser.DefineConst("pi", Pi);
     Parser.DefineConst("deg", Pi / 180.0);
   }
@@ -257,60 +256,29 @@ public:
   }
 
   /**
-   * The values of the constants muParser reads in `expanded`, in order: every run of name
-   * characters (muParser looks a token up among the constants first) that is one; `key`
-   * is the text with which runs those are. False (not to be remembered) when a name is
-   * neither a constant nor a function called, nor a number: a variable, or an unknown
-   * name (an error, never remembered).
+   * The values of the constants muParser reads in `expanded`, in order: every name run
+   * (muParser looks a token up among the constants first) that is one; `key` is the text
+   * with which runs those are. False (not to be remembered) when a name is neither a
+   * constant nor a function called, nor a number: a variable, or an unknown name (an
+   * error, never remembered).
    */
   bool constantsIn(const std::string& expanded, std::vector<double>& constants, std::string& key) const
   {
     key = expanded;
     key += '\0';
     const auto& defined = Parser.GetConst();
-    auto isNameChar = [](char c) {
-      return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-        c == '_' || c == '.';
-    };
-    const std::size_t n = expanded.size();
-    std::size_t i = 0;
-    while (i < n)
-    {
-      if (!isNameChar(expanded[i]))
-      {
-        ++i;
-        continue;
-      }
-      std::size_t j = i;
-      while (j < n && isNameChar(expanded[j]))
-      {
-        ++j;
-      }
-      const std::string token = expanded.substr(i, j - i);
-      const auto found = defined.find(token);
+    return forEachNameRun(expanded, [&](std::size_t start, std::size_t end, bool called) {
+      const auto found = defined.find(expanded.substr(start, end - start));
       key += found != defined.end() ? 'c' : 'n';
       if (found != defined.end())
       {
         constants.push_back(found->second);
+        return true;
       }
-      else
-      {
-        const char first = expanded[i];
-        std::size_t next = j;
-        while (next < n && (expanded[next] == ' ' || expanded[next] == '\t'))
-        {
-          ++next;
-        }
-        const bool number = (first >= '0' && first <= '9') || first == '.';
-        const bool called = next < n && expanded[next] == '(';
-        if (!number && !called)
-        {
-          return false;
-        }
-      }
-      i = j;
-    }
-    return true;
+      const char first = expanded[start];
+      const bool number = (first >= '0' && first <= '9') || first == '.';
+      return number || called;
+    });
   }
 
   /**
@@ -461,54 +429,83 @@ public:
     return out;
   }
 
-  /// The `name.attribute` tokens of an expression (names start with a letter or '_').
   /// The names an expression refers to: (vertex, attribute) for `vertex.attribute`, (name, "")
-  /// for plain names (parameters, definitions, constants); functions are left out.
+  /// for plain names (parameters, definitions, constants); functions and numbers are left
+  /// out. Names start with a letter or '_'; of a run `a.b.c`, only (a, b) is a reference.
   static std::vector<std::pair<std::string, std::string>> referencedNames(const std::string& text)
   {
     std::vector<std::pair<std::string, std::string>> names;
-    auto isStart = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; };
-    auto isChar = [&](char c) { return isStart(c) || (c >= '0' && c <= '9'); };
-    std::size_t i = 0;
-    const std::size_t n = text.size();
-    while (i < n)
-    {
-      if (isStart(text[i]) && (i == 0 || !(isChar(text[i - 1]) || text[i - 1] == '.')))
+    forEachNameRun(text, [&](std::size_t start, std::size_t end, bool called) {
+      const char first = text[start];
+      if (!((first >= 'a' && first <= 'z') || (first >= 'A' && first <= 'Z') || first == '_'))
       {
-        std::size_t j = i;
-        while (j < n && isChar(text[j]))
-        {
-          ++j;
-        }
-        if (j < n && text[j] == '.')
-        {
-          std::size_t k = j + 1;
-          while (k < n && isChar(text[k]))
-          {
-            ++k;
-          }
-          names.emplace_back(text.substr(i, j - i), text.substr(j + 1, k - j - 1));
-          i = k;
-          continue;
-        }
-        std::size_t next = j;
-        while (next < n && (text[next] == ' ' || text[next] == '\t'))
-        {
-          ++next;
-        }
-        if (next >= n || text[next] != '(') // a function call is not a name
-        {
-          names.emplace_back(text.substr(i, j - i), std::string());
-        }
-        i = j;
-        continue;
+        return true; // a number
       }
-      ++i;
-    }
+      const std::size_t dot = text.find('.', start);
+      if (dot < end)
+      {
+        const std::size_t attributeEnd = std::min(text.find('.', dot + 1), end);
+        names.emplace_back(
+          text.substr(start, dot - start), text.substr(dot + 1, attributeEnd - dot - 1));
+      }
+      else if (!called)
+      {
+        names.emplace_back(text.substr(start, end - start), std::string());
+      }
+      return true;
+    });
     return names;
   }
 
+  /**
+   * The one tokenizer of names: calls visit(start, end, called) for every maximal run of
+   * muParser's name characters (NameChars) in `text`, in order, as muParser reads them as
+   * one token (a number, a name or a vertex query); `called` when the run is followed,
+   * past blanks, by '(' (a function call). Stops, returning false, when visit does.
+   */
+  template <typename Visit>
+  static bool forEachNameRun(const std::string& text, Visit&& visit)
+  {
+    const std::size_t n = text.size();
+    std::size_t i = 0;
+    while (i < n)
+    {
+      if (!isNameChar(text[i]))
+      {
+        ++i;
+        continue;
+      }
+      std::size_t j = i;
+      while (j < n && isNameChar(text[j]))
+      {
+        ++j;
+      }
+      std::size_t next = j;
+      while (next < n && (text[next] == ' ' || text[next] == '\t'))
+      {
+        ++next;
+      }
+      if (!visit(i, j, next < n && text[next] == '('))
+      {
+        return false;
+      }
+      i = j;
+    }
+    return true;
+  }
+
 private:
+  /// The characters of muParser names: '.' joins a vertex name and an attribute,
+  /// le_hub.radius (format 2 queries).
+  static constexpr const char* NameChars =
+    "0123456789_abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ.";
+  /// One of NameChars (isNameChar and NameChars must agree).
+  static bool isNameChar(char c)
+  {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+      c == '_' || c == '.';
+  }
+
   static bool parenthesesBalance(const std::string& text)
   {
     int depth = 0;
