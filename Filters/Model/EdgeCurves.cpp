@@ -117,24 +117,11 @@ private:
   mutable std::shared_ptr<DerivativeSamples> Recorded = std::make_shared<DerivativeSamples>();
 };
 
-/// Whether a follow edge follows named edge `index` (its table's derivatives are kept).
-bool followed(const BlockModel& model, int index)
+/// The length table of `named.curve`, keeping its derivatives when a follow edge follows
+/// the edge (`followed`, see followedEdges).
+void buildLengthTable(bool followed, NamedCurve& named)
 {
-  for (const Edge& edge : model.edges)
-  {
-    if (edge.kind == Edge::Kind::Follow && edge.source == index)
-    {
-      return true;
-    }
-  }
-  return false;
-}
-
-/// The length table of `named.curve`, keeping its derivatives when a follow edge follows it.
-void buildLengthTable(const BlockModel& model, const Edge& edge, NamedCurve& named)
-{
-  const int index = static_cast<int>(&edge - model.edges.data());
-  if (index < 0 || index >= static_cast<int>(model.edges.size()) || !followed(model, index))
+  if (!followed)
   {
     named.lengthTable = std::make_shared<ArcLength>(named.curve);
     return;
@@ -189,9 +176,24 @@ Eigen::Vector2d edgeEndParameters(const BlockModel& model, const CarrierGeometry
   return vertexOnCarrier(model, geometry, vertex, edge.carrier, size, "attach it to the carrier");
 }
 
-NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geometry,
-  const std::vector<NamedCurve>& previous, const Edge& edge, double size)
+std::vector<char> followedEdges(const BlockModel& model)
 {
+  std::vector<char> followed(model.edges.size(), 0);
+  for (const Edge& edge : model.edges)
+  {
+    if (edge.kind == Edge::Kind::Follow && edge.source >= 0 &&
+      edge.source < static_cast<int>(followed.size()))
+    {
+      followed[edge.source] = 1;
+    }
+  }
+  return followed;
+}
+
+NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geometry,
+  const std::vector<NamedCurve>& previous, int index, bool followed, double size)
+{
+  const Edge& edge = model.edges[index];
   const Vec3& start = model.vertices[edge.from].position;
   const Vec3& end = model.vertices[edge.to].position;
   NamedCurve named;
@@ -248,7 +250,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       named.curve = std::make_shared<ParameterLineCurve>(geometry.surface(edge.carrier), a, b,
         geometry.closedS(edge.carrier), geometry.closedT(edge.carrier),
         geometry.extendsT(edge.carrier));
-      buildLengthTable(model, edge, named);
+      buildLengthTable(followed, named);
       named.length = named.lengthTable->totalLength();
       break;
     }
@@ -266,8 +268,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
     }
     case Edge::Kind::Periodic:
     {
-      const int self = static_cast<int>(&edge - model.edges.data());
-      if (edge.source < 0 || edge.source >= self)
+      if (edge.source < 0 || edge.source >= index)
       {
         throw GeometryError("the source of a periodic edge must be an edge defined before it");
       }
@@ -297,8 +298,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
     }
     case Edge::Kind::Follow:
     {
-      const int self = static_cast<int>(&edge - model.edges.data());
-      if (edge.source < 0 || edge.source >= self)
+      if (edge.source < 0 || edge.source >= index)
       {
         throw GeometryError("the source of a follow edge must be an edge defined before it");
       }
@@ -350,7 +350,7 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       points.push_back(end);
       named.curve = std::make_shared<BSplineCurve>(
         BSplineCurve::interpolate(points, 3, ParameterMethod::ChordLength));
-      buildLengthTable(model, edge, named);
+      buildLengthTable(followed, named);
       named.length = named.lengthTable->totalLength();
       break;
     }
@@ -423,15 +423,17 @@ std::vector<NamedCurve> buildNamedCurves(const BlockModel& model, const CarrierG
   std::sort(tabulated.begin(), tabulated.end());
   tabulated.erase(std::unique(tabulated.begin(), tabulated.end()), tabulated.end());
   geometry.prepareLengthTables(tabulated);
-  for (const Edge& edge : model.edges)
+  const std::vector<char> followed = followedEdges(model);
+  for (std::size_t e = 0; e < model.edges.size(); ++e)
   {
     try
     {
-      curves.push_back(buildNamedCurve(model, geometry, curves, edge, size));
+      curves.push_back(
+        buildNamedCurve(model, geometry, curves, static_cast<int>(e), followed[e] != 0, size));
     }
     catch (const GeometryError& error)
     {
-      fail(edge.where, entity("edge", edge.name), error.what());
+      fail(model.edges[e].where, entity("edge", model.edges[e].name), error.what());
     }
   }
   return curves;

@@ -66,10 +66,14 @@ struct NamedCurve
 /// Tolerance of "lies on a carrier": 1e-9 of the larger of the model and the carrier.
 double carrierTolerance(const CarrierGeometry& geometry, int carrier, double size);
 
-/// The curve of named edge `edge` (`previous`: the curves of the edges before it, which a
-/// periodic or follow edge takes its shape from). Throws GeometryError.
+/// Per named edge: whether a follow edge follows it (its length table's derivatives are
+/// then kept, NamedCurve::samples).
+std::vector<char> followedEdges(const BlockModel& model);
+/// The curve of named edge `index` (`previous`: the curves of the edges before it, which a
+/// periodic or follow edge takes its shape from; `followed`: followedEdges()[index]).
+/// Throws GeometryError.
 NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geometry,
-  const std::vector<NamedCurve>& previous, const Edge& edge, double size);
+  const std::vector<NamedCurve>& previous, int index, bool followed, double size);
 /// Curves of all named edges; GeometryError becomes a TemplateError naming the edge.
 std::vector<NamedCurve> buildNamedCurves(const BlockModel& model, const CarrierGeometry& geometry);
 

@@ -45,6 +45,7 @@ struct MeshPlan::Impl
   // What depends on what, built once.
   std::vector<std::vector<int>> VertexNamedEdges;  ///< vertex -> named edges ending at it
   std::vector<std::vector<int>> NamedFollowers;    ///< named edge -> periodic/follow edges
+  std::vector<char> FollowedEdges;                 ///< named edge -> followed (followedEdges)
   std::vector<std::vector<int>> VertexUniqueEdges; ///< vertex -> unique edges ending at it
   std::vector<int> NamedUnique;                    ///< named edge -> unique edge, -1
   std::vector<std::vector<int>> EdgeFaces;         ///< unique edge -> unique faces
@@ -125,6 +126,7 @@ void MeshPlan::Impl::buildDependencies()
   VertexBlocks.assign(vertexCount, {});
   NamedFollowers.assign(Model.edges.size(), {});
   NamedUnique.assign(Model.edges.size(), -1);
+  FollowedEdges = followedEdges(Model);
   for (std::size_t e = 0; e < Model.edges.size(); ++e)
   {
     const Edge& edge = Model.edges[e];
@@ -327,7 +329,8 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
     try
     {
       followEdgeEnds(model, Geometry, static_cast<int>(e), movedVertex);
-      Curves[e] = buildNamedCurve(model, Geometry, Curves, model.edges[e], size);
+      Curves[e] = buildNamedCurve(
+        model, Geometry, Curves, static_cast<int>(e), FollowedEdges[e] != 0, size);
     }
     catch (const GeometryError& error)
     {
