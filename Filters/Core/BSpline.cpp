@@ -1,11 +1,11 @@
 #include "BSpline.h"
+#include "CoreSupport.h"
 
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 namespace blockforge
 {
@@ -14,23 +14,9 @@ namespace
 using bspline::MaxDegree;
 constexpr int MaxBasis = MaxDegree + 1;
 
-bool isFinite(const Vec3& v)
-{
-  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
-}
-
-std::string toString(double value)
-{
-  std::ostringstream s;
-  s.precision(10);
-  s << value;
-  return s.str();
-}
-
-std::string toString(const Vec3& v)
-{
-  return "(" + toString(v.x()) + ", " + toString(v.y()) + ", " + toString(v.z()) + ")";
-}
+using core::clampUnit;
+using core::isFinite;
+using core::format;
 
 void requireDegree(int degree, const char* what)
 {
@@ -48,7 +34,7 @@ void requireFinitePoints(const std::vector<Vec3>& points, const char* what)
     if (!isFinite(points[i]))
     {
       throw GeometryError(std::string(what) + ": point " + std::to_string(i) +
-        " has a non-finite coordinate " + toString(points[i]));
+        " has a non-finite coordinate " + format(points[i]));
     }
   }
 }
@@ -103,7 +89,7 @@ void validateKnots(int degree, std::vector<double>& knots, int count, const char
     }
     if (multiplicity > degree)
     {
-      throw GeometryError(std::string(what) + ": interior knot " + toString(knots[i]) +
+      throw GeometryError(std::string(what) + ": interior knot " + format(knots[i]) +
         " is repeated more than degree times, which would break the curve");
     }
   }
@@ -120,11 +106,6 @@ void validateKnots(int degree, std::vector<double>& knots, int count, const char
       knots[knots.size() - 1 - i] = 1.0;
     }
   }
-}
-
-double clampUnit(double t)
-{
-  return t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
 }
 
 /**
@@ -613,7 +594,7 @@ BSplineCurve BSplineCurve::interpolate(const std::vector<Vec3>& points, int degr
     if (!(gap > 1e-12 * size))
     {
       throw GeometryError("curve interpolation: points " + std::to_string(i - 1) + " and " +
-        std::to_string(i) + " coincide at " + toString(points[i]) +
+        std::to_string(i) + " coincide at " + format(points[i]) +
         "; remove the duplicate point");
     }
   }

@@ -1,4 +1,5 @@
 #include "Curve.h"
+#include "CoreSupport.h"
 
 #include <Eigen/Geometry>
 
@@ -12,18 +13,8 @@ namespace
 {
 constexpr double Pi = 3.14159265358979323846;
 
-bool isFinite(const Vec3& v)
-{
-  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
-}
-
-std::string format(const Vec3& v)
-{
-  std::ostringstream s;
-  s.precision(10);
-  s << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
-  return s.str();
-}
+using core::format;
+using core::isFinite;
 
 void requireFinite(const Vec3& v, const char* what, const char* curveKind)
 {

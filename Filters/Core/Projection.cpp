@@ -1,5 +1,6 @@
 #include "Projection.h"
 
+#include "CoreSupport.h"
 #include "RootFinding.h"
 
 #include "WorkBudget.h"
@@ -65,17 +66,14 @@ private:
   const BSplineCurve* Spline;
 };
 
+using core::clampUnit;
+
 void requireFinite(const Vec3& p)
 {
-  if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
+  if (!core::isFinite(p))
   {
     throw GeometryError("projection: the point to project has a non-finite coordinate");
   }
-}
-
-double clampUnit(double t)
-{
-  return t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
 }
 
 struct Candidate

@@ -1,4 +1,5 @@
 #include "Surface.h"
+#include "CoreSupport.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,16 +7,7 @@
 
 namespace blockforge
 {
-namespace
-{
-std::string toString(const Vec3& v)
-{
-  std::ostringstream s;
-  s.precision(10);
-  s << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
-  return s.str();
-}
-} // namespace
+using core::format;
 
 CoonsPatch::CoonsPatch(CurvePtr bottom, CurvePtr right, CurvePtr top, CurvePtr left)
   : Bottom(std::move(bottom))
@@ -43,7 +35,7 @@ CoonsPatch::CoonsPatch(CurvePtr bottom, CurvePtr right, CurvePtr top, CurvePtr l
       std::ostringstream s;
       s.precision(6);
       s << "Coons patch: the boundary curves do not meet at the " << where << " corner "
-        << toString(corner) << " (gap " << gap << ")";
+        << format(corner) << " (gap " << gap << ")";
       throw GeometryError(s.str());
     }
   };
