@@ -81,9 +81,10 @@ int locateInterval(const std::vector<double>& nodes, double x)
 /// derivatives (jet[0..Order]). The factors (x - x_k) / (x_i - x_k) are exactly 1 at
 /// x = x_i and exactly 0 at the other nodes, so the surface passes through its curves bit
 /// for bit. The value takes the same operations for either order (the same bits), so
-/// point() and derivatives() agree; Order 0 skips the derivatives' work.
+/// point() and derivatives() agree; Order 0 skips the derivatives' work. Inline: point()
+/// calls Order 0 per section, and a call costs as much as the value.
 template <int Order>
-void lagrangeJet(const std::vector<double>& nodes, int i, double x, double jet[])
+inline void lagrangeJet(const std::vector<double>& nodes, int i, double x, double jet[])
 {
   static_assert(Order == 0 || Order == 2, "values, or values and two derivatives");
   double p = 1.0, p1 = 0.0, p2 = 0.0;
@@ -167,7 +168,7 @@ std::vector<double> naturalCardinalSpline(const std::vector<double>& x, int j)
 /// ends: jet[0..Order] = value and, for Order 2, its first two derivatives. The value takes
 /// the same operations for either order (the same bits).
 template <int Order>
-void splineJet(const std::vector<double>& nodes, const std::vector<double>& coefficients,
+inline void splineJet(const std::vector<double>& nodes, const std::vector<double>& coefficients,
   int j, int k, double x, double jet[])
 {
   static_assert(Order == 0 || Order == 2, "values, or values and two derivatives");
