@@ -230,7 +230,7 @@ int vtkBlockOptimizer::RequestData(
     if (!result.after.feasible)
     {
       vtkWarningMacro(<< "The optimized model still cannot be meshed without inverted cells: "
-                      << result.after.failure);
+                      << blockforge::vtkglue::printable(result.after.failure.c_str()));
     }
     if (result.keptStep < 1.0)
     {
@@ -309,7 +309,7 @@ int vtkBlockOptimizer::RequestData(
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro(<< error.what());
+    vtkErrorMacro(<< blockforge::vtkglue::printable(error.what()));
     output->Initialize();
     history->Initialize();
     return 0;
