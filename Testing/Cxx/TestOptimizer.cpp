@@ -462,8 +462,10 @@ TEST(OptimizerPassage, RefusesAGridTheMesherWouldRefuse)
     EXPECT_NE(std::string(error.what()).find("lower the density multiplier"), std::string::npos)
       << error.what();
   }
-  // A density within MaximumMeasuredNodes is measured as it is.
-  EXPECT_EQ(measuredDensity(loaded.model, 2.0), 2.0);
+  // A density within MaximumMeasuredNodes is measured as it is (1.5: about 48,000 nodes;
+  // 2, about 113,000, is above it since the blade sides have 18 cells and the edges 10).
+  EXPECT_EQ(measuredDensity(loaded.model, 1.5), 1.5);
+  EXPECT_LT(measuredDensity(loaded.model, 2.0), 2.0);
   EXPECT_LT(measuredDensity(loaded.model, 3.0), 3.0);
 }
 
@@ -561,14 +563,14 @@ TEST(OptimizerPassage, RejectedTrialsPutBackGiveTheSameSearch)
  * written), no cell in MinAngle class 0-20 or 20-40, within 700 trials (a bound on the
  * time that does not depend on the machine). Without the shear (o_shear 0) the same run
  * stays at 34.7 and 31.8 degrees: the shear is what lifts it. The bounds guard today's
- * values: 48.28 and 46.56 since the sides' O arcs `match` the O corners' cells (issue 8:
- * neighbour ratio on Rotor 37 at density 4 22.9 -> 4.1), 51.5 and 46.3 before (the
- * distributor's bound 48.5 -> 48.0, Rotor 37's 44.5 -> 46.0).
+ * values: 47.86 and 46.98 since the sides' O arcs `match` the O corners' cells (issue 8:
+ * neighbour ratio on Rotor 37 at density 4 22.9 -> 4.1), 53.26 and 48.50 before (the
+ * distributor's bound 48.5 -> 47.5, Rotor 37's 44.5 -> 46.5).
  */
 TEST(OptimizerPassage, ShearedOGridReachesFortyDegrees)
 {
   for (const auto& [machine, bound] :
-    { std::pair<const char*, double>{ "distributor", 48.0 }, { "rotor37/turbogrid", 46.0 } })
+    { std::pair<const char*, double>{ "distributor", 47.5 }, { "rotor37/turbogrid", 46.5 } })
   {
     SCOPED_TRACE(machine);
     Loaded loaded;
