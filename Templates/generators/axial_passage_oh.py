@@ -121,7 +121,7 @@ parameters:
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction ...
   o_corner_fan: 65deg     # ... this far at a sharp edge whose edge block is a fan on the tip (o_fan): further round, so that the H blocks beside the blade keep an open corner there
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
-  o_shear: 45deg          # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg: the optimized distributor and Rotor 37 reach 49 and 45 deg)
+  o_shear: 45deg          # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg: the optimized distributor and Rotor 37 reach 47.9 and 47.0 deg at density 1)
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   bisect_step: 0.005      # at a sheared edge the H lines bisect the blade direction and the O curve's at the unsheared corner, measured over this step along it (fraction of the loop)
