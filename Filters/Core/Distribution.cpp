@@ -461,7 +461,7 @@ bool grownKeepsEnds(double first, double last, double length, int cells, double 
 } // namespace
 
 std::vector<double> matchedNodes(double first, double last, double length, int nodeCount,
-  double ratio)
+  double ratio, double flatness)
 {
   if (nodeCount < 2)
   {
@@ -484,6 +484,17 @@ std::vector<double> matchedNodes(double first, double last, double length, int n
   if ((first <= 0.0 && last <= 0.0) || cells == 1 || length == 0.0)
   {
     return uniform(nodeCount);
+  }
+  if (flatness != 0.0)
+  {
+    if (!(flatness >= 1.0) || !std::isfinite(flatness))
+    {
+      throw GeometryError("match distribution: the flatness of the bump must be at least 1, "
+        "got " + toString(flatness));
+    }
+    const double mean = length / cells;
+    return endSizes(first > 0.0 ? first / mean : 1.0, last > 0.0 ? last / mean : 1.0,
+      nodeCount, flatness);
   }
   // An end cell larger than the mean cell: cells shrink from it towards the other end or
   // the middle, with both ends exact (log-linear sizes plus a bump, as the Ends law) --
@@ -566,7 +577,7 @@ std::vector<double> distributeNodes(const DistributionLaw& law, int nodeCount,
       return endSizes(law.firstCellSize, law.lastCellSize, nodeCount, law.endsFlatness);
     case DistributionLaw::Kind::Match:
       return matchedNodes(law.firstCellSize, law.lastCellSize, edgeLength, nodeCount,
-        law.expansionRatio);
+        law.expansionRatio, law.matchFlatness);
     case DistributionLaw::Kind::ProjectFrom:
       throw GeometryError("the nodes of a project_from edge are the projections of another "
                           "edge's nodes, which only the mesher knows");

@@ -70,13 +70,22 @@ struct DistributionLaw
   /// mean when the end cells are small (ends 0.1 on 16 cells: the largest cell 1.51 times
   /// the mean with k = 2, 2.09 with k = 1), the cells growing faster next to the ends.
   double endsFlatness = 1.0;
+  /// Match only: 0 (the default), cells grow from the matched end cells by
+  /// expansionRatio up to a uniform middle; k >= 1, the cells between the matched end
+  /// cells follow the Ends law's shape with them (relative to the mean cell) and a bump of
+  /// flatness k, so that the edge keeps the fractions of an `ends`-graded edge beside it
+  /// (axial_passage_oh: an O-grid side starting from the O corner's small cell, beside a
+  /// periodic line graded `ends`: grown by 2 the sides' middle cells were 2.7 times the
+  /// mean at density 0.5, chords far off the turbine's curved O-grid side).
+  double matchFlatness = 0.0;
 
   bool operator==(const DistributionLaw& o) const
   {
     return kind == o.kind && expansionRatio == o.expansionRatio &&
       firstCellSize == o.firstCellSize && lastCellSize == o.lastCellSize &&
       sourceEdge == o.sourceEdge && leanLimit == o.leanLimit && fadeStart == o.fadeStart &&
-      fadeEnd == o.fadeEnd && endsFlatness == o.endsFlatness;
+      fadeEnd == o.fadeEnd && endsFlatness == o.endsFlatness &&
+      matchFlatness == o.matchFlatness;
   }
   bool operator!=(const DistributionLaw& o) const { return !(*this == o); }
 };
@@ -101,10 +110,12 @@ constexpr double DefaultMatchRatio = 1.2;
  * given end by `ratio` (> 1) and are uniform where that would make them larger than the
  * edge needs. When the cells growing by `ratio` cannot fill the edge, the ratio is raised
  * until they do; when the given end cells are too large for the edge, the cells are as
- * near them as filling the edge allows (uniform in the limit).
+ * near them as filling the edge allows (uniform in the limit). With `flatness` >= 1
+ * (DistributionLaw::matchFlatness) the nodes are instead the Ends law's with the given end
+ * cells over the mean cell (a free end: the mean cell) and that bump flatness.
  */
 std::vector<double> matchedNodes(double first, double last, double length, int nodeCount,
-  double ratio);
+  double ratio, double flatness = 0.0);
 
 /// The law seen from the other end of the edge (Geometric k -> 1/k, Ends and Match swapped). FirstCell cannot be
 /// reversed into a law of the same kind; callers reverse its node parameters instead.

@@ -150,6 +150,7 @@ void buildMatchGroups(const BlockModel& model, MeshTopology& topology)
       {
         edge.matched = true;
         edge.matchRatio = law.expansionRatio;
+        edge.matchFlatness = law.matchFlatness;
         edge.matchLean = std::max(edge.matchLean, law.leanLimit);
       }
     }

@@ -95,19 +95,21 @@ void computeEdgeParameters(const BlockModel& model, MeshTopology& topology, int 
     {
       const Block& block = model.blocks[use.block];
       const DistributionLaw& law = block.laws[use.localEdge];
-      if (law.kind != DistributionLaw::Kind::Match || law.expansionRatio != edge.matchRatio)
+      if (law.kind != DistributionLaw::Kind::Match || law.expansionRatio != edge.matchRatio ||
+        law.matchFlatness != edge.matchFlatness)
       {
         const std::array<int, 2> ends = edgeVertices(use.localEdge);
         fail(block.where, blockEntity(model, use.block),
           "edge " + edgeText(model, block.vertices[ends[0]], block.vertices[ends[1]]) + " (" +
             syntax::edgeLabel(use.localEdge) + ") is matched to its neighbours in another "
-            "block that uses it: give it the same law 'match' (with the same ratio) here");
+            "block that uses it: give it the same law 'match' (with the same ratio and flat) here");
       }
     }
     try
     {
       edge.params = matchedNodes(
-        edge.matchFirst, edge.matchLast, edge.length, edge.nodeCount, edge.matchRatio);
+        edge.matchFirst, edge.matchLast, edge.length, edge.nodeCount, edge.matchRatio,
+        edge.matchFlatness);
     }
     catch (const GeometryError& error)
     {

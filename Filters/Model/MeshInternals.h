@@ -112,6 +112,7 @@ struct UniqueEdge : TopologyEdge
   /// block interfaces (matchEdgeEnds), lengths in the canonical direction (0: free).
   bool matched = false;
   double matchRatio = DefaultMatchRatio;
+  double matchFlatness = 0.0; ///< DistributionLaw::matchFlatness of its blocks' law
   double matchFirst = 0.0, matchLast = 0.0;
   /// Law `project_from` in its blocks: the unique edge whose nodes are projected onto this
   /// one (-1: none), and whether that edge's nodes come after the matched edges' (a chain

@@ -265,7 +265,7 @@ namespace
 {
 const char* const LawSyntax =
   "uniform, {geometric: k}, {two_sided: k}, {first_cell: h, ratio: r}, "
-  "{ends: [a, b]}, {ends: [a, b], flat: k}, match, {match: r}, {match: r, lean: angle}, "
+  "{ends: [a, b]}, {ends: [a, b], flat: k}, match, {match: r}, {match: r, lean: angle}, {match: r, flat: k}, "
   "{project_from: edge} or "
   "{project_from: edge, fade: k} (or fade: [k_first, k_last])";
 }
@@ -346,10 +346,21 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
   const MapEntry* lean = findEntry(entries, "lean");
   if (const MapEntry* match = findEntry(entries, "match"))
   {
-    if (entries.size() != (lean ? 2u : 1u))
+    const MapEntry* matchFlat = findEntry(entries, "flat");
+    if (entries.size() != 1u + (lean ? 1u : 0u) + (matchFlat ? 1u : 0u))
     {
       reporter.fail(match->line, entityText,
-        what + ": expected {match: r} or {match: r, lean: angle} alone");
+        what + ": expected {match: r} with lean: angle, flat: k or both, alone");
+    }
+    if (matchFlat)
+    {
+      law.matchFlatness = number(matchFlat->value, matchFlat->line, what + " flat");
+      if (!(law.matchFlatness >= 1.0) || !std::isfinite(law.matchFlatness))
+      {
+        reporter.fail(matchFlat->line, entityText,
+          what + ": the flatness of a matched edge's bump must be at least 1, got " +
+            formatNumber(law.matchFlatness));
+      }
     }
     if (lean)
     {
@@ -409,7 +420,7 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
   }
   if (flat)
   {
-    reporter.fail(flat->line, entityText, what + ": 'flat' belongs to the law ends");
+    reporter.fail(flat->line, entityText, what + ": 'flat' belongs to the laws ends and match");
   }
   const MapEntry* geometric = findEntry(entries, "geometric");
   const MapEntry* twoSided = findEntry(entries, "two_sided");
@@ -493,6 +504,10 @@ void emitLaw(YAML::Emitter& out, const DistributionLaw& law, const BlockModel& m
       if (law.leanLimit > 0.0)
       {
         out << YAML::Key << "lean" << YAML::Value << formatNumber(law.leanLimit);
+      }
+      if (law.matchFlatness != 0.0)
+      {
+        out << YAML::Key << "flat" << YAML::Value << formatNumber(law.matchFlatness);
       }
       out << YAML::EndMap;
       return;

@@ -93,21 +93,22 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 # Grading (Templates/README.md, laws `match`, `ends`, `project_from`), so that neighbour cells
 # across the block interfaces differ little at every density:
 # - the O-grid: geometric k_o away from the blade (its outer cell is what the H blocks start
-#   with); the blade sides `ends`, their end cells side_end times their mean cell, side_shear
-#   next to a sheared edge on the side whose corner moves along the blade, side_tip on the
-#   other side (its corner stays on the tip, so its first cell shares the nose's fan with the
-#   edge block), or side_fan next to a sharp edge's fan (o_fan), so that they
-#   shrink towards the edge block's cells (numbers per edge, not expressions of the corners:
-#   the optimizer's live model keeps laws as the template gave them), `flat` side_flat
-#   (side_flat_fan where a side ends at a sharp edge's fan) so
-#   that their middle cells stay near their mean cell; the O-grid's
-#   outer sides the normal offsets of the blade sides' nodes (project_from); the edge blocks'
-#   outer arcs `match` (cells of their neighbours at both ends, growing by o_match towards
-#   the middle), their blade arcs the normal feet of the outer arcs' nodes (project_from:
-#   on a thin or sharp edge a fan, the nose resolved by the feet);
+#   with); every O-grid arc `match`: the sides' outer arcs too, so they start at an O
+#   corner from the same cell as the edge block's arc there (with `flat` side_arc_flat: the
+#   shape of the law `ends` between those small end cells); the blade arcs of all four O
+#   blocks the normal feet of their outer arcs' nodes (project_from): where an O corner's
+#   radial line starts on a fan round a thin or sharp tip (or a cap's corner), the feet on
+#   both sides of it are cut from the fan alike, so the blade's first cells there match
+#   (with the sides graded on the blade and only the edge block's feet fanning, the edge
+#   block's cell shrank with the square of the density, the side's linearly: Rotor 37 8.5
+#   -> 22.9 at density 0.5 -> 4). At a sharp edge whose edge block is a fan on the tip
+#   (o_fan) the corners lean o_corner_fan, further round, so the H blocks beside the blade
+#   keep an open corner there;
 # - every H edge `match`: the H blocks start from the O-grid's outer cells and the edge
 #   blocks' and sides' cells and grow towards the inlet, outlet and periodic lines; the
-#   periodic lines beside the sides take the sides' relative end cells (`ends`).
+#   periodic lines beside the sides `ends` (period_end, period_flat), so that their nodes
+#   lie at nearly the fractions of the sides' matched outer arcs (the H blocks between
+#   them are not sheared along the blade).
 blockforge: 2
 name: axial_passage_oh
 description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.
@@ -117,9 +118,10 @@ machine: {theta_zero: sections}   # theta = 0 through the blade, so the passage 
 
 parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
-  o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction
+  o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction ...
+  o_corner_fan: 65deg     # ... this far at a sharp edge whose edge block is a fan on the tip (o_fan): further round, so that the H blocks beside the blade keep an open corner there
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
-  o_shear: 45deg          # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg: the optimized distributor and Rotor 37 reach 49 and 45 deg)
+  o_shear: 45deg          # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg: the optimized distributor and Rotor 37 reach 47.9 and 47.0 deg at density 1)
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   bisect_step: 0.005      # at a sheared edge the H lines bisect the blade direction and the O curve's at the unsheared corner, measured over this step along it (fraction of the loop)
@@ -135,32 +137,29 @@ parameters:
   n_up: 8                 # cells from inlet to the O-grid
   n_down: 8               # cells from the O-grid to the outlet
   n_pitch: 6              # cells across each H column beside the O-grid
-  n_le: 8                 # cells around the leading edge
-  n_te: 8                 # cells around the trailing edge
-  n_side: 16              # cells along each blade side
+  n_le: 10                # cells around the leading edge
+  n_te: 10                # cells around the trailing edge
+  n_side: 18              # cells along each blade side (16 left the turbine's grid at density 0.5 0.59 % off its volume: its sides' middle cells, between the O corners' small ones, chord its cambered O-grid sides)
   n_o: 6                  # cells across the O-grid
   n_span: 12              # cells from hub to shroud
   k_o: 1.15               # expansion ratio away from the blade in the O-grid
   k_span: 1.05            # expansion ratio away from hub and shroud (two-sided)
-  side_end: 0.35          # blade sides (and the periodic lines beside them): end cells this fraction of their mean cell, towards the edge blocks' cells ...
-  side_fan: 0.03          # ... the same at a sharp edge whose edge block is a fan on the tip (o_fan) ...
-  side_shear: 0.2         # ... and at a sheared edge (o_shear), on the side whose corner moves along the blade ...
-  side_tip: 0.15          # ... and the other side's, whose corner stays at the edge tip (a fan shared with the edge block: smaller cells leave less of it to the side's first cell)
-  side_flat: 3            # flatness of the sides' grading between its end cells (law `ends`, `flat`): their middle cells stay near the mean however small the ends ...
-  side_flat_fan: 2        # ... and of a side that ends at a sharp edge's fan (o_fan): flatter, its cells next to the fan's tiny end cells grow so fast that the optimizer stalls (compressor, density 4: 9.6 deg against 22.1)
+  side_arc_flat: 2        # the blade sides' O-grid arcs (law `match` from the O corners' cells, `flat`): between their small end cells the shape of the law `ends` with this flatness, not cells grown by o_match to a uniform middle (2.7 times the mean cell at density 0.5) ...
+  period_end: 0.1         # ... and the periodic lines beside them (law `ends`): end cells this fraction of their mean cell ...
+  period_flat: 3          # ... and that flat in between, so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
 """
 
 FOOTER = """blocks:
   O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_le_h}, E5: {project_from: ol_le_s}}}}
-  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_le_a_h, se_te_a_h], flat: sf_h}, E3: {project_from: bl_a_h}, E5: {ends: [se_le_a_s, se_te_a_s], flat: sf_s}, E7: {project_from: bl_a_s}}}}
+  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_a_h}, E5: {project_from: ol_a_s}}}}
   O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
-  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {ends: [se_te_b_h, se_le_b_h], flat: sf_h}, E3: {project_from: bl_b_h}, E5: {ends: [se_te_b_s, se_le_b_s], flat: sf_s}, E7: {project_from: bl_b_s}}}}
+  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
   U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
-  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {project_from: bl_a_h}, E4: {ends: [se_le_h, se_te_h], flat: sf_h}, E6: {project_from: bl_a_s}, E8: {ends: [se_le_s, se_te_s], flat: sf_s}}}}
-  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E2: {ends: [se_le_h, se_te_h], flat: sf_h}, E4: {project_from: bl_b_h}, E6: {ends: [se_le_s, se_te_s], flat: sf_s}, E8: {project_from: bl_b_s}}}}
+  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end, period_end], flat: period_flat}, E8: {ends: [period_end, period_end], flat: period_flat}}}}
+  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end, period_end], flat: period_flat}, E6: {ends: [period_end, period_end], flat: period_flat}}}}
   D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
   D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
@@ -221,13 +220,6 @@ def template_text():
             outer = f'sqrt((r{a}_{l}.axial - r{b}_{l}.axial)^2 + (rm_{l}*(r{a}_{l}.theta - r{b}_{l}.theta))^2)'
             inner = f'sqrt((k{a}_{l}.axial - k{b}_{l}.axial)^2 + (rm_{l}*(k{a}_{l}.theta - k{b}_{l}.theta))^2)'
             w(f'  off_{e}_{l}: "{outer} <= o_fan*{inner}"')
-            w(f'  se_{e}_{l}: "off_{e}_{l} ? (shear_{e} ? side_shear : side_end) : side_fan"      # the blade sides\' relative end cells at this edge')
-            # per side: at a sheared edge the side whose corner stays at the tip (o_lean_shear)
-            # shares the nose's fan with the edge block, whose cells there are the feet of its
-            # outer arc's: side_tip; the periodic lines keep se_{e} (one law for lo and hi)
-            for sd, moved in (('a', f'sa_{"f" if e == "le" else "r"}_{l}'), ('b', f'sb_{"f" if e == "le" else "r"}_{l}')):
-                w(f'  se_{e}_{sd}_{l}: "off_{e}_{l} ? (shear_{e} ? ({moved} ? side_shear : side_tip) : side_end) : side_fan"      # side {sd}\'s relative end cell at this edge')
-        w(f'  sf_{l}: "off_le_{l} && off_te_{l} ? side_flat : side_flat_fan"      # the blade sides\' flatness (law ends, flat): side_flat_fan where one ends at a fan')
         # H lines upstream / downstream: slope d(r theta)/d(axial distance from the O-grid)
         w(f'  slope_in_{l}: "tan(follow_le*atan2(le_uy_{l}, -le_ux_{l}))"')
         w(f'  slope_out_{l}: "tan(follow_te*atan2(te_uy_{l}, te_ux_{l}))"')
@@ -324,7 +316,7 @@ def template_text():
             # h: the o_corner points and (g) their feet, for round_le/te; q: the corners before the
             # shear (at a sheared edge the unsheared one leans o_lean_shear)
             for v, e, side, towards in corners:
-                c = 'o_corner' if pass_ == 'h' else f'(s{partners[v[1:]]}_{l} ? o_lean_shear : o_corner)'
+                c = 'o_corner' if pass_ == 'h' else f'(s{partners[v[1:]]}_{l} ? o_lean_shear : (round_{e}_{l} ? o_corner : o_corner_fan))'
                 dx = f'(cos({c})*{e}_ux_{l} {side} sin({c})*{e}_vx_{l})'
                 dy = f'(cos({c})*{e}_uy_{l} {side} sin({c})*{e}_vy_{l})'
                 far = f'o{e}_{l}.s {towards} dir_{l}*o_window'

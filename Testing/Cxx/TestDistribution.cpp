@@ -499,6 +499,36 @@ TEST(Distribution, MatchGivesTheEndCellsAndGrowsByTheRatio)
   EXPECT_THROW(matchedNodes(0.01, 0.01, 1.0, 5, std::nan("")), GeometryError);
 }
 
+TEST(Distribution, MatchWithFlatIsTheEndsShapeWithTheMatchedCells)
+{
+  // {match: r, flat: k}: the matched end cells (0.01 and 0.02 on an edge of length 2, 16
+  // cells: 0.08 and 0.16 of the mean cell 0.125) with the Ends law's shape in between,
+  // bit for bit the Ends law's nodes with those relative cells; a free end takes the mean
+  // cell; the ratio plays no part; a flatness below 1 is an error.
+  DistributionLaw ends;
+  ends.kind = DistributionLaw::Kind::Ends;
+  ends.firstCellSize = 0.01 / 0.125;
+  ends.lastCellSize = 0.02 / 0.125;
+  ends.endsFlatness = 3.0;
+  const std::vector<double> expected = distributeNodes(ends, 17);
+  EXPECT_EQ(matchedNodes(0.01, 0.02, 2.0, 17, 1.2, 3.0), expected);
+  EXPECT_EQ(matchedNodes(0.01, 0.02, 2.0, 17, 5.0, 3.0), expected);
+  const std::vector<double> s = matchedNodes(0.01, 0.02, 2.0, 17, 1.2, 3.0);
+  expectValidNodes(s, 17);
+  EXPECT_NEAR(cell(s, 0) * 2.0, 0.01, 1e-14);
+  EXPECT_NEAR(cell(s, 15) * 2.0, 0.02, 1e-14);
+  // grown by 1.2 to a uniform middle the same ends give other nodes
+  EXPECT_NE(matchedNodes(0.01, 0.02, 2.0, 17, 1.2), expected);
+  DistributionLaw law;
+  law.kind = DistributionLaw::Kind::Match;
+  law.expansionRatio = 2.0;
+  law.firstCellSize = 0.01;
+  law.matchFlatness = 3.0;
+  ends.lastCellSize = 1.0;
+  EXPECT_EQ(distributeNodes(law, 17, 2.0), distributeNodes(ends, 17));
+  EXPECT_THROW(matchedNodes(0.01, 0.02, 2.0, 17, 1.2, 0.5), GeometryError);
+}
+
 TEST(Distribution, MatchNodesDoNotJumpWhenAnEndCellPassesTheMeanCell)
 {
   // Two edges across a periodic pair share one end cell, the geometric mean of their

@@ -462,8 +462,10 @@ TEST(OptimizerPassage, RefusesAGridTheMesherWouldRefuse)
     EXPECT_NE(std::string(error.what()).find("lower the density multiplier"), std::string::npos)
       << error.what();
   }
-  // A density within MaximumMeasuredNodes is measured as it is.
-  EXPECT_EQ(measuredDensity(loaded.model, 2.0), 2.0);
+  // A density within MaximumMeasuredNodes is measured as it is (1.5: about 48,000 nodes;
+  // 2, about 113,000, is above it since the blade sides have 18 cells and the edges 10).
+  EXPECT_EQ(measuredDensity(loaded.model, 1.5), 1.5);
+  EXPECT_LT(measuredDensity(loaded.model, 2.0), 2.0);
   EXPECT_LT(measuredDensity(loaded.model, 3.0), 3.0);
 }
 
@@ -497,9 +499,27 @@ TEST(OptimizerPassage, RejectedTrialsPutBackGiveTheSameSearch)
   // A trial the compass search does not take is put back (ControlProblem::reject: the mesh
   // plan's undo, the angles measured before it, the laws of skewed edges) instead of being
   // moved back by the next evaluation: every evaluation, the steps and the result the same,
-  // bit for bit, on the O-grid with its distribution skews (laws the plan does not keep; without putting
-  // those back the distributor's search differs within these 300 evaluations).
-  Loaded loaded = loadPassage("axial_passage_oh", "distributor");
+  // bit for bit, on the O-grid with distribution skews (laws the plan does not keep;
+  // without putting those back the distributor's search differs within these 300
+  // evaluations). axial_passage_oh grades no direction `ends` on all four edges away from
+  // the periodic faces any more (its O arcs `match`), so its spanwise laws are made
+  // `ends` here: the O blocks and the edge H blocks get spanwise skews.
+  Loaded loaded;
+  {
+    const model::TemplateInputs inputs = test::readTemplateInputs(
+      std::string(BLOCKFORGE_SOURCE_DIR) + "/Data/distributor/BladeGen.inf");
+    std::string text = test::readText(test::templatePath("axial_passage_oh.yaml"));
+    const std::string twoSided = "k: {two_sided: k_span}", ends = "k: {ends: [0.75, 0.75]}";
+    int replaced = 0;
+    for (std::size_t at = text.find(twoSided); at != std::string::npos;
+         at = text.find(twoSided, at + ends.size()), ++replaced)
+    {
+      text.replace(at, twoSided.size(), ends);
+    }
+    ASSERT_EQ(replaced, 12); // every block's spanwise direction
+    loaded.model =
+      model::parseTemplate(text, "axial_passage_oh.yaml", {}, &inputs, &loaded.geometry);
+  }
   SearchSettings settings;
   settings.maxEvaluations = 300;
   const OptimizerSettings defaults;
@@ -542,12 +562,15 @@ TEST(OptimizerPassage, RejectedTrialsPutBackGiveTheSameSearch)
  * stall rule): no element angle below 40 degrees, aiming at 45 (49.05 and 44.89 when
  * written), no cell in MinAngle class 0-20 or 20-40, within 700 trials (a bound on the
  * time that does not depend on the machine). Without the shear (o_shear 0) the same run
- * stays at 34.7 and 31.8 degrees: the shear is what lifts it.
+ * stays at 34.7 and 31.8 degrees: the shear is what lifts it. The bounds guard today's
+ * values: 47.86 and 46.98 since the sides' O arcs `match` the O corners' cells (issue 8:
+ * neighbour ratio on Rotor 37 at density 4 22.9 -> 4.1), 53.26 and 48.50 before (the
+ * distributor's bound 48.5 -> 47.5, Rotor 37's 44.5 -> 46.5).
  */
 TEST(OptimizerPassage, ShearedOGridReachesFortyDegrees)
 {
   for (const auto& [machine, bound] :
-    { std::pair<const char*, double>{ "distributor", 48.5 }, { "rotor37/turbogrid", 44.5 } })
+    { std::pair<const char*, double>{ "distributor", 47.5 }, { "rotor37/turbogrid", 46.5 } })
   {
     SCOPED_TRACE(machine);
     Loaded loaded;

@@ -452,5 +452,14 @@ TEST(ProjectedEdges, FlatEndsTravelInTheModelDocument)
   EXPECT_TRUE(contains(errorOf(quarterRing("{ends: [0.1, 0.3], flat: 0.5}", "uniform")),
     "must be at least 1"));
   EXPECT_TRUE(contains(errorOf(quarterRing("{geometric: 1.2, flat: 2}", "uniform")),
-    "'flat' belongs to the law ends"));
+    "'flat' belongs to the laws ends and match"));
+  // `match` with `flat` (matchFlatness) travels too; below 1 it is an error.
+  const BlockModel matched =
+    parseTemplate(quarterRing("{match: 2, flat: 3}", "uniform"), "ring.yaml");
+  const std::string matchedDocument = writeModelDocument(matched);
+  EXPECT_TRUE(contains(matchedDocument, "{match: 2, flat: 3}")) << matchedDocument;
+  EXPECT_EQ(readModelDocument(matchedDocument).blocks[0].laws, matched.blocks[0].laws);
+  EXPECT_EQ(matched.blocks[0].laws[0].matchFlatness, 3.0);
+  EXPECT_TRUE(contains(errorOf(quarterRing("{match: 2, flat: 0.5}", "uniform")),
+    "must be at least 1"));
 }

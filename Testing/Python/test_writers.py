@@ -160,7 +160,7 @@ class FoamFormatsTest(unittest.TestCase):
             reader.Update()
             internal = reader.GetOutput().GetBlock(0)
             result.append((internal.GetNumberOfCells(), bftest.points(internal)))
-        self.assertEqual(result[0][0], 1200)
+        self.assertEqual(result[0][0], 1356)
         self.assertEqual(result[0][0], result[1][0])
         self.assertTrue(np.array_equal(result[0][1], result[1][1]))
 
@@ -342,7 +342,9 @@ class NativeCommandLineTest(unittest.TestCase):
             self.assertTrue(filecmp.cmp(os.path.join(folder, objective, "python", "grid.xyz"),
                                         os.path.join(folder, objective, "native", "grid.xyz"),
                                         shallow=False), objective)
-        self.assertLess(largest["non-orthogonality"], largest["min-angle"] - 5.0, largest)
+        # 5 degrees lower until the O-grid's sides matched its corners' cells (issue 8); now
+        # 52.23 against 53.66 (n_span 8)
+        self.assertLess(largest["non-orthogonality"], largest["min-angle"] - 1.0, largest)
         run = subprocess.run([CLI, CYLINDER, "--objective", "smoothness", "-o", "x.foam"],
                              capture_output=True, text=True)
         self.assertEqual(run.returncode, 2)
