@@ -45,9 +45,16 @@ void FaceWalker::numberPoints()
       }
     }
   }
+  degenerate.assign(blockCount, 0);
   for (int b = 0; b < blockCount; ++b)
   {
+    const std::array<bool, 12>& collapsed = grid.collapsedEdges[b];
+    degenerate[b] = std::any_of(collapsed.begin(), collapsed.end(), [](bool c) { return c; });
     uniteCollapsed(sets, b);
+    if (uniteCoincident(sets, b))
+    {
+      degenerate[b] = 1;
+    }
   }
   // Points in order of their first node.
   pointOf.resize(static_cast<std::size_t>(nodeBase.back()));
@@ -93,6 +100,42 @@ void FaceWalker::uniteCollapsed(NodeSets& sets, int b)
       }
     }
   }
+}
+
+/// Neighbour nodes along a grid line of the block that are the same point (equal
+/// coordinates, bit for bit) are one point: a block edge or face that the geometry
+/// collapses without the model saying so (two vertices placed on one point, a fan's feet
+/// on a sharp tip) gives prisms as a wedge block does. Exact equality only: nodes a
+/// round-off apart stay apart, so the cells written are the cells GridQuality measures
+/// (it treats an edge shorter than 1e-14 of the cell's longest edge as collapsed). True
+/// when any nodes were merged.
+bool FaceWalker::uniteCoincident(NodeSets& sets, int b)
+{
+  const GridBlock& block = grid.blocks[b];
+  const long long steps[3] = { 1, block.nodes[0], static_cast<long long>(block.nodes[0]) * block.nodes[1] };
+  const long long count = block.nodeCount();
+  const int base = static_cast<int>(nodeBase[b]);
+  bool any = false;
+  for (long long n = 0; n < count; ++n)
+  {
+    const long long index[3] = { n % block.nodes[0], (n / block.nodes[0]) % block.nodes[1],
+      n / steps[2] };
+    const double* p = block.xyz + 3 * n;
+    for (int d = 0; d < 3; ++d)
+    {
+      if (index[d] + 1 >= block.nodes[d])
+      {
+        continue;
+      }
+      const double* q = p + 3 * steps[d];
+      if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2])
+      {
+        sets.unite(base + static_cast<int>(n), base + static_cast<int>(n + steps[d]));
+        any = true;
+      }
+    }
+  }
+  return any;
 }
 
 /// Fills `across` for both sides of every interface.

@@ -230,6 +230,63 @@ class CheckMeshTest(unittest.TestCase):
                 difference = np.abs(theirs - ours)
                 self.assertLess(np.max(difference), CELL_QUALITY_BOUND, int(np.argmax(difference)))
 
+    def test_compressor_fans_as_exact_prisms(self):
+        """The compressor's fans (edge blocks O_le, O_te at its sharp edges) with their blade
+        rows moved onto the tip by hand (within a micrometre): the writer merges the
+        coincident nodes, the fans' wall cells are prisms, checkMesh finds no concave cell
+        (97 as meshed), and checkMesh and GridQuality still agree cell by cell on them.
+        GridQuality's MinAngle of a prism is its apex angle on the tip (about 11 degrees at
+        density 1 where the hexahedra with blade faces of 1e-7 m showed 75)."""
+        from blockforge import vtkGridQuality
+        grid = blockforge.mesh_template(template("axial_passage_oh"), input_file=MACHINES[2][1],
+                                        optimize=False).GetOutputDataObject(0)
+        fans = ("O_le", "O_te")
+        moved = foamtools.collapse_rows(grid, fans)
+        self.assertLess(moved, 1e-6)  # the feet lie within a micrometre of the tip
+        quality = vtkGridQuality()
+        quality.SetInputData(grid)
+        quality.Update()
+        measured = quality.GetOutputDataObject(0)
+        case = bftest.output_path(os.path.join("openfoam", "compressor_fan_prisms"))
+        shutil.rmtree(case, ignore_errors=True)
+        writers.write_solver_grid(grid, os.path.join(case, "fans.foam"))
+        status, plain = foamtools.run_foam(["checkMesh"], case)
+        self.assertTrue(foamtools.check_mesh_summary(plain)["ok"], plain[-3000:])
+        status, text = foamtools.run_foam(
+            ["checkMesh", "-allGeometry", "-allTopology", "-writeFields",
+             "(nonOrthoAngle skewness)"], case)
+        summary = foamtools.check_mesh_summary(text)
+        ni, _, nk = foamtools.blocks_of(grid)["O_le"][1]
+        prisms = 2 * (ni - 1) * (nk - 1)  # the wall cells of both fans
+        self.assertEqual(summary["prisms"], prisms)
+        self.assertEqual(summary["hexahedra"], 9600 - prisms)
+        failed = summary["failed"]
+        self.assertFalse([line for line in failed if "Concave" in line], failed)
+        # left: the thin wall cells' determinant, and 6 face tets at D_M's outlet corner
+        # (cells of 0.1 x 5.9 mm, the fans' small cells carried to the outlet by `match`)
+        self.assertEqual(len(failed), 2, failed)
+        self.assertIn("face tets: 6 faces", failed[0])
+        self.assertIn("determinant", failed[1])
+        constant = os.path.join(case, "constant")
+        for field, array in (("nonOrthoAngle", "NonOrthogonality"), ("skewness", "Skewness")):
+            theirs = foamtools.read_cell_field(os.path.join(constant, field))
+            ours = block_cell_array(measured, array)
+            self.assertLess(np.max(np.abs(theirs - ours)), CELL_QUALITY_BOUND, field)
+        # A prism's smallest angle is the apex of its triangles: the angle on the tip
+        # between the radial lines of the fan's neighbouring outer nodes.
+        apex = []
+        for fan in fans:
+            block, dims = foamtools.blocks_of(grid)[fan]
+            points = dsa.WrapDataObject(block).Points.reshape(dims[2], dims[1], dims[0], 3)
+            radial = points[:, 1] - points[:, 0]
+            radial /= np.linalg.norm(radial, axis=-1)[..., None]
+            cosine = np.clip((radial[:, 1:] * radial[:, :-1]).sum(-1), -1, 1)
+            angle = np.degrees(np.arccos(cosine))
+            apex.append(np.minimum(angle[1:], angle[:-1]).ravel())  # per cell, its two layers
+        self.assertAlmostEqual(float(foamtools.row_cells(measured, fans, "MinAngle").min()),
+                               float(np.concatenate(apex).min()), delta=1e-9)
+        self.assertGreater(float(foamtools.row_cells(measured, fans, "ScaledJacobian").min()), 0.9)
+
 
 if __name__ == "__main__":
     bftest.run_tests()
