@@ -112,25 +112,29 @@ void FaceWalker::uniteCollapsed(NodeSets& sets, int b)
 bool FaceWalker::uniteCoincident(NodeSets& sets, int b)
 {
   const GridBlock& block = grid.blocks[b];
-  const long long steps[3] = { 1, block.nodes[0], static_cast<long long>(block.nodes[0]) * block.nodes[1] };
+  const int ni = block.nodes[0], nj = block.nodes[1];
+  const long long steps[3] = { 1, ni, static_cast<long long>(ni) * nj };
   const long long count = block.nodeCount();
+  const double* xyz = block.xyz;
   const int base = static_cast<int>(nodeBase[b]);
   bool any = false;
-  for (long long n = 0; n < count; ++n)
+  for (int d = 0; d < 3; ++d)
   {
-    const long long index[3] = { n % block.nodes[0], (n / block.nodes[0]) % block.nodes[1],
-      n / steps[2] };
-    const double* p = block.xyz + 3 * n;
-    for (int d = 0; d < 3; ++d)
+    const long long step = steps[d];
+    // x first, in a tight loop (equal x is rare); the whole point and whether n has a
+    // neighbour along d (not the last node of its line) only then.
+    for (long long n = 0; n + step < count; ++n)
     {
-      if (index[d] + 1 >= block.nodes[d])
+      if (xyz[3 * n] != xyz[3 * (n + step)])
       {
         continue;
       }
-      const double* q = p + 3 * steps[d];
-      if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2])
+      const double* p = xyz + 3 * n;
+      const double* q = xyz + 3 * (n + step);
+      const bool inside = d == 0 ? n % ni + 1 < ni : d == 1 ? (n / ni) % nj + 1 < nj : true;
+      if (inside && p[1] == q[1] && p[2] == q[2])
       {
-        sets.unite(base + static_cast<int>(n), base + static_cast<int>(n + steps[d]));
+        sets.unite(base + static_cast<int>(n), base + static_cast<int>(n + step));
         any = true;
       }
     }
