@@ -90,36 +90,6 @@ def blocks_of(grid):
     return found
 
 
-def collapse_rows(grid, names):
-    """Moves the j = 0 row of every block in *names* onto the row's middle node, spanwise
-    layer by layer, in every block that shares those nodes (shared nodes are the same
-    doubles in every block): the fans of axial_passage_oh at a sharp edge (O_le, O_te),
-    whose blade rows are the feet of their outer nodes within about a micrometre of the
-    tip, become exact prisms for the polyMesh writer, which merges coincident neighbour
-    nodes. Edits the grid in place; returns the largest move."""
-    from vtkmodules.numpy_interface import dataset_adapter as dsa
-    blocks = blocks_of(grid)
-    moves = {}
-    for name in names:
-        block, dims = blocks[name]
-        points = dsa.WrapDataObject(block).Points.reshape(dims[2], dims[1], dims[0], 3)
-        for k in range(dims[2]):
-            tip = np.array(points[k, 0, dims[0] // 2])
-            for i in range(dims[0]):
-                moves[tuple(points[k, 0, i])] = tip
-    largest = 0.0
-    for block, _ in blocks.values():
-        points = dsa.WrapDataObject(block).Points
-        for n in range(points.shape[0]):
-            tip = moves.get(tuple(points[n]))
-            if tip is not None:
-                largest = max(largest, float(np.linalg.norm(points[n] - tip)))
-                points[n] = tip
-        block.GetPoints().Modified()
-        block.Modified()
-    return largest
-
-
 def row_cells(grid, names, array):
     """Cell array *array* on the cells next to the j = 0 face of the blocks in *names*."""
     from vtkmodules.numpy_interface import dataset_adapter as dsa
