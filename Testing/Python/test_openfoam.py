@@ -237,7 +237,7 @@ class CheckMeshTest(unittest.TestCase):
         cell (97 placed, 22 optimized by default); optimized, the thin-wall determinant is
         the only failed check; checkMesh and GridQuality agree cell by cell. GridQuality's
         MinAngle of a prism is its apex on the tip: the angle there between the radial lines
-        of the fan's neighbouring nodes (10.9 degrees placed, where the default grid's
+        of the fan's neighbouring nodes (10.8 degrees placed, where the default grid's
         hexahedra with blade faces of 1e-7 m show 75)."""
         fans = ("O_le", "O_te")
         for optimize in (False, True):
