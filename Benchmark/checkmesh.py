@@ -10,9 +10,10 @@ the cells under the determinant threshold with their aspect ratio (checkMesh's, 
 `-writeFields`), and the largest per-cell difference between checkMesh's non-orthogonality
 and skewness (`-writeFields`) and GridQuality's. Then the O-grid at other densities where
 issue 10 is still open (the compressor at 0.5, 2 and 4, Rotor 37 at 0.5), in a second table.
-
-Needs a build (its Python package on PYTHONPATH, e.g. `source build/blockforge-env.sh`)
-and OpenFOAM (Debian `openfoam`). Usage: checkmesh.py [--output FILE]
+A third table: the compressor with `o_fan_prisms: 1` (its fans' feet one point on the tip,
+the fans' wall cells prisms), every density, placed and optimized, with GridQuality's
+smallest MinAngle and ScaledJacobian of the fans' wall cells and the whole grid's smallest
+MinAngle, each against the default grid's (o_fan_prisms 0).
 """
 import argparse
 import os
@@ -46,6 +47,10 @@ DENSITY_CASES = ([("axial_passage_oh", "compressor", MACHINES[2][1], optimize, d
                   for density in (0.5, 2.0, 4.0) for optimize in (False, True)] +
                  [("axial_passage_oh", "Rotor 37", MACHINES[1][1], optimize, 0.5)
                   for optimize in (False, True)])
+# The compressor with o_fan_prisms (third table): every density.
+FAN_CASES = [("axial_passage_oh", "compressor", MACHINES[2][1], optimize, density)
+             for density in (0.5, 1.0, 2.0, 4.0) for optimize in (False, True)]
+FANS = ("O_le", "O_te")  # the edge blocks, fans at the compressor's sharp edges
 FAILED = [("determinant", "cell determinant"), ("interpolation weight", "interpolation weight"),
           ("Concave cells", "concave cells"), ("small volume ratio", "volume ratio"),
           ("face tets", "face tets"), ("skew faces", "skew faces"),
@@ -90,13 +95,28 @@ def main():
     work = Path(tempfile.mkdtemp(prefix="blockforge-checkmesh-"))
     rows = []
     density_rows = []
+    fan_rows = []
     try:
-        for template, machine, path, optimize, density in CASES + DENSITY_CASES:
+        for number, (template, machine, path, optimize, density) in enumerate(
+                CASES + DENSITY_CASES + FAN_CASES):
+            fans = number >= len(CASES) + len(DENSITY_CASES)
             quality = blockforge.mesh_template(str(ROOT / "Templates" / f"{template}.yaml"),
                                                input_file=str(path) if path else None,
-                                               optimize=optimize, density_multiplier=density)
+                                               optimize=optimize, density_multiplier=density,
+                                               parameters={"o_fan_prisms": 1} if fans else None)
             grid = quality.GetOutputDataObject(0)
-            case = work / f"{template}_{machine or ''}_{int(optimize)}_{density}".replace(" ", "")
+            if fans:
+                default = blockforge.mesh_template(
+                    str(ROOT / "Templates" / f"{template}.yaml"), input_file=str(path),
+                    optimize=optimize, density_multiplier=density).GetOutputDataObject(0)
+                before = (foamtools.row_cells(default, FANS, "MinAngle").min(),
+                          foamtools.row_cells(default, FANS, "ScaledJacobian").min(),
+                          cell_array(default, "MinAngle").min())
+                after = (foamtools.row_cells(grid, FANS, "MinAngle").min(),
+                         foamtools.row_cells(grid, FANS, "ScaledJacobian").min(),
+                         cell_array(grid, "MinAngle").min())
+                del default
+            case = work / f"{template}_{machine or ''}_{int(optimize)}_{density}_{int(fans)}".replace(" ", "")
             writers.write_solver_grid(grid, str(case / "c.foam"))
             _, plain = foamtools.run_foam(["checkMesh"], str(case))
             _, full = foamtools.run_foam(
@@ -113,6 +133,16 @@ def main():
             label = (template + (f", {machine}" if machine else "") +
                      (f", density {density:g}" if density != 1.0 else "") +
                      (", optimized" if optimize else ""))
+            if fans:
+                fan_rows.append(
+                    f"| {machine}, density {density:g}{', optimized' if optimize else ''} | "
+                    f"{int(summary['cells'])} | {int(summary['hexahedra'] or 0)} / "
+                    f"{int(summary['prisms'] or 0)} | "
+                    f"{'Mesh OK' if summary['ok'] else 'FAILED'} | {'; '.join(failed) or 'none'} | "
+                    f"{before[0]:.1f} / {after[0]:.1f} | {before[1]:.3f} / {after[1]:.3f} | "
+                    f"{before[2]:.1f} / {after[2]:.1f} | {agreement[0]:.1e} / {agreement[1]:.1e} |")
+                print(fan_rows[-1], flush=True)
+                continue
             (rows if density == 1.0 else density_rows).append(
                 f"| {label} | {int(summary['cells'])} | {int(summary['hexahedra'] or 0)} / "
                 f"{int(summary['prisms'] or 0)} | {summary['non_orthogonality']:.2f} | "
@@ -139,7 +169,19 @@ def main():
         "(fans on the tips) and Rotor 37's thin edges at density 0.5, the same columns:", "",
         "| template, machine | cells | hexahedra / prisms | non-orthogonality [°] | skewness | "
         "aspect ratio | verdict | failed under -allGeometry -allTopology | per cell vs GridQuality |",
-        "|---|---|---|---|---|---|---|---|---|"] + density_rows + [""])
+        "|---|---|---|---|---|---|---|---|---|"] + density_rows + [
+        "", "## The compressor's fans as prisms (o_fan_prisms: 1)", "",
+        "The compressor's O-grid with `-p o_fan_prisms=1`: at its sharp edges both feet of "
+        "each fan (edge blocks O_le and O_te) are one point on the tip, the fan's blade arc "
+        "collapses into it and the polyMesh writer writes the fan's wall cells as prisms. "
+        "MinAngle [°] and ScaledJacobian: GridQuality's smallest on the fans' wall cells, "
+        "default (o_fan_prisms 0: hexahedra whose blade faces are 1e-7 m wide) / prisms (a "
+        "prism's MinAngle is its apex on the tip); then the smallest MinAngle of the whole "
+        "grid, default / prisms.", "",
+        "| machine, density | cells | hexahedra / prisms | verdict | failed under "
+        "-allGeometry -allTopology | fan MinAngle [°] | fan ScaledJacobian | grid MinAngle [°] | "
+        "per cell vs GridQuality |",
+        "|---|---|---|---|---|---|---|---|---|"] + fan_rows + [""])
     Path(args.output).write_text(text)
     print(text)
 

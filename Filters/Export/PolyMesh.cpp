@@ -45,9 +45,16 @@ void FaceWalker::numberPoints()
       }
     }
   }
+  degenerate.assign(blockCount, 0);
   for (int b = 0; b < blockCount; ++b)
   {
+    const std::array<bool, 12>& collapsed = grid.collapsedEdges[b];
+    degenerate[b] = std::any_of(collapsed.begin(), collapsed.end(), [](bool c) { return c; });
     uniteCollapsed(sets, b);
+    if (uniteCoincident(sets, b))
+    {
+      degenerate[b] = 1;
+    }
   }
   // Points in order of their first node.
   pointOf.resize(static_cast<std::size_t>(nodeBase.back()));
@@ -93,6 +100,46 @@ void FaceWalker::uniteCollapsed(NodeSets& sets, int b)
       }
     }
   }
+}
+
+/// Neighbour nodes along a grid line of the block that are the same point (equal
+/// coordinates, bit for bit) are one point: a block edge or face that the geometry
+/// collapses without the model saying so (two vertices placed on one point, a fan's feet
+/// on a sharp tip) gives prisms as a wedge block does. Exact equality only: nodes a
+/// round-off apart stay apart, so the cells written are the cells GridQuality measures
+/// (it treats an edge shorter than 1e-14 of the cell's longest edge as collapsed). True
+/// when any nodes were merged.
+bool FaceWalker::uniteCoincident(NodeSets& sets, int b)
+{
+  const GridBlock& block = grid.blocks[b];
+  const int ni = block.nodes[0], nj = block.nodes[1];
+  const long long steps[3] = { 1, ni, static_cast<long long>(ni) * nj };
+  const long long count = block.nodeCount();
+  const double* xyz = block.xyz;
+  const int base = static_cast<int>(nodeBase[b]);
+  bool any = false;
+  for (int d = 0; d < 3; ++d)
+  {
+    const long long step = steps[d];
+    // x first, in a tight loop (equal x is rare); the whole point and whether n has a
+    // neighbour along d (not the last node of its line) only then.
+    for (long long n = 0; n + step < count; ++n)
+    {
+      if (xyz[3 * n] != xyz[3 * (n + step)])
+      {
+        continue;
+      }
+      const double* p = xyz + 3 * n;
+      const double* q = xyz + 3 * (n + step);
+      const bool inside = d == 0 ? n % ni + 1 < ni : d == 1 ? (n / ni) % nj + 1 < nj : true;
+      if (inside && p[1] == q[1] && p[2] == q[2])
+      {
+        sets.unite(base + static_cast<int>(n), base + static_cast<int>(n + step));
+        any = true;
+      }
+    }
+  }
+  return any;
 }
 
 /// Fills `across` for both sides of every interface.

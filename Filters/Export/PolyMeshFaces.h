@@ -84,7 +84,8 @@ long long faceCell(const GridBlock& block, int face, int ca, int cb)
 }
 
 /**
- * Numbers the points (interfaces and collapsed edges merged, first occurrence first) and
+ * Numbers the points (interfaces, collapsed edges and coincident neighbour nodes merged,
+ * first occurrence first) and
  * walks the faces. A sink has internalFace(owner, neighbour, corners, count),
  * boundaryFace(owner, corners, count) and patch(FoamPatch) (after the patch's faces).
  */
@@ -148,6 +149,10 @@ private:
   }
   void numberPoints();
   void uniteCollapsed(NodeSets& sets, int b);
+  bool uniteCoincident(NodeSets& sets, int b);
+  /// Per block: some nodes merged (collapsed edges or coincident nodes), so cell faces
+  /// may lose corners.
+  std::vector<char> degenerate;
   void linkInterfaces();
   void linkSide(model::BlockFace from, model::BlockFace to, FaceTransform transform);
 
@@ -189,9 +194,8 @@ private:
       const int ci = ni - 1, cj = block.nodes[1] - 1, ck = block.nodes[2] - 1;
       const int* points = pointOf.data() + nodeBase[b];
       int cell = static_cast<int>(cellBase[b]);
-      // Without collapsed edges no cell face can lose a corner: no check needed.
-      const std::array<bool, 12>& collapsed = grid.collapsedEdges[b];
-      const bool regular = std::none_of(collapsed.begin(), collapsed.end(), [](bool c) { return c; });
+      // Without merged nodes no cell face can lose a corner: no check needed.
+      const bool regular = !degenerate[b];
       for (int k = 0; k < ck; ++k)
       {
         for (int j = 0; j < cj; ++j)

@@ -215,7 +215,8 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
       }
       const double u0 = edgeEndParameters(model, geometry, edge, 0, size)[0];
       const double u1 = edgeEndParameters(model, geometry, edge, 1, size)[0];
-      if (u0 == u1)
+      // one point (both ends on it): a collapsed edge, all its nodes there
+      if (u0 == u1 && start != end)
       {
         throw GeometryError("both ends are at the same curve parameter");
       }
@@ -357,7 +358,8 @@ NamedCurve buildNamedCurve(const BlockModel& model, const CarrierGeometry& geome
     default:
       break;
   }
-  if (!std::isfinite(named.length) || !(named.length > 0.0))
+  const bool collapsed = named.length == 0.0 && start == end; // on one point (above)
+  if (!std::isfinite(named.length) || !(named.length > 0.0 || collapsed))
   {
     throw GeometryError("the edge has no length");
   }

@@ -740,6 +740,50 @@ std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopolo
 }
 
 
+namespace
+{
+/// A face whose two opposite edges are each one point and whose other two edges are the
+/// same nodes is a line (a fan's blade face on a sharp tip): every row across it is made
+/// that line's node, so the face's nodes coincide exactly (the interpolation between two
+/// equal edges leaves them a round-off apart) and the writers see prisms.
+void snapLineFace(std::vector<double>& xyz, int na, int nb)
+{
+  const auto at = [&](int a, int b) { return &xyz[3 * (static_cast<std::size_t>(b) * na + a)]; };
+  const auto same = [](const double* p, const double* q) {
+    return p[0] == q[0] && p[1] == q[1] && p[2] == q[2];
+  };
+  for (int direction = 0; direction < 2; ++direction)
+  {
+    // direction 0: rows b = 0 and b = nb - 1 are points, columns a = 0 and na - 1 equal
+    const int n = direction == 0 ? na : nb, m = direction == 0 ? nb : na;
+    const auto node = [&](int along, int across) {
+      return direction == 0 ? at(along, across) : at(across, along);
+    };
+    bool line = n > 1;
+    for (int i = 1; line && i < n; ++i)
+    {
+      line = same(node(i, 0), node(0, 0)) && same(node(i, m - 1), node(0, m - 1));
+    }
+    for (int j = 0; line && j < m; ++j)
+    {
+      line = same(node(0, j), node(n - 1, j));
+    }
+    if (!line)
+    {
+      continue;
+    }
+    for (int j = 1; j + 1 < m; ++j)
+    {
+      for (int i = 1; i + 1 < n; ++i)
+      {
+        std::copy_n(node(0, j), 3, node(i, j));
+      }
+    }
+    return;
+  }
+}
+} // namespace
+
 void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
   const std::map<int, int>& onSurface, MeshTopology& topology, int f, ProjectionCache* cache)
 {
@@ -756,6 +800,7 @@ void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
     {
       faceFromEdges(model, topology, owner.block, owner.face, face.xyz);
     }
+    snapLineFace(face.xyz, face.na, face.nb);
   }
   catch (const GeometryError& error)
   {

@@ -220,6 +220,17 @@ void projectEdgeParameters(const BlockModel& model, const std::vector<NamedCurve
   const bool crossed = runsAgainst(model, edge, source);
   std::vector<double> params(n, 0.0);
   params[n - 1] = 1.0;
+  if (start == end && (!named || named->length == 0.0))
+  {
+    // A collapsed edge (its ends one point, e.g. a fan's blade arc on a sharp tip): every
+    // node is that point, whatever the parameters; they stay evenly spread.
+    for (int i = 1; i < n - 1; ++i)
+    {
+      params[i] = static_cast<double>(i) / (n - 1);
+    }
+    edge.params = std::move(params);
+    return;
+  }
   for (int i = 1; i < n - 1; ++i)
   {
     const Vec3 node = edgeNodePoint(model, curves, geometry, source, crossed ? n - 1 - i : i);

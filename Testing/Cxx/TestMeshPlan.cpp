@@ -86,9 +86,15 @@ TEST(Placement, PassageRulesAndOrder)
   const BlockModel& model = rotor37Passage().model;
   const int oa = vertexIndex(model, "oa_f_h"), a = vertexIndex(model, "a_f_h");
   const int lo = vertexIndex(model, "lo_f_h"), hi = vertexIndex(model, "hi_f_h");
+  // a_f_h is the projection of ta_f_h, the O curve's point at oa_f_h's parameter (or, with
+  // o_fan_prisms at a sharp edge, off the tip), which follows oa_f_h by its expression
+  const int ta = vertexIndex(model, "ta_f_h");
   EXPECT_EQ(model.vertices[oa].rule.kind, VertexRule::Kind::OnCarrier);
   EXPECT_EQ(model.vertices[a].rule.kind, VertexRule::Kind::Projected);
-  EXPECT_EQ(model.vertices[a].rule.source, oa);
+  EXPECT_EQ(model.vertices[a].rule.source, ta);
+  const std::vector<int>& follows = model.vertices[ta].rule.expressions.follows;
+  EXPECT_NE(std::find(follows.begin(), follows.end(), oa), follows.end());
+  EXPECT_TRUE(test::sameBits(model.vertices[ta].position, model.vertices[oa].position));
   EXPECT_EQ(model.vertices[hi].rule.kind, VertexRule::Kind::Periodic);
   EXPECT_EQ(ruleSource(model.vertices[hi]), lo);
   EXPECT_EQ(model.vertices[vertexIndex(model, "le_h")].rule.kind, VertexRule::Kind::OnCarrier);
@@ -108,7 +114,8 @@ TEST(Placement, PassageRulesAndOrder)
     }
   }
   const std::vector<std::vector<int>> dependents = vertexDependents(model);
-  EXPECT_NE(std::find(dependents[oa].begin(), dependents[oa].end(), a), dependents[oa].end());
+  EXPECT_NE(std::find(dependents[oa].begin(), dependents[oa].end(), ta), dependents[oa].end());
+  EXPECT_NE(std::find(dependents[ta].begin(), dependents[ta].end(), a), dependents[ta].end());
 
   // Applying every rule again changes nothing: the template placed its vertices with them.
   BlockModel again = model;
@@ -159,7 +166,7 @@ TEST(Placement, RulesTravelInTheModelDocument)
   const BlockModel& model = rotor37Passage().model;
   const std::string document = writeModelDocument(model);
   EXPECT_NE(document.find("blockforge_model: 4"), std::string::npos);
-  EXPECT_NE(document.find("rule: projected, source: oa_f_h"), std::string::npos);
+  EXPECT_NE(document.find("rule: projected, source: ta_f_h"), std::string::npos);
   EXPECT_NE(document.find("through: [lo_f_h, lo_m_h, lo_r_h]"), std::string::npos);
   EXPECT_NE(document.find("expression_scope:"), std::string::npos);
   const BlockModel reread = readModelDocument(document);
@@ -231,7 +238,7 @@ TEST(Placement, RulesTravelInTheModelDocument)
   }
 
   // Bad rules are named.
-  test::expectError([&] { readModelDocument(test::replaced(document, "rule: projected, source: oa_f_h", "rule: glued, source: oa_f_h")); },
+  test::expectError([&] { readModelDocument(test::replaced(document, "rule: projected, source: ta_f_h", "rule: glued, source: ta_f_h")); },
     { "vertex 'a_f_h'", "unknown placement rule 'glued'" });
 }
 

@@ -1,5 +1,6 @@
 // OpenFOAM polyMesh assembly on hand-made block grids with analytic volumes: a box, two
-// blocks joined through a turned face, a wedge (prism cells) and a periodic pair.
+// blocks joined through a turned face, a wedge (prism cells, collapsed in the model or only
+// by coincident nodes) and a periodic pair.
 #include "PolyMesh.h"
 #include "StagedOutput.h"
 
@@ -253,6 +254,60 @@ TEST(PolyMesh, WedgeBlockGivesPrisms)
   // Polygonal sector: (na - 1) triangles of the chord polygon, times H.
   const double expected = (na - 1) * 0.5 * R * R * std::sin(phi / (na - 1)) * H;
   EXPECT_NEAR(totalVolume(mesh), expected, 1e-12);
+}
+
+TEST(PolyMesh, CoincidentNodesGivePrismsWithoutCollapsedEdges)
+{
+  // The pie slice of WedgeBlockGivesPrisms, its axis nodes the same point per level but
+  // the model saying nothing (no collapsed edge, face i0 an ordinary face in the patch):
+  // a fan whose feet lie on one tip. The writer merges the coincident nodes itself and
+  // writes the very mesh of the collapsed block.
+  const double phi = Pi / 3.0, R = 1.0, H = 0.5;
+  const int nr = 5, na = 7, nh = 3;
+  auto slice = [&]() {
+    std::vector<OwnedBlock> blocks;
+    blocks.push_back(makeBlock("fan", { nr, na, nh }, [&](int i, int j, int k) {
+      const double r = R * i / (nr - 1), t = phi * j / (na - 1);
+      return Vec3(r * std::cos(t), r * std::sin(t), H * k / (nh - 1));
+    }));
+    return blocks;
+  };
+  std::vector<OwnedBlock> collapsedBlocks = slice(), plainBlocks = slice();
+  ExportGrid collapsed = gridOf(collapsedBlocks);
+  collapsed.collapsedEdges[0][3] = collapsed.collapsedEdges[0][7] = true;
+  collapsed.collapsedFaces[0][0] = true;
+  ExportGrid plain = gridOf(plainBlocks);
+  GridPatch all;
+  all.name = "outside";
+  all.type = "wall";
+  all.faces = { { 0, 1 }, { 0, 2 }, { 0, 3 }, { 0, 4 }, { 0, 5 } };
+  collapsed.patches = { all };
+  all.faces.insert(all.faces.begin(), { 0, 0 }); // the axis: no face survives
+  plain.patches = { all };
+  const PolyMesh expected = buildPolyMesh(collapsed);
+  const PolyMesh mesh = buildPolyMesh(plain);
+  EXPECT_EQ(mesh.pointCount(), (nr - 1) * na * nh + nh);
+  EXPECT_EQ(mesh.triangleFaces, (na - 1) * nh);
+  EXPECT_EQ(mesh.points, expected.points);
+  EXPECT_EQ(mesh.faceNodes, expected.faceNodes);
+  EXPECT_EQ(mesh.faceOffsets, expected.faceOffsets);
+  EXPECT_EQ(mesh.owner, expected.owner);
+  EXPECT_EQ(mesh.neighbour, expected.neighbour);
+  ASSERT_EQ(mesh.patches.size(), 1u);
+  EXPECT_EQ(mesh.patches[0].faceCount, expected.patches[0].faceCount);
+  const double volume = (na - 1) * 0.5 * R * R * std::sin(phi / (na - 1)) * H;
+  EXPECT_NEAR(totalVolume(mesh), volume, 1e-12);
+
+  // Nodes a round-off apart are not merged: the cells stay what GridQuality measures.
+  std::vector<OwnedBlock> nearBlocks = slice();
+  for (int k = 0; k < nh; ++k)
+    for (int j = 1; j < na; j += 2)
+      nearBlocks[0].xyz[3 * (static_cast<std::size_t>(nr) * (j + na * k))] = 1e-15;
+  ExportGrid near = gridOf(nearBlocks);
+  near.patches = { all };
+  const PolyMesh kept = buildPolyMesh(near);
+  EXPECT_EQ(kept.pointCount(), nr * na * nh); // every other axis node moved: none merge
+  EXPECT_EQ(kept.triangleFaces, 0);
 }
 
 TEST(PolyMesh, PeriodicPairIsCyclicInMatchingOrder)

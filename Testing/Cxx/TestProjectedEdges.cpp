@@ -10,6 +10,7 @@
 
 #include "TestHelpers.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -462,4 +463,63 @@ TEST(ProjectedEdges, FlatEndsTravelInTheModelDocument)
   EXPECT_EQ(matched.blocks[0].laws[0].matchFlatness, 3.0);
   EXPECT_TRUE(contains(errorOf(quarterRing("{match: 2, flat: 0.5}", "uniform")),
     "must be at least 1"));
+}
+
+TEST(ProjectedEdges, CollapsedEdgeIsOnePointAndItsFaceALine)
+{
+  // A fan: a quarter disc of radius 1.5, its inner edges E1 and E5 collapsed onto an axis
+  // by the geometry only (p0 = p1, p4 = p5: two vertices on one point, as the feet of a
+  // fan on a sharp tip), the axis leaning (0.3, 0.2) over the height 1 so that the face
+  // j0 between the two axis edges is interpolated between equal edges (a round-off apart
+  // unless the mesher makes it the line). The collapsed edges project from the outer
+  // arcs: every node on the point, the face j0 every row the axis node, exactly.
+  const std::string text = "blockforge: 1\n"
+                           "vertices:\n"
+                           "  p0: [0, 0, 0]\n"
+                           "  p1: [0, 0, 0]\n"
+                           "  p2: [1.5, 0, 0]\n"
+                           "  p3: [0, 1.5, 0]\n"
+                           "  p4: [0.3, 0.2, 1]\n"
+                           "  p5: [0.3, 0.2, 1]\n"
+                           "  p6: [1.8, 0.2, 1]\n"
+                           "  p7: [0.3, 1.7, 1]\n"
+                           "edges:\n"
+                           "  out0: {arc: [p2, p3], centre: [0, 0, 0]}\n"
+                           "  out1: {arc: [p6, p7], centre: [0.3, 0.2, 1]}\n"
+                           "blocks:\n"
+                           "  fan: {vertices: [p0, p1, p2, p3, p4, p5, p6, p7], cells: [6, 4, 7], "
+                           "grading: {k: {geometric: 1.3}, edges: {E1: {project_from: out0}, "
+                           "E5: {project_from: out1}}}}\n";
+  const test::Grid grid = test::meshAll(parseTemplate(text, "fan.yaml"));
+  const auto& n = grid.nodes[0];
+  double volume = 0.0;
+  for (int k = 0; k < n[2]; ++k)
+  {
+    const Vec3 axis = node(grid, 0, 0, 0, k);
+    EXPECT_NEAR((axis - Vec3(0.3, 0.2, 1.0) * axis.z()).norm(), 0.0, 1e-12) << k;
+    for (int i = 1; i < n[0]; ++i)
+    {
+      EXPECT_EQ(node(grid, 0, i, 0, k), axis) << i << ", " << k; // bit for bit
+    }
+  }
+  // The sheared fan's volume: the polygon of the outer nodes (equal angles) times the height.
+  for (int k = 0; k + 1 < n[2]; ++k)
+  {
+    for (int i = 0; i + 1 < n[0]; ++i)
+    {
+      // layer k to k + 1 of the triangle fan, as two wedges (a prism of the axis and two
+      // outer-arc nodes at each level, cut into three tetrahedra)
+      const Vec3 a0 = node(grid, 0, i, 0, k), b0 = node(grid, 0, i, n[1] - 1, k),
+                 c0 = node(grid, 0, i + 1, n[1] - 1, k);
+      const Vec3 a1 = node(grid, 0, i, 0, k + 1), b1 = node(grid, 0, i, n[1] - 1, k + 1),
+                 c1 = node(grid, 0, i + 1, n[1] - 1, k + 1);
+      const auto tet = [](const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& s) {
+        return (q - p).dot((r - p).cross(s - p)) / 6.0;
+      };
+      volume += tet(a0, b0, c0, a1) + tet(b0, c0, a1, b1) + tet(c0, a1, b1, c1);
+    }
+  }
+  const double Pi = 3.14159265358979323846;
+  // (i runs clockwise seen from +z, from p3's side to p2's: the tetrahedra come out negative)
+  EXPECT_NEAR(-volume, 6 * 0.5 * 1.5 * 1.5 * std::sin(Pi / 12), 1e-12);
 }

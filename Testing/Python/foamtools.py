@@ -74,3 +74,29 @@ def residuals(log_text):
     for match in re.finditer(r"Solving for (\w+), Initial residual = ([0-9.eE+-]+)", log_text):
         series.setdefault(match.group(1), []).append(float(match.group(2)))
     return series
+
+
+def blocks_of(grid):
+    """{block name: (block, node dimensions [ni, nj, nk])} of a BlockForge multiblock grid."""
+    found = {}
+    iterator = grid.NewIterator()
+    iterator.InitTraversal()
+    while not iterator.IsDoneWithTraversal():
+        block = iterator.GetCurrentDataObject()
+        dims = [0, 0, 0]
+        block.GetDimensions(dims)
+        found[iterator.GetCurrentMetaData().Get(grid.NAME())] = (block, dims)
+        iterator.GoToNextItem()
+    return found
+
+
+def row_cells(grid, names, array):
+    """Cell array *array* on the cells next to the j = 0 face of the blocks in *names*."""
+    from vtkmodules.numpy_interface import dataset_adapter as dsa
+    values = []
+    blocks = blocks_of(grid)
+    for name in names:
+        block, dims = blocks[name]
+        cells = np.array(dsa.WrapDataObject(block).CellData[array])
+        values.append(cells.reshape(dims[2] - 1, dims[1] - 1, dims[0] - 1)[:, 0, :].ravel())
+    return np.concatenate(values)
