@@ -84,7 +84,10 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   times the blade arc between their feet): the edge block of a sharp edge is a fan on its
 #   tip, which a corner moved along one side folds. At the default 45deg the distributor's
 #   trailing edge and Rotor 37's edges are sheared; the compressor (sharp) and the turbine
-#   (stagger below 45 deg) are not (o_shear 0: no edge is).
+#   (stagger below 45 deg) are not (o_shear 0: no edge is). With shear_camber 1 the stagger
+#   is the larger of that and the camber's at the edge itself (the turbine's trailing edge,
+#   exit about 60 deg, is then sheared; not the default: its wake block folds at density 0.5
+#   with the outlet where its contours end).
 # - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
