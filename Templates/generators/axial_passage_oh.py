@@ -84,7 +84,10 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   times the blade arc between their feet): the edge block of a sharp edge is a fan on its
 #   tip, which a corner moved along one side folds. At the default 45deg the distributor's
 #   trailing edge and Rotor 37's edges are sheared; the compressor (sharp) and the turbine
-#   (stagger below 45 deg) are not (o_shear 0: no edge is).
+#   (stagger below 45 deg) are not (o_shear 0: no edge is). With shear_camber 1 the stagger
+#   is the larger of that and the camber's at the edge itself (the turbine's trailing edge,
+#   exit about 60 deg, is then sheared; not the default: its wake block folds at density 0.5
+#   with the outlet where its contours end).
 # - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
@@ -123,6 +126,7 @@ parameters:
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
   o_shear: 45deg          # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg: the optimized distributor and Rotor 37 reach 47.9 and 47.0 deg at density 1)
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
+  shear_camber: 0         # 1: the stagger that decides the shear (o_shear) at an edge is the larger of the blade's near the edge (edge to mid-camber) and the camber's at the edge itself (the turbine's trailing edge is then sheared: optimized 26.4 -> 38.0 deg at density 1, but its wake block folds at density 0.5 unless the outlet is further, extend 1); 0: the blade's near the edge
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   bisect_step: 0.005      # at a sheared edge the H lines bisect the blade direction and the O curve's at the unsheared corner, measured over this step along it (fraction of the loop)
   o_back: 0.012           # at a trailing edge neither sharp nor sheared (round or capped) the corners' feet stay at least this far from the edge (fraction of the loop; the turbine's cap spans 0.007), the H lines downstream then leave along the bisector as at a sheared edge
@@ -239,8 +243,15 @@ def template_text():
         w(f'  mc_th_{l}: "(fm_{l}.theta + bm_{l}.theta)/2"')
         for e, (x0, y0) in (('le', (f'mc_ax_{l} - le_{l}.axial', f'rm_{l}*(mc_th_{l} - le_{l}.theta)')),
                             ('te', (f'te_{l}.axial - mc_ax_{l}', f'rm_{l}*(te_{l}.theta - mc_th_{l})'))):
-            w(f'  {e}_tx_{l}: "({x0})/sqrt(({x0})^2 + ({y0})^2)"      # unit direction of the blade near the edge, downstream')
-            w(f'  {e}_ty_{l}: "({y0})/sqrt(({x0})^2 + ({y0})^2)"')
+            w(f'  {e}_cx_{l}: "({x0})/sqrt(({x0})^2 + ({y0})^2)"      # unit direction of the blade near the edge, downstream')
+            w(f'  {e}_cy_{l}: "({y0})/sqrt(({x0})^2 + ({y0})^2)"')
+            # with shear_camber, the camber direction at the edge itself where it is more
+            # staggered (a strongly cambered blade's exit: the turbine's trailing edge leaves at
+            # about 60 deg while its chord from mid-camber is below 45 deg)
+            sg = '-' if e == 'le' else ''
+            camber = f'shear_camber > 0.5 && abs({e}_uy_{l}) > abs({e}_cy_{l})'
+            w(f'  {e}_tx_{l}: "{camber} ? {sg}{e}_ux_{l} : {e}_cx_{l}"')
+            w(f'  {e}_ty_{l}: "{camber} ? {sg}{e}_uy_{l} : {e}_cy_{l}"')
             w(f'  {e}_shear_{l}: "abs({e}_ty_{l})*tan(o_shear) > abs({e}_tx_{l})"      # 1: the corners are sheared at this edge')
             w(f'  {e}_lam_{l}: "{e}_shear_{l} ? abs({e}_tx_{l})/(abs({e}_ty_{l})*tan(o_shear)) : 1"')
             w(f'  {e}_dx_{l}: "{e}_tx_{l}*{e}_ty_{l}*({e}_lam_{l} - 1)"      # direction of the sheared lines across the passage')
