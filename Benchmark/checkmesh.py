@@ -100,10 +100,22 @@ def main():
         for number, (template, machine, path, optimize, density) in enumerate(
                 CASES + DENSITY_CASES + FAN_CASES):
             fans = number >= len(CASES) + len(DENSITY_CASES)
-            quality = blockforge.mesh_template(str(ROOT / "Templates" / f"{template}.yaml"),
-                                               input_file=str(path) if path else None,
-                                               optimize=optimize, density_multiplier=density,
-                                               parameters={"o_fan_prisms": 1} if fans else None)
+            try:
+                quality = blockforge.mesh_template(
+                    str(ROOT / "Templates" / f"{template}.yaml"),
+                    input_file=str(path) if path else None, optimize=optimize,
+                    density_multiplier=density,
+                    parameters={"o_fan_prisms": 1} if fans else None)
+            except RuntimeError as error:
+                if not fans:
+                    raise
+                # the option is not the default: a grid it folds is a row, not the end
+                message = str(error).split(": ", 1)[-1].split("; the grid folds")[0]
+                fan_rows.append(f"| {machine}, density {density:g}"
+                                f"{', optimized' if optimize else ''} | not meshed: {message} "
+                                f"| | | | | | | |")
+                print(fan_rows[-1], flush=True)
+                continue
             grid = quality.GetOutputDataObject(0)
             if fans:
                 default = blockforge.mesh_template(
