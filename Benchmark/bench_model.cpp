@@ -4,7 +4,7 @@
  * evaluation costs after a control point moves, against building everything again.
  *
  * On Templates/axial_passage_oh.yaml with Data/rotor37/turbogrid (Rotor 37, 36 blades) at
- * the template's default density (9,600 cells):
+ * the template's default density (10,848 cells since stop 13, 9,600 before):
  * - ApplyTemplate:      loadTemplate() with the point sets read once (what BlockTemplate
  *                       does per update), the carriers handed over;
  * - FullEvaluation:     MultiBlockMesher (full model check) + computeBoundaries() +
