@@ -344,23 +344,28 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
     reporter.fail(fade->line, entityText, what + ": 'fade' belongs to the law project_from");
   }
   const MapEntry* lean = findEntry(entries, "lean");
+  // `flat: k`, the bump flatness of the laws ends and match (at least 1); `rule` states the
+  // bound for the law in the message.
+  const MapEntry* flat = findEntry(entries, "flat");
+  const auto flatness = [&](const std::string& rule) {
+    const double k = number(flat->value, flat->line, what + " flat");
+    if (!(k >= 1.0) || !std::isfinite(k))
+    {
+      reporter.fail(flat->line, entityText,
+        what + ": the flatness of " + rule + ", got " + formatNumber(k));
+    }
+    return k;
+  };
   if (const MapEntry* match = findEntry(entries, "match"))
   {
-    const MapEntry* matchFlat = findEntry(entries, "flat");
-    if (entries.size() != 1u + (lean ? 1u : 0u) + (matchFlat ? 1u : 0u))
+    if (entries.size() != 1u + (lean ? 1u : 0u) + (flat ? 1u : 0u))
     {
       reporter.fail(match->line, entityText,
         what + ": expected {match: r} with lean: angle, flat: k or both, alone");
     }
-    if (matchFlat)
+    if (flat)
     {
-      law.matchFlatness = number(matchFlat->value, matchFlat->line, what + " flat");
-      if (!(law.matchFlatness >= 1.0) || !std::isfinite(law.matchFlatness))
-      {
-        reporter.fail(matchFlat->line, entityText,
-          what + ": the flatness of a matched edge's bump must be at least 1, got " +
-            formatNumber(law.matchFlatness));
-      }
+      law.matchFlatness = flatness("a matched edge's bump must be at least 1");
     }
     if (lean)
     {
@@ -386,7 +391,6 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
   {
     reporter.fail(lean->line, entityText, what + ": 'lean' belongs to the law match");
   }
-  const MapEntry* flat = findEntry(entries, "flat");
   if (const MapEntry* ends = findEntry(entries, "ends"))
   {
     if (entries.size() != (flat ? 2u : 1u) || !ends->value.IsSequence() ||
@@ -398,13 +402,7 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
     }
     if (flat)
     {
-      law.endsFlatness = number(flat->value, flat->line, what + " flat");
-      if (!(law.endsFlatness >= 1.0) || !std::isfinite(law.endsFlatness))
-      {
-        reporter.fail(flat->line, entityText,
-          what + ": the flatness of an ends law's bump must be at least 1 (1: the default "
-                 "bump), got " + formatNumber(law.endsFlatness));
-      }
+      law.endsFlatness = flatness("an ends law's bump must be at least 1 (1: the default bump)");
     }
     law.kind = DistributionLaw::Kind::Ends;
     law.firstCellSize = number(ends->value[0], ends->line, what + " ends a");
