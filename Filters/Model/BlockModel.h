@@ -254,6 +254,10 @@ struct Block
   std::array<int, 8> vertices{};
   /// Cells along i (s), j (t), k (u) before the density multiplier.
   std::array<int, 3> cells{ 1, 1, 1 };
+  /// The fewest cells a density multiplier below 1 leaves along i, j, k (template key
+  /// `min_cells`; never more than `cells`): graded laws need a few cells to grow from
+  /// small matched end cells to the cells beside them (1: the plain rule).
+  std::array<int, 3> minCells{ 1, 1, 1 };
   /// Distribution law of each local edge (Transfinite.h numbering), in the local edge
   /// direction (increasing i, j or k).
   std::array<DistributionLaw, 12> laws{};

@@ -27,9 +27,12 @@ std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int c
   std::array<int, 3> nodes{};
   for (int d = 0; d < 3; ++d)
   {
-    // validated by checkDensityMultiplier: at most MaxScaledCellsPerDirection
+    // validated by checkDensityMultiplier: at most MaxScaledCellsPerDirection. A coarser
+    // grid keeps at least the block's min_cells (at most its cells), so that the graded
+    // laws still have the cells to grow from small matched end cells
     const double scaled = std::round(block.cells[d] * multiplier);
-    int cells = static_cast<int>(std::max(1.0, scaled));
+    const int floor = std::max(1, std::min(block.cells[d], block.minCells[d]));
+    int cells = static_cast<int>(std::max(static_cast<double>(floor), scaled));
     if (cap > 0)
     {
       cells = std::min(cells, cap);

@@ -199,6 +199,13 @@ void checkBasics(const BlockModel& model)
         fail(block.where, entity("block", block.name), "cells must be at least 1");
       }
     }
+    for (int cells : block.minCells)
+    {
+      if (cells < 1)
+      {
+        fail(block.where, entity("block", block.name), "min_cells must be at least 1");
+      }
+    }
     for (int e = 0; e < 12; ++e)
     {
       const DistributionLaw& law = block.laws[e];
@@ -365,12 +372,44 @@ void checkSurfaceFaces(const BlockModel& model, const CarrierGeometry& geometry,
     }
   }
 }
+/// Blocks sharing an edge keep the same cells along it at every density multiplier, so
+/// they must keep the same fewest cells there (min_cells, at most cells) when coarsened.
+void checkMinCells(const BlockModel& model, const Topology& topology)
+{
+  static const char* const directionNames[3] = { "i", "j", "k" };
+  auto floorOf = [&model](const EdgeUse& use) {
+    const Block& block = model.blocks[use.block];
+    const int d = edgeDirection(use.localEdge);
+    return std::min(block.cells[d], block.minCells[d]);
+  };
+  for (const TopologyEdge& edge : topology.edges)
+  {
+    for (const EdgeUse& use : edge.uses)
+    {
+      const EdgeUse& first = edge.uses.front();
+      if (floorOf(use) != floorOf(first))
+      {
+        const Block& block = model.blocks[use.block];
+        fail(block.where, entity("block", block.name),
+          "edge " + edgeText(model, edge.a, edge.b) + " (" + syntax::edgeLabel(use.localEdge) +
+            ") has min_cells " + std::to_string(floorOf(use)) + " along " +
+            directionNames[edgeDirection(use.localEdge)] + " here but " +
+            std::to_string(floorOf(first)) + " in block '" + model.blocks[first.block].name +
+            "' (" + syntax::edgeLabel(first.localEdge) +
+            "); blocks sharing an edge need the same min_cells along it (a min_cells above "
+            "cells counts as cells)");
+      }
+    }
+  }
+}
+
 void checkModelWith(const BlockModel& model, const CarrierGeometry& geometry)
 {
   const double size = modelSize(model);
   checkCarriers(model, geometry, size);
   const std::vector<NamedCurve> curves = buildNamedCurves(model, geometry);
   MeshTopology topology = buildMeshTopology(model, geometry, curves, baseNodeCounts(model), false);
+  checkMinCells(model, topology.connectivity);
   checkNamedEdgesUsed(model, topology);
   checkSurfaceFaces(model, geometry, topology, size);
   checkOrientation(model, curves, size);

@@ -613,7 +613,7 @@ private:
   {
     Block block;
     const auto keys =
-      entries(node, "block", { "vertices", "cells", "laws" }, block.name, block.where);
+      entries(node, "block", { "vertices", "cells", "min_cells", "laws" }, block.name, block.where);
     const std::string entityText = entity("block", block.name);
     const MapEntry& vertices = required(keys, "vertices", node, entityText);
     if (!vertices.value.IsSequence() || vertices.value.size() != 8)
@@ -635,6 +635,21 @@ private:
       if (block.cells[d] < 1)
       {
         fail(cells.line, entityText, "cells must be at least 1");
+      }
+    }
+    if (const MapEntry* least = syntax::findEntry(keys, "min_cells"))
+    {
+      if (!least->value.IsSequence() || least->value.size() != 3)
+      {
+        fail(least->line, entityText, "'min_cells' needs three counts");
+      }
+      for (int d = 0; d < 3; ++d)
+      {
+        block.minCells[d] = integer(least->value[d], least->line, entityText, "min_cells");
+        if (block.minCells[d] < 1)
+        {
+          fail(least->line, entityText, "min_cells must be at least 1");
+        }
       }
     }
     const MapEntry& laws = required(keys, "laws", node, entityText);

@@ -357,6 +357,15 @@ std::string writeModelDocument(const BlockModel& model)
       out << cells;
     }
     out << YAML::EndSeq;
+    if (block.minCells != std::array<int, 3>{ 1, 1, 1 })
+    {
+      out << YAML::Key << "min_cells" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      for (int cells : block.minCells)
+      {
+        out << cells;
+      }
+      out << YAML::EndSeq;
+    }
     out << YAML::Key << "laws" << YAML::Value << YAML::Flow << YAML::BeginSeq;
     for (const DistributionLaw& law : block.laws)
     {

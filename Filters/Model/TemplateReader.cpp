@@ -343,7 +343,7 @@ void TemplateReader::readBlocks()
     }
     const auto keys =
       syntax::mapEntries(entry.value, entry.line, entityText, "the block", Report);
-    syntax::checkKeys(keys, { "vertices", "cells", "grading" }, entityText, Report);
+    syntax::checkKeys(keys, { "vertices", "cells", "min_cells", "grading" }, entityText, Report);
     Block block;
     block.name = entry.key;
     block.where = where(entry.line);
@@ -391,6 +391,32 @@ void TemplateReader::readBlocks()
             syntax::formatNumber(value));
       }
       block.cells[d] = static_cast<int>(whole);
+    }
+    // the fewest cells a density multiplier below 1 leaves (optional; a count above
+    // `cells` means `cells`, so a parameter lowering `cells` needs no matching edit)
+    if (const MapEntry* least = syntax::findEntry(keys, "min_cells"))
+    {
+      if (!least->value.IsSequence() || least->value.size() != 3)
+      {
+        fail(lineOrFallback(least->value, least->line), entityText,
+          "'min_cells' expects three counts [ni, nj, nk]");
+      }
+      for (int d = 0; d < 3; ++d)
+      {
+        const YAML::Node node = least->value[d];
+        const double value =
+          number(node, least->line, entityText, std::string("min_cells ") + directionNames[d]);
+        const double whole = std::round(value);
+        if (std::abs(value - whole) > 1e-9 * std::max(1.0, std::abs(value)) || whole < 1 ||
+          whole > MaxCellsPerDirection)
+        {
+          fail(lineOrFallback(node, least->line), entityText,
+            std::string("min_cells must be whole numbers from 1 to 1000000, but ") +
+              directionNames[d] + " = '" + node.Scalar() + "' = " +
+              syntax::formatNumber(value));
+        }
+        block.minCells[d] = static_cast<int>(whole);
+      }
     }
 
     if (const MapEntry* grading = syntax::findEntry(keys, "grading"))

@@ -117,7 +117,8 @@ struct Topology
 std::vector<std::array<int, 3>> baseNodeCounts(const BlockModel& model);
 
 /// Node counts of a block at a density multiplier, as the mesher makes them:
-/// max(1, round(cells * m)) cells per direction, at most `cap` when cap > 0, plus one.
+/// max(min(cells, min_cells), round(cells * m)) cells per direction (min_cells 1 by
+/// default: max(1, round(cells * m))), at most `cap` when cap > 0, plus one.
 /// The multiplier must be valid (checkDensityMultiplier), so every count fits an int.
 std::array<int, 3> scaledNodeCounts(const Block& block, double multiplier, int cap = 0);
 

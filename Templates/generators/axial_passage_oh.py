@@ -111,7 +111,12 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   blocks' and sides' cells and grow towards the inlet, outlet and periodic lines; the
 #   periodic lines beside the sides `ends` (period_end, period_flat), so that their nodes
 #   lie at nearly the fractions of the sides' matched outer arcs (the H blocks between
-#   them are not sheared along the blade).
+#   them are not sheared along the blade);
+# - coarsened (density multiplier below 1) the blocks keep at least min_pitch cells across
+#   the H columns, min_side along the blade sides, min_up / min_down from the O-grid to
+#   the inlet / outlet (min_cells): with fewer, the match laws cannot grow from the O-grid's
+#   small cells by o_match to the periodic lines, inlet and outlet (the cells jump at the
+#   interfaces, or the last cells are long and fail checkMesh's face tets).
 blockforge: 2
 name: axial_passage_oh
 description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.
@@ -142,6 +147,10 @@ parameters:
   n_up: 8                 # cells from inlet to the O-grid
   n_down: 8               # cells from the O-grid to the outlet
   n_pitch: 6              # cells across each H column beside the O-grid
+  min_pitch: 5            # coarsened (density multiplier below 1; min_cells) the H columns beside the O-grid keep at least this many cells across: from the O corner's small matched cell the match laws need a few cells to grow to the periodic line (3 cells at density 0.5: the distributor's U_M against U_R 2.54, the compressor's U_L against U_M 3.73)
+  min_side: 12            # ... the blade sides at least this many cells along (9 at density 0.5: Rotor 37's long wall cells on its curved, twisted suction side fail checkMesh's face tets)
+  min_up: 8               # ... the upstream and downstream blocks at least these many from the O-grid to the inlet and outlet: the match laws grow from the O-grid's outer cell by at most o_match only with that many (4 at density 0.5: by 2.75 on Rotor 37, whose wake block's long last cells fail face tets at the outlet)
+  min_down: 8
   n_le: 10                # cells around the leading edge
   n_te: 10                # cells around the trailing edge
   n_side: 18              # cells along each blade side (16 left the turbine's grid at density 0.5 0.59 % off its volume: its sides' middle cells, between the O corners' small ones, chord its cambered O-grid sides)
@@ -157,17 +166,17 @@ parameters:
 
 FOOTER = """blocks:
   O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_le_h}, E5: {project_from: ol_le_s}}}}
-  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_a_h}, E5: {project_from: ol_a_s}}}}
+  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, 1], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_a_h}, E5: {project_from: ol_a_s}}}}
   O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
-  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
-  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
-  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
-  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
-  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end, period_end], flat: period_flat}, E8: {ends: [period_end, period_end], flat: period_flat}}}}
-  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end, period_end], flat: period_flat}, E6: {ends: [period_end, period_end], flat: period_flat}}}}
-  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
-  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
-  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, 1], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
+  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end, period_end], flat: period_flat}, E8: {ends: [period_end, period_end], flat: period_flat}}}}
+  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end, period_end], flat: period_flat}, E6: {ends: [period_end, period_end], flat: period_flat}}}}
+  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
 
 faces:
   hub_faces: {on_surface: hub, faces: [O_le.k0, O_a.k0, O_te.k0, O_b.k0, U_L.k0, U_M.k0, U_R.k0, M_L.k0, M_R.k0, D_L.k0, D_M.k0, D_R.k0]}

@@ -348,6 +348,50 @@ TEST(Mesher, DensityMultiplierAndCap)
   EXPECT_NO_THROW(meshBlocks(annulus, 0.2));
 }
 
+TEST(Mesher, DensityMultiplierKeepsMinCells)
+{
+  // min_cells: the fewest cells a multiplier below 1 leaves, never more than cells. The
+  // left box keeps 5 of its 6 cells along i (not shared with the right box); along j, which
+  // the boxes share, both keep their 4 (the left box's 9 counts as its 4 cells); k and the
+  // right box's i have no floor.
+  const std::string text = R"yaml(blockforge: 1
+name: floors
+vertices:
+  a0: [0, 0, 0]
+  a1: [1, 0, 0]
+  a2: [1, 1, 0]
+  a3: [0, 1, 0]
+  a4: [0, 0, 1]
+  a5: [1, 0, 1]
+  a6: [1, 1, 1]
+  a7: [0, 1, 1]
+  b1: [2, 0, 0]
+  b2: [2, 1, 0]
+  b5: [2, 0, 1]
+  b6: [2, 1, 1]
+blocks:
+  left: {vertices: [a0, a1, a2, a3, a4, a5, a6, a7], cells: [6, 4, 6], min_cells: [5, 9, 1]}
+  right: {vertices: [a1, b1, b2, a2, a5, b5, b6, a6], cells: [6, 4, 6], min_cells: [1, 4, 1]}
+)yaml";
+  const BlockModel model = parseTemplate(text, "floors.yaml");
+  const std::vector<std::pair<double, std::array<std::array<int, 3>, 2>>> expected = {
+    { 1.0, { { { 7, 5, 7 }, { 7, 5, 7 } } } },    // the template's counts
+    { 2.0, { { { 13, 9, 13 }, { 13, 9, 13 } } } }, // refined: floors play no part
+    { 0.5, { { { 6, 5, 4 }, { 4, 5, 4 } } } },     // i: 3 -> 5 on the left; j: 2 -> 4
+    { 0.1, { { { 6, 5, 2 }, { 2, 5, 2 } } } },     // never fewer than one cell
+  };
+  for (const auto& [density, nodes] : expected)
+  {
+    SCOPED_TRACE(density);
+    MultiBlockMesher mesher(model, density);
+    EXPECT_EQ(mesher.nodeCounts(0), nodes[0]);
+    EXPECT_EQ(mesher.nodeCounts(1), nodes[1]);
+    const auto grids = meshBlocks(model, density);
+    ASSERT_EQ(grids.size(), 2u);
+    EXPECT_EQ(grids[0].ni, nodes[0][0]);
+  }
+}
+
 TEST(Mesher, Deterministic)
 {
   for (const std::string& name : ExampleTemplates)

@@ -122,6 +122,7 @@ void expectIdenticalModels(const BlockModel& a, const BlockModel& b)
     EXPECT_EQ(x.name, y.name);
     EXPECT_EQ(x.vertices, y.vertices);
     EXPECT_EQ(x.cells, y.cells);
+    EXPECT_EQ(x.minCells, y.minCells);
     for (int e = 0; e < 12; ++e)
     {
       EXPECT_EQ(x.laws[e].kind, y.laws[e].kind);
@@ -396,6 +397,22 @@ TEST(TemplateErrors, NonWholeCells)
     "cells: [n, 0, n]", "block 'left'", { "whole numbers from 1" });
 }
 
+TEST(TemplateErrors, BadMinCells)
+{
+  const std::string left = "    cells: [n, n, n]\n  right:";
+  expectTwoBoxesError(replaced(TwoBoxes, left, "    cells: [n, n, n]\n    min_cells: [3, 0, 1]\n  right:"),
+    "min_cells: [3, 0, 1]", "block 'left'", { "min_cells must be whole numbers from 1", "j = '0'" });
+  expectTwoBoxesError(replaced(TwoBoxes, left, "    cells: [n, n, n]\n    min_cells: [3, 2]\n  right:"),
+    "min_cells: [3, 2]", "block 'left'", { "'min_cells' expects three counts" });
+  // j and k run along the face the boxes share: the same floor on both sides, or an error
+  // naming the edge and both blocks (a floor above cells counts as cells: 4 here)
+  expectTwoBoxesError(replaced(TwoBoxes, left, "    cells: [n, n, n]\n    min_cells: [1, 3, 1]\n  right:"),
+    "  right:", "block 'right'", { "edge a1-a2", "min_cells 1 along j here but 3 in block 'left'" });
+  EXPECT_NO_THROW(parseTemplate(replaced(replaced(TwoBoxes, left,
+    "    cells: [n, n, n]\n    min_cells: [1, 9, 1]\n  right:"), "    cells: [n, n, n]\npatches",
+    "    cells: [n, n, n]\n    min_cells: [1, 4, 1]\npatches"), TwoBoxesFile));
+}
+
 TEST(TemplateErrors, MismatchedNodeCountsOnSharedEdge)
 {
   const std::string text =
@@ -583,6 +600,24 @@ TEST(ModelDocument, RoundTripIsBitIdentical)
       EXPECT_TRUE(sameBits(original.xyz[b], fromDocument.xyz[b])) << "block " << b;
     }
   }
+}
+
+TEST(ModelDocument, KeepsMinCells)
+{
+  // min_cells is written only where a block has one (older documents read as before)
+  const std::string plain = writeModelDocument(parseTemplate(TwoBoxes, TwoBoxesFile));
+  EXPECT_EQ(plain.find("min_cells"), std::string::npos);
+  const BlockModel model = parseTemplate(replaced(TwoBoxes, "    cells: [n, n, n]\n  right:",
+    "    cells: [n, n, n]\n    min_cells: [3, 1, 1]\n  right:"), TwoBoxesFile);
+  EXPECT_EQ(model.blocks[0].minCells, (std::array<int, 3>{ 3, 1, 1 }));
+  const std::string document = writeModelDocument(model);
+  EXPECT_NE(document.find("min_cells: [3, 1, 1]"), std::string::npos);
+  const BlockModel reread = readModelDocument(document);
+  expectIdenticalModels(model, reread);
+  EXPECT_EQ(writeModelDocument(reread), document);
+  expectError([&] { readModelDocument(replaced(document, "min_cells: [3, 1, 1]",
+                      "min_cells: [3, 0, 1]")); },
+    { "block 'left'", "min_cells must be at least 1" });
 }
 
 TEST(ModelDocument, ErrorsAfterReloadNameTheTemplateLine)
