@@ -86,8 +86,8 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   trailing edge and Rotor 37's edges are sheared; the compressor (sharp) and the turbine
 #   (stagger below 45 deg) are not (o_shear 0: no edge is). With shear_camber 1 the stagger
 #   is the larger of that and the camber's at the edge itself (the turbine's trailing edge,
-#   exit about 60 deg, is then sheared; not the default: its wake block folds at density 0.5
-#   with the outlet where its contours end).
+#   exit about 60 deg, is then sheared; not the default: at density 0.5 the blade cells of
+#   O_a against O_te's 3.89 times, and without min_down its wake block folded there).
 # - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
@@ -131,7 +131,7 @@ parameters:
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
   o_shear: 45deg          # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg: the optimized distributor and Rotor 37 reach 47.9 and 47.0 deg at density 1)
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
-  shear_camber: 0         # 1: the stagger that decides the shear (o_shear) at an edge is the larger of the blade's near the edge (edge to mid-camber) and the camber's at the edge itself (the turbine's trailing edge is then sheared: optimized 26.4 -> 38.0 deg at density 1, but its wake block folds at density 0.5 unless the outlet is further, extend 1); 0: the blade's near the edge
+  shear_camber: 0         # 1: the stagger that decides the shear (o_shear) at an edge is the larger of the blade's near the edge (edge to mid-camber) and the camber's at the edge itself (the turbine's trailing edge is then sheared: optimized 26.4 -> 38.0 deg at density 1, but at density 0.5 O_a's blade cells 3.89 times O_te's; its wake block folded there before min_down); 0: the blade's near the edge
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   bisect_step: 0.005      # at a sheared edge the H lines bisect the blade direction and the O curve's at the unsheared corner, measured over this step along it (fraction of the loop)
   o_back: 0.012           # at a trailing edge neither sharp nor sheared (round or capped) the corners' feet stay at least this far from the edge (fraction of the loop; the turbine's cap spans 0.007), the H lines downstream then leave along the bisector as at a sheared edge
