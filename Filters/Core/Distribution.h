@@ -110,7 +110,10 @@ constexpr double DefaultMatchRatio = 1.2;
  * given end by `ratio` (> 1) and are uniform where that would make them larger than the
  * edge needs. When the cells growing by `ratio` cannot fill the edge, the ratio is raised
  * until they do; when the given end cells are too large for the edge, the cells are as
- * near them as filling the edge allows (uniform in the limit). With `flatness` >= 1
+ * near them as filling the edge allows (uniform in the limit). Both end cells above the
+ * mean cell (and not kept by cells grown to a uniform middle): the Ends law's shape
+ * between them, with the end cells lowered towards the mean where that shape would change
+ * by more than ratio^2 from one cell to the next (few cells between large ends). With `flatness` >= 1
  * (DistributionLaw::matchFlatness) the nodes are instead the Ends law's with the given end
  * cells over the mean cell (a free end: the mean cell) and that bump flatness.
  */

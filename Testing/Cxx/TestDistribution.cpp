@@ -546,10 +546,43 @@ TEST(Distribution, MatchNodesDoNotJumpWhenAnEndCellPassesTheMeanCell)
   }
   EXPECT_NEAR(cell(above, 0) * length, mean * (1.0 + 1e-9), 1e-12);
   EXPECT_NEAR(cell(above, 5) * length, 0.1, 1e-12);
-  // Ends too large to be kept that way still shrink towards the middle (as before).
+  // Ends too large to be kept that way still shrink towards the middle, by at most
+  // 1.2^2 from cell to cell (the ends lowered towards the mean: see the next test).
   const std::vector<double> big = matchedNodes(0.5, 0.45, length, 7, 1.2);
-  EXPECT_NEAR(cell(big, 0) * length, 0.5, 1e-9);
   EXPECT_LT(cell(big, 3), cell(big, 0));
+  EXPECT_GT(cell(big, 0) * length, mean);
+  EXPECT_LT(cell(big, 0) * length, 0.5);
+}
+
+TEST(Distribution, MatchBetweenTwoLargeEndCellsShrinksByAtMostTheRatioSquared)
+{
+  // Five cells between end cells 2.2 times the mean (a wake block's outlet edge at density
+  // 0.5): the ends law's shape gives 2.2, 0.22, 0.1, 0.22, 2.2 times the mean, the middle
+  // cells 10 times thinner than their neighbours. The end cells are lowered (both by the
+  // same power towards the mean) until no cell is more than ratio^2 = 4 times its neighbour.
+  const double length = 1.0, mean = 0.2;
+  const std::vector<double> s = matchedNodes(2.2 * mean, 2.2 * mean, length, 6, 2.0);
+  expectValidNodes(s, 6);
+  double largest = 1.0;
+  for (int i = 1; i < 5; ++i)
+  {
+    largest = std::max(largest, std::max(cell(s, i) / cell(s, i - 1), cell(s, i - 1) / cell(s, i)));
+  }
+  EXPECT_LE(largest, 4.0 * (1.0 + 1e-12));
+  EXPECT_GT(largest, 4.0 * (1.0 - 1e-9)); // the largest ends that keep the limit
+  EXPECT_NEAR(cell(s, 0), cell(s, 4), 1e-12);
+  EXPECT_GT(cell(s, 0) * length, 1.5 * mean);
+  EXPECT_LT(cell(s, 0) * length, 2.2 * mean);
+  // Within the limit the nodes are the ends law's with the matched end cells, bit for bit.
+  const std::vector<double> kept = matchedNodes(1.5 * mean, 1.4 * mean, length, 6, 2.0);
+  DistributionLaw ends;
+  ends.kind = DistributionLaw::Kind::Ends;
+  ends.firstCellSize = 1.5 * mean / (length / 5); // as matchedNodes divides
+  ends.lastCellSize = 1.4 * mean / (length / 5);
+  EXPECT_EQ(kept, distributeNodes(ends, 6));
+  // One end above the mean and one below: as before (no limit).
+  const std::vector<double> mixed = matchedNodes(2.2 * mean, 0.5 * mean, length, 6, 2.0);
+  EXPECT_NEAR(cell(mixed, 0) * length, 2.2 * mean, 1e-9);
 }
 
 TEST(Distribution, MatchWithAnEndCellNearTheWholeEdgeDoesNotFail)
