@@ -50,7 +50,8 @@ void checkModel(const BlockModel& model, const CarrierGeometry& geometry);
 class MultiBlockMesher
 {
 public:
-  /// `densityMultiplier` scales every cell count: cells = max(1, round(cells * m)).
+  /// `densityMultiplier` scales every cell count: cells = max(min(cells, min_cells),
+  /// round(cells * m)) (min_cells 1 unless the block gives one).
   /// Calls checkModel(); throws TemplateError on any problem, also when the multiplier is
   /// not in (0, MaxDensityMultiplier] or a scaled count exceeds MaxScaledCellsPerDirection
   /// (checkDensityMultiplier; errors, not clamps: the user asked for something else than
