@@ -455,9 +455,10 @@ void computeEdgeGrading(const BlockModel& model, const std::vector<NamedCurve>& 
   bool allowFallback)
 {
   const auto isChanged = [&](int u) { return !changed || (*changed)[u]; };
-  // Feet joined at blade corners (joinFeet): the edges of a chain of joins are projected
-  // again together when anything a join reads changed, so that a join always starts from
-  // fresh projections (the same nodes as a full run).
+  // Feet joined at blade corners (joinFeet), from the projections as they came (kept in
+  // projectedParams): where anything a join reads changed, every edge of its chain of joins
+  // restarts from its projection and the chain's joins are made again, so that the nodes
+  // are a full run's; an edge whose nodes come out different is marked changed.
   const std::vector<FootJoin> joins =
     topology.projectionOrder.empty() ? std::vector<FootJoin>() : footJoins(model, topology);
   std::vector<int> chain(topology.edges.size());
@@ -473,30 +474,12 @@ void computeEdgeGrading(const BlockModel& model, const std::vector<NamedCurve>& 
   {
     chain[chainOf(join.edge[0])] = chainOf(join.edge[1]);
   }
-  std::vector<char> chainChanged(topology.edges.size(), 0);
-  const auto markChains = [&](bool afterMatch) {
-    for (const FootJoin& join : joins)
-    {
-      const UniqueEdge& first = topology.edges[join.edge[0]];
-      const UniqueEdge& second = topology.edges[join.edge[1]];
-      if (first.projectedAfterMatch != afterMatch || second.projectedAfterMatch != afterMatch)
-      {
-        continue;
-      }
-      if (isChanged(join.edge[0]) || isChanged(first.projectedFrom) || isChanged(join.edge[1]) ||
-        isChanged(second.projectedFrom) || isChanged(join.radial))
-      {
-        chainChanged[chainOf(join.edge[0])] = 1;
-      }
-    }
-  };
   const auto project = [&](bool afterMatch) {
-    markChains(afterMatch);
     for (const int u : topology.projectionOrder)
     {
       UniqueEdge& edge = topology.edges[u];
       if (edge.projectedAfterMatch != afterMatch ||
-        !(isChanged(u) || isChanged(edge.projectedFrom) || chainChanged[chainOf(u)]))
+        !(isChanged(u) || isChanged(edge.projectedFrom)))
       {
         continue;
       }
@@ -505,18 +488,59 @@ void computeEdgeGrading(const BlockModel& model, const std::vector<NamedCurve>& 
         (*changed)[u] = 1;
       }
       projectEdgeParameters(model, curves, geometry, topology, u);
+      edge.projectedParams = edge.params;
     }
+    // the joins of this pass: both edges projected in it, and before the matched edges only
+    // where the radial edge's nodes are there already
+    std::vector<char> redo(topology.edges.size(), 0);
+    std::vector<const FootJoin*> pass;
     for (const FootJoin& join : joins)
     {
       const UniqueEdge& first = topology.edges[join.edge[0]];
       const UniqueEdge& second = topology.edges[join.edge[1]];
       const UniqueEdge& radial = topology.edges[join.radial];
-      // before the matched edges, only where the radial edge's nodes are there already
-      if (first.projectedAfterMatch == afterMatch && second.projectedAfterMatch == afterMatch &&
-        chainChanged[chainOf(join.edge[0])] &&
-        (afterMatch || (!radial.matched && radial.projectedFrom < 0)))
+      if (first.projectedAfterMatch != afterMatch || second.projectedAfterMatch != afterMatch ||
+        !(afterMatch || (!radial.matched && radial.projectedFrom < 0)))
       {
-        joinFeet(model, topology, join);
+        continue;
+      }
+      pass.push_back(&join);
+      if (isChanged(join.edge[0]) || isChanged(join.edge[1]) || isChanged(first.projectedFrom) ||
+        isChanged(second.projectedFrom) || isChanged(join.radial))
+      {
+        redo[chainOf(join.edge[0])] = 1;
+      }
+    }
+    std::vector<std::vector<double>> before(topology.edges.size());
+    for (const FootJoin* join : pass)
+    {
+      for (const int u : join->edge)
+      {
+        if (redo[chainOf(u)] && before[u].empty())
+        {
+          UniqueEdge& edge = topology.edges[u];
+          before[u] = edge.params;
+          if (edge.projectedParams.size() != static_cast<std::size_t>(edge.nodeCount))
+          {
+            projectEdgeParameters(model, curves, geometry, topology, u); // none kept yet
+            edge.projectedParams = edge.params;
+          }
+          edge.params = edge.projectedParams;
+        }
+      }
+    }
+    for (const FootJoin* join : pass)
+    {
+      if (redo[chainOf(join->edge[0])])
+      {
+        joinFeet(model, topology, *join);
+      }
+    }
+    for (int u = 0; changed && u < static_cast<int>(topology.edges.size()); ++u)
+    {
+      if (!before[u].empty() && before[u] != topology.edges[u].params)
+      {
+        (*changed)[u] = 1;
       }
     }
   };
