@@ -18,9 +18,14 @@
  *   parameter grid.
  * The face takes the projected TFI; where one of its cell corners is nearly flat or
  * folded (scaled Jacobian below a small bound, measured with the surface's first
- * fundamental form) the nodes are moved towards the parameter grid, halving their step
- * until every cell corner is at least as good as the bound or the parameter grid's.
- * Faces where the projected TFI is fine keep it bit for bit.
+ * fundamental form), or one of its cell sides is more than 2 times longer or shorter than
+ * the parameter grid's (the 3-D TFI node off the surface by more than a cell near a thin
+ * edge, projected to a point that slid along the edge's round without folding anything:
+ * Rotor 37's trailing-edge cells 6 times shorter at mid-span than at hub and shroud), the
+ * nodes are moved towards the parameter grid, halving their step until every cell corner
+ * is at least as good as the bound or the parameter grid's and, on a face that slid so,
+ * every side within 1.5 of the parameter grid's. Faces where the projected TFI is fine keep
+ * it bit for bit.
  */
 #pragma once
 

@@ -124,6 +124,8 @@ struct UniqueEdge : TopologyEdge
   double matchLean = 0.0;
   std::array<double, 2> matchFloor{ { 0.0, 0.0 } };
   std::vector<double> params;
+  /// A projected edge's params as projected, before its feet joined (ProjectedEdges.cpp).
+  std::vector<double> projectedParams;
   std::vector<double> xyz;
 };
 

@@ -15,6 +15,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <numeric>
 
 namespace blockforge
 {
@@ -80,6 +82,154 @@ int projectedSource(const BlockModel& model, const UniqueEdge& edge)
     }
   }
   return source;
+}
+
+/// Two projected edges that continue one another through a vertex V (a blade corner)
+/// whose sources continue one another through the corresponding vertex S (an O corner),
+/// with the edge V-S between them (the radial edge at the corner).
+struct FootJoin
+{
+  int edge[2];   ///< unique edges
+  int end[2];    ///< 0: at the edge's vertex a, 1: at b
+  int radial;    ///< unique edge V-S
+  int vertex;    ///< V
+};
+
+/// The feet's widths at a blade corner are held within this ratio (below).
+constexpr double FootWidthRatio = 1.2;
+/// ... and the cut foot's wall cell stays within this of the next one (or their ratio).
+constexpr double InBlockRatio = 2.0;
+
+int sourceEndVertex(const BlockModel& model, const MeshTopology& topology, int u, int end)
+{
+  const UniqueEdge& edge = topology.edges[u];
+  const UniqueEdge& source = topology.edges[edge.projectedFrom];
+  const bool crossed = runsAgainst(model, edge, source);
+  return (end == 0) != crossed ? source.a : source.b;
+}
+
+std::vector<FootJoin> footJoins(const BlockModel& model, const MeshTopology& topology)
+{
+  std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> ends; // (V, S) -> (edge, end)
+  std::map<std::pair<int, int>, int> byVertices;
+  for (int u = 0; u < static_cast<int>(topology.edges.size()); ++u)
+  {
+    const UniqueEdge& edge = topology.edges[u];
+    byVertices[{ std::min(edge.a, edge.b), std::max(edge.a, edge.b) }] = u;
+    if (edge.projectedFrom < 0 || edge.a == edge.b)
+    {
+      continue;
+    }
+    for (int end = 0; end < 2; ++end)
+    {
+      ends[{ end == 0 ? edge.a : edge.b, sourceEndVertex(model, topology, u, end) }].push_back({ u, end });
+    }
+  }
+  std::vector<FootJoin> joins;
+  for (const auto& [key, members] : ends)
+  {
+    const auto radial = byVertices.find({ std::min(key.first, key.second), std::max(key.first, key.second) });
+    if (members.size() != 2 || members[0].first == members[1].first || key.first == key.second ||
+      radial == byVertices.end())
+    {
+      continue;
+    }
+    joins.push_back(FootJoin{ { members[0].first, members[1].first },
+      { members[0].second, members[1].second }, radial->second, key.first });
+  }
+  return joins;
+}
+
+double cellAtEnd(const UniqueEdge& edge, int end)
+{
+  const std::vector<double>& p = edge.params;
+  const std::size_t n = p.size();
+  return edge.length * (end == 0 ? p[1] - p[0] : p[n - 1] - p[n - 2]);
+}
+
+/**
+ * The feet at a blade corner (FootJoin): the wall cells on both sides of the radial edge
+ * there are measured as the neighbour size ratio measures them, the mean of the foot (the
+ * projected edge's end cell e) and the first layer's line, estimated as e + (o - e) h / W
+ * (o the source's end cell, h and W the radial edge's first cell and length). Where the
+ * larger of the two is more than FootWidthRatio times the other, its foot is cut down to
+ * that ratio (not below the other foot), the cells after it taking the length it gives up
+ * in equal parts (up to four cells, never the other end's). Why: a foot is where the normal
+ * of its outer node meets the blade, and at a corner whose radial edge starts on a fan (a
+ * sharp tip, a thin edge) the fan's feet sit on the tip while the side's first outer node,
+ * past the fan, has its foot on the flank: the compressor's side cells at the wall were
+ * 3.4 times the fan's at density 0.5; round a cap's corner the smoothed O curve's normals
+ * spread the feet on one side (turbine 1.6). Only the larger foot moves: the fan's feet
+ * cannot spread (they share the tip), and the moved foot's radial line leans by its shift
+ * over the O-grid's width.
+ */
+void joinFeet(const BlockModel& model, MeshTopology& topology, const FootJoin& join)
+{
+  UniqueEdge* edges[2] = { &topology.edges[join.edge[0]], &topology.edges[join.edge[1]] };
+  const UniqueEdge& radial = topology.edges[join.radial];
+  if (radial.params.size() < 2 || !(radial.length > 0.0))
+  {
+    return;
+  }
+  const double layer = cellAtEnd(radial, radial.a == join.vertex ? 0 : 1) / radial.length / 2;
+  double foot[2], outer[2], width[2];
+  for (int k = 0; k < 2; ++k)
+  {
+    foot[k] = cellAtEnd(*edges[k], join.end[k]);
+    const UniqueEdge& source = topology.edges[edges[k]->projectedFrom];
+    const bool crossed = runsAgainst(model, *edges[k], source);
+    outer[k] = cellAtEnd(source, crossed ? 1 - join.end[k] : join.end[k]);
+    width[k] = foot[k] + (outer[k] - foot[k]) * layer;
+  }
+  const int large = width[0] > width[1] ? 0 : 1, small = 1 - large;
+  if (!(width[large] > FootWidthRatio * width[small]))
+  {
+    return;
+  }
+  UniqueEdge& edge = *edges[large];
+  const int cells = static_cast<int>(edge.params.size()) - 1;
+  if (cells < 3 || !(edge.length > 0.0))
+  {
+    return;
+  }
+  const int spread = std::min(3, (cells - 2) / 2); // the cells after the foot that share
+  // The cut foot's wall cell against the next one inside its edge (which grows by its
+  // share): at most the ratio they had, or InBlockRatio if that is more. Why: next to a
+  // fan on a sharp tip the side's second foot is on the flank, tens of times the first
+  // (the compressor's wall cells there 24 times at density 1); cut further, the faces
+  // between them fall under checkMesh's interpolation weight (26 -> 48 faces optimized).
+  const UniqueEdge& source = topology.edges[edge.projectedFrom];
+  const bool crossed = runsAgainst(model, edge, source);
+  const int second = join.end[large] == 0 ? 1 : cells - 2; // the next cell's first node
+  const std::vector<double>& q = source.params;
+  const double nextFoot = edge.length * (edge.params[second + 1] - edge.params[second]);
+  const int sourceSecond = (join.end[large] == 0) != crossed ? 1 : cells - 2;
+  const double nextOuter = source.length * (q[sourceSecond + 1] - q[sourceSecond]);
+  const double nextWidth = nextFoot + (nextOuter - nextFoot) * layer;
+  const double allowed = std::max(InBlockRatio, nextWidth / width[large]);
+  const double share = (1.0 - layer) / (spread + 1);
+  const double floor = (nextWidth + foot[large] * share - allowed * outer[large] * layer) /
+    ((1.0 - layer) * allowed + share);
+  const double wanted = std::max(std::max(foot[small], floor),
+    (FootWidthRatio * width[small] - outer[large] * layer) / (1.0 - layer));
+  if (!(wanted < foot[large]))
+  {
+    return;
+  }
+  const double given = (foot[large] - wanted) / edge.length;
+  std::vector<double>& p = edge.params;
+  for (int k = 1; k <= spread + 1; ++k)
+  {
+    const double shift = given * (spread + 2 - k) / (spread + 1);
+    if (join.end[large] == 0)
+    {
+      p[k] -= shift;
+    }
+    else
+    {
+      p[cells - k] += shift;
+    }
+  }
 }
 } // namespace
 
@@ -305,6 +455,25 @@ void computeEdgeGrading(const BlockModel& model, const std::vector<NamedCurve>& 
   bool allowFallback)
 {
   const auto isChanged = [&](int u) { return !changed || (*changed)[u]; };
+  // Feet joined at blade corners (joinFeet), from the projections as they came (kept in
+  // projectedParams): where anything a join reads changed, every edge of its chain of joins
+  // restarts from its projection and the chain's joins are made again, so that the nodes
+  // are a full run's; an edge whose nodes come out different is marked changed.
+  const std::vector<FootJoin> joins =
+    topology.projectionOrder.empty() ? std::vector<FootJoin>() : footJoins(model, topology);
+  std::vector<int> chain(topology.edges.size());
+  std::iota(chain.begin(), chain.end(), 0);
+  const auto chainOf = [&](int u) {
+    while (chain[u] != u)
+    {
+      u = chain[u] = chain[chain[u]];
+    }
+    return u;
+  };
+  for (const FootJoin& join : joins)
+  {
+    chain[chainOf(join.edge[0])] = chainOf(join.edge[1]);
+  }
   const auto project = [&](bool afterMatch) {
     for (const int u : topology.projectionOrder)
     {
@@ -319,6 +488,60 @@ void computeEdgeGrading(const BlockModel& model, const std::vector<NamedCurve>& 
         (*changed)[u] = 1;
       }
       projectEdgeParameters(model, curves, geometry, topology, u);
+      edge.projectedParams = edge.params;
+    }
+    // the joins of this pass: both edges projected in it, and before the matched edges only
+    // where the radial edge's nodes are there already
+    std::vector<char> redo(topology.edges.size(), 0);
+    std::vector<const FootJoin*> pass;
+    for (const FootJoin& join : joins)
+    {
+      const UniqueEdge& first = topology.edges[join.edge[0]];
+      const UniqueEdge& second = topology.edges[join.edge[1]];
+      const UniqueEdge& radial = topology.edges[join.radial];
+      if (first.projectedAfterMatch != afterMatch || second.projectedAfterMatch != afterMatch ||
+        !(afterMatch || (!radial.matched && radial.projectedFrom < 0)))
+      {
+        continue;
+      }
+      pass.push_back(&join);
+      if (isChanged(join.edge[0]) || isChanged(join.edge[1]) || isChanged(first.projectedFrom) ||
+        isChanged(second.projectedFrom) || isChanged(join.radial))
+      {
+        redo[chainOf(join.edge[0])] = 1;
+      }
+    }
+    std::vector<std::vector<double>> before(topology.edges.size());
+    for (const FootJoin* join : pass)
+    {
+      for (const int u : join->edge)
+      {
+        if (redo[chainOf(u)] && before[u].empty())
+        {
+          UniqueEdge& edge = topology.edges[u];
+          before[u] = edge.params;
+          if (edge.projectedParams.size() != static_cast<std::size_t>(edge.nodeCount))
+          {
+            projectEdgeParameters(model, curves, geometry, topology, u); // none kept yet
+            edge.projectedParams = edge.params;
+          }
+          edge.params = edge.projectedParams;
+        }
+      }
+    }
+    for (const FootJoin* join : pass)
+    {
+      if (redo[chainOf(join->edge[0])])
+      {
+        joinFeet(model, topology, *join);
+      }
+    }
+    for (int u = 0; changed && u < static_cast<int>(topology.edges.size()); ++u)
+    {
+      if (!before[u].empty() && before[u] != topology.edges[u].params)
+      {
+        (*changed)[u] = 1;
+      }
     }
   };
   const int count = static_cast<int>(topology.edges.size());

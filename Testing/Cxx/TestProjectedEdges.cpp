@@ -523,3 +523,127 @@ TEST(ProjectedEdges, CollapsedEdgeIsOnePointAndItsFaceALine)
   // (i runs clockwise seen from +z, from p3's side to p2's: the tetrahedra come out negative)
   EXPECT_NEAR(-volume, 6 * 0.5 * 1.5 * 1.5 * std::sin(Pi / 12), 1e-12);
 }
+
+namespace
+{
+/**
+ * Two blocks meeting at a blade corner: R round a tip about the origin (its inner edge an
+ * arc of radius `tip` from (-tip, 0) to (0, tip), its outer edge the concentric arc of
+ * radius tip + 0.5), A along the flank y = tip from x = 0 to 2 (its outer line y = tip + 0.5
+ * matched to R's arc's cell at (0, tip + 0.5)); both inner edges projected from the outer
+ * ones, 1 high, j graded geometric 1.3 away from the wall.
+ */
+std::string bladeCorner(double tip)
+{
+  const std::string t = std::to_string(tip), o = std::to_string(tip + 0.5);
+  std::string text = "blockforge: 1\nvertices:\n";
+  for (const char* z : { "0", "1" })
+  {
+    const std::string k = z;
+    text += "  p0" + k + ": [-" + t + ", 0, " + k + "]\n  p1" + k + ": [0, " + t + ", " + k +
+      "]\n  s" + k + ": [0, " + o + ", " + k + "]\n  t" + k + ": [-" + o + ", 0, " + k +
+      "]\n  w0" + k + ": [2, " + t + ", " + k + "]\n  w3" + k + ": [2, " + o + ", " + k + "]\n";
+  }
+  text += "edges:\n";
+  for (const char* z : { "0", "1" })
+  {
+    const std::string k = z;
+    text += "  tip" + k + ": {arc: [p0" + k + ", p1" + k + "], centre: [0, 0, " + k + "]}\n" +
+      "  fan" + k + ": {arc: [t" + k + ", s" + k + "], centre: [0, 0, " + k + "]}\n" +
+      "  side" + k + ": {line: [s" + k + ", w3" + k + "]}\n" +
+      "  flank" + k + ": {line: [p1" + k + ", w0" + k + "]}\n";
+  }
+  text += "blocks:\n"
+          "  R: {vertices: [p00, p10, s0, t0, p01, p11, s1, t1], cells: [6, 5, 1], grading: "
+          "{j: {geometric: 1.3}, edges: {E1: {project_from: fan0}, E5: {project_from: fan1}, "
+          "E3: match, E7: match}}}\n"
+          "  A: {vertices: [p10, w00, w30, s0, p11, w01, w31, s1], cells: [12, 5, 1], grading: "
+          "{j: {geometric: 1.3}, edges: {E1: {project_from: side0}, E5: {project_from: side1}, "
+          "E3: match, E7: match}}}\n";
+  return text;
+}
+} // namespace
+
+TEST(ProjectedEdges, FeetAtABladeCornerKeepTheWallCellsAlike)
+{
+  // R's feet lie on a circle of radius 1, 1.5 times nearer one another than the outer
+  // nodes (radius 1.5), A's on the flank as far apart as theirs: the wall cells across R|A
+  // differ by about 1.45 (their outer cells match). The feet join (joinFeet): A's first
+  // foot is cut so that the wall cells differ by 1.2 (estimated from the radial edge's first
+  // layer), the next four cells taking the length it gives up; A's other feet stay the
+  // normal feet of its outer nodes. At a thin tip (radius 0.001: R a fan, its feet 500
+  // times nearer one another than its outer nodes) A's first foot would be cut to a few
+  // hundredths of its next one: it is cut only to half of it (InBlockRatio).
+  for (const double tip : { 1.0, 0.001 })
+  {
+    const BlockModel model = parseTemplate(bladeCorner(tip), "corner.yaml");
+    for (const double density : { 1.0, 2.0 })
+    {
+      SCOPED_TRACE(std::to_string(tip) + " " + std::to_string(density));
+      const test::Grid grid = test::meshAll(model, density);
+      const int nr = grid.nodes[0][0], na = grid.nodes[1][0], outer = grid.nodes[1][1] - 1;
+      // the wall cells' widths as the neighbour ratio measures them: between the centres
+      // of their faces across i (k = 0 to 1, j = 0 to 1)
+      const auto centre = [&](int b, int i) -> Vec3 {
+        return 0.25 * (node(grid, b, i, 0, 0) + node(grid, b, i, 1, 0) + node(grid, b, i, 0, 1) +
+                        node(grid, b, i, 1, 1));
+      };
+      const double ring = (centre(0, nr - 1) - centre(0, nr - 2)).norm();
+      const double side = (centre(1, 1) - centre(1, 0)).norm();
+      const double next = (centre(1, 2) - centre(1, 1)).norm();
+      std::printf("tip %g, density %g: wall cells R %.4g, A %.4g (ratio %.3f), A's next %.4g (%.3f)\n",
+        tip, density, ring, side, side / ring, next, next / side);
+      if (tip == 1.0)
+      {
+        EXPECT_NEAR(side / ring, 1.2, 0.01);
+      }
+      else
+      {
+        EXPECT_NEAR(next / side, 2.0, 0.05);
+        EXPECT_GT(side / ring, 5.0);
+      }
+      for (int i = 1; i < na; ++i)
+      {
+        const double foot = node(grid, 1, i, 0, 0).x(), above = node(grid, 1, i, outer, 0).x();
+        if (i >= 5)
+        {
+          EXPECT_NEAR(foot, above, 1e-12) << i; // the normal feet
+        }
+        else
+        {
+          EXPECT_LT(foot, above) << i; // the cut foot's length taken up by the next four
+          EXPECT_GT(foot, node(grid, 1, i - 1, 0, 0).x()) << i;
+        }
+      }
+    }
+  }
+}
+
+TEST(ProjectedEdges, JoinedFeetFollowMovesAsAFreshMesherDoes)
+{
+  // The ring's corner beside the flank (bladeCorner(1)): A's first foot is cut. The flank's
+  // far end moves (its outer and inner corners, w00 and w30, along x): the outer line's
+  // matched nodes change, the flank's projection with them, the join is made again from
+  // the new projection, and the grid is a fresh mesher's, bit for bit; moved back, too.
+  const BlockModel model = parseTemplate(bladeCorner(1.0), "corner.yaml");
+  const CarrierGeometry carriers(model);
+  MeshPlan plan(model, carriers);
+  const int inner = plan.model().findVertex("w00"), outer = plan.model().findVertex("w30");
+  for (const double x : { 2.4, 1.7, 2.0 })
+  {
+    SCOPED_TRACE(x);
+    plan.model().vertices[inner].position.x() = x;
+    plan.model().vertices[outer].position.x() = x;
+    const Feasibility feasibility = plan.update({ inner, outer });
+    ASSERT_TRUE(feasibility.feasible()) << feasibility.message;
+    const test::Grid fresh = test::meshAll(plan.model());
+    for (int b = 0; b < 2; ++b)
+    {
+      EXPECT_TRUE(test::sameBits(plan.blockNodes(b), fresh.xyz[b])) << b;
+    }
+    // the join applies: A's first foot short of its outer node
+    EXPECT_LT(node(fresh, 1, 1, 0, 0).x(), 0.9 * node(fresh, 1, 1, fresh.nodes[1][1] - 1, 0).x());
+  }
+  const test::Grid back = test::meshAll(model);
+  EXPECT_TRUE(test::sameBits(plan.blockNodes(1), back.xyz[1]));
+}
