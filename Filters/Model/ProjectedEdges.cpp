@@ -26,9 +26,12 @@ using syntax::shortNumber;
 namespace
 {
 /// A projected edge's end run of cells narrower together than this fraction of the next
-/// cell is widened to it (feet on a tip; projectEdgeParameters). A twentieth: checkMesh's
-/// interpolation weight fails where neighbour cells differ by more than 19.
-constexpr double tipFloor = 0.05;
+/// cell is widened to it (feet on a tip; projectEdgeParameters). A 25th: the narrowest
+/// that leaves no interpolation-weight face on the compressor's sides at densities 0.5 and
+/// 1 (a 30th: 6 faces at 0.5; a 50th: 48 at 1); wider, the sides' cells beside the fans'
+/// prisms grow against them (issue 8's neighbour ratio O_le|O_b at density 1: 2.55, 2.93
+/// with a 20th).
+constexpr double tipFloor = 0.04;
 
 const DistributionLaw& useLaw(const BlockModel& model, const EdgeUse& use)
 {
@@ -259,7 +262,7 @@ void projectEdgeParameters(const BlockModel& model, const std::vector<NamedCurve
   // hundredth of it: a sliver (the compressor's sides: checkMesh's interpolation weight
   // failed between it and the next cell, and it folded at density 2). Such an end run,
   // narrower together than tipFloor of the cell after it, is widened to tipFloor of it
-  // (each of its cells tipFloor of the next): wide enough for the mesher and checkMesh,
+  // (each of its cells tipFloor of the one after): wide enough for the mesher and checkMesh,
   // narrow enough that the edge block's fan beside it (its wall cells shrink to the tip)
   // stays within a few times its size.
   const auto widenTip = [&](auto at, auto set) {
