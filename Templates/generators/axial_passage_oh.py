@@ -375,13 +375,13 @@ def template_text():
                 w(f'  rb{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"kb{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
                 corner = f'(shear_{e} ? {corner} : {distance2(f"rb{b}_{l}")})'
             w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {corner} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
-            # the foot's source: the corner; with o_fan_prisms, at a sharp edge's fan the O
-            # curve's point off the tip (both feet then one point: the fan's blade arc collapses
-            # into the tip, its wall cells prisms), elsewhere where the template put the corner
-            # (the corner's own search). The choice is a search (fixed: it follows nothing; not
-            # the corner, which the optimizer moves), so that by default the
-            # source follows only its corner (an expression of off_{e} or o{e} would follow
-            # {e}, which the optimizer moves: 6-30 % more work on every O template's run)
+            # the foot's source: the corner; with o_fan_prisms (the default), at a sharp edge's
+            # fan (fan_{e}) the O curve's point off the tip (both feet then one point: the fan's
+            # blade arc collapses into the tip, its wall cells prisms). That point is a search
+            # (fixed: it follows nothing; not the corner, which the optimizer moves), and fan_{e}
+            # is decided on fixed helpers, so that elsewhere the source follows only its corner
+            # (an expression of off_{e} or o{e} would follow {e}, which the optimizer moves:
+            # 6-30 % more work on every O template's run)
             w(f'  u{b}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {corner} : {distance2(f"o{e}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
             w(f'  t{b}_{l}: {{on_curve: o_{l}, at: "fan_{e}_{l} ? u{b}_{l}.s : {v}_{l}.s", fixed: true}}')
             w(f'  {b}_{l}: {{project: t{b}_{l}, onto: blade_{l}}}')
