@@ -5,7 +5,10 @@
  *
  * Adds these cell arrays to every vtkStructuredGrid block of the input:
  * - MinAngle, MaxAngle: smallest/largest corner angle of the cell's 6 faces [degrees]
- *   (the paper's criterion; below 20 degrees harms accuracy and convergence);
+ *   (the paper's criterion; below 20 degrees harms accuracy and convergence); a prism
+ *   written as a hexahedron (a collapsed edge: wedge blocks on an axis, fans on a sharp
+ *   blade tip) leaves out its apex at the collapsed edge, whose angle is the share of the
+ *   wedge or the tip's turn the cells round it divide, geometry no node placement fixes;
  * - NonOrthogonality: OpenFOAM's angle between a face normal and the line joining the
  *   two cell centres (OpenFOAM's cell centres: volume centroids), maximum over the cell's
  *   faces, block interfaces and periodic faces included [degrees];

@@ -22,7 +22,8 @@ namespace blockforge
 {
 /// Smallest and largest corner angle of the 6 quadrilateral faces (24 angles), degrees.
 /// Degenerate faces (a collapsed edge: shorter than 1e-14 of the cell's longest edge)
-/// count as triangles; collapsed faces are skipped; a cell with no face left gets 0, 180.
+/// count as triangles without the corner at the collapsed edge (a prism's apex: geometry,
+/// see collapsedCellAngles); collapsed faces are skipped; a cell with no face left gets 0, 180.
 void hexFaceAngles(const std::array<Vec3, 8>& corners, double& minAngle, double& maxAngle);
 
 /**

@@ -27,6 +27,14 @@ using syntax::shortNumber;
 
 namespace
 {
+/// A projected edge's end run of cells narrower together than this fraction of the next
+/// cell is widened to it (feet on a tip; projectEdgeParameters). A 25th: the narrowest
+/// that leaves no interpolation-weight face on the compressor's sides at densities 0.5 and
+/// 1 (a 30th: 6 faces at 0.5; a 50th: 48 at 1); wider, the sides' cells beside the fans'
+/// prisms grow against them (issue 8's neighbour ratio O_le|O_b at density 1: 2.55, 2.93
+/// with a 20th).
+constexpr double tipFloor = 0.04;
+
 const DistributionLaw& useLaw(const BlockModel& model, const EdgeUse& use)
 {
   return model.blocks[use.block].laws[use.localEdge];
@@ -398,6 +406,31 @@ void projectEdgeParameters(const BlockModel& model, const std::vector<NamedCurve
           "nodes to project in order");
     }
   }
+  // Feet on a tip: where an O corner's radial line starts on a sharp tip (a fan), the
+  // source's nodes next to it may still lie on the O curve's arc round the tip, so their
+  // feet are the tip too, 1e-7-1e-5 of the edge from its end, beside a next cell of a
+  // hundredth of it: a sliver (the compressor's sides: checkMesh's interpolation weight
+  // failed between it and the next cell, and it folded at density 2). Such an end run,
+  // narrower together than tipFloor of the cell after it, is widened to tipFloor of it
+  // (each of its cells tipFloor of the one after): wide enough for the mesher and checkMesh,
+  // narrow enough that the edge block's fan beside it (its wall cells shrink to the tip)
+  // stays within a few times its size.
+  const auto widenTip = [&](auto at, auto set) {
+    int m = 1;
+    while (m + 1 < n - 1 && at(m) < tipFloor * (at(m + 1) - at(m)))
+    {
+      ++m;
+    }
+    double node = at(m);
+    for (int i = m - 1; i >= 1; --i)
+    {
+      node *= tipFloor;
+      set(i, node);
+    }
+  };
+  widenTip([&](int i) { return params[i]; }, [&](int i, double v) { params[i] = v; });
+  widenTip([&](int i) { return 1.0 - params[n - 1 - i]; },
+    [&](int i, double v) { params[n - 1 - i] = 1.0 - v; });
   const DistributionLaw law = lawAlongEdge(model, edge, use);
   if (law.fadeStart > 0.0 || law.fadeEnd > 0.0)
   {

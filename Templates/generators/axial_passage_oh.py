@@ -137,7 +137,7 @@ parameters:
   o_back: 0.012           # at a trailing edge neither sharp nor sheared (round or capped) the corners' feet stay at least this far from the edge (fraction of the loop; the turbine's cap spans 0.007), the H lines downstream then leave along the bisector as at a sheared edge
   o_tip: 0.001            # the corners' feet on the blade stay this far from the edge (fraction of the section loop), the corners then their normal offsets ...
   o_fan: 30               # ... where the edge block's outer chord is at most this many times its blade chord (sharper edges keep corners and feet on the tip: a fan)
-  o_fan_prisms: 0         # 1: at a sharp edge (o_fan) the fan's two feet are one point on the tip, its blade arc collapses and its wall cells are prisms (checkMesh: no concave cells), their apex angle on the tip then the grid's smallest (compressor: 11.3 deg optimized at density 1, 6.5 at 4); the other corners' feet then stay where the template put them; 0: feet a micrometre apart, hexahedra with blade faces of 1e-7 m
+  o_fan_prisms: 1         # 1: at a sharp edge (o_fan) the fan's two feet are one point on the tip, its blade arc collapses and its wall cells are prisms (checkMesh: no concave cells; their apex angle on the tip is geometry, which MinAngle leaves out); the other corners' feet follow their corners as with 0; 0: feet a micrometre apart, hexahedra with blade faces of 1e-7 m (concave cells)
   probe: 0.02             # camber direction at an edge: from the mid-point of the sides this far (fraction of the section loop) from it
   follow_le: 0.7          # upstream H lines follow this fraction of the blade's leading-edge angle (0: axial)
   follow_te: 0.7          # downstream H lines follow this fraction of the trailing-edge angle
@@ -234,6 +234,11 @@ def template_text():
             outer = f'sqrt((r{a}_{l}.axial - r{b}_{l}.axial)^2 + (rm_{l}*(r{a}_{l}.theta - r{b}_{l}.theta))^2)'
             inner = f'sqrt((k{a}_{l}.axial - k{b}_{l}.axial)^2 + (rm_{l}*(k{a}_{l}.theta - k{b}_{l}.theta))^2)'
             w(f'  off_{e}_{l}: "{outer} <= o_fan*{inner}"')
+            # with o_fan_prisms, a fan's feet are one point (t below); the same test on fixed
+            # helpers (kf: where k starts), so that the feet do not follow {e} (which off_{e}
+            # follows through k and rm, and which the optimizer moves: 25 % more work)
+            d3 = lambda p, q: f'sqrt(({p}.x - {q}.x)^2 + ({p}.y - {q}.y)^2 + ({p}.z - {q}.z)^2)'
+            w(f'  fan_{e}_{l}: "o_fan_prisms > 0.5 && {d3(f"r{a}_{l}", f"r{b}_{l}")} > o_fan*{d3(f"kf{a}_{l}", f"kf{b}_{l}")}"')
         # H lines upstream / downstream: slope d(r theta)/d(axial distance from the O-grid)
         w(f'  slope_in_{l}: "tan(follow_le*atan2(le_uy_{l}, -le_ux_{l}))"')
         w(f'  slope_out_{l}: "tan(follow_te*atan2(te_uy_{l}, te_ux_{l}))"')
@@ -368,6 +373,7 @@ def template_text():
             lim = f'max({off}, o_tip)' if towards == '+' else f'min({off}, -o_tip)'
             w(f'  k{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{lim}", fixed: true}}')
             w(f'  r{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"k{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
+            w(f'  kf{b}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"k{b}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
             corner = distance2(f"r{b}_{l}")
             if e == 'te':
                 # a trailing edge neither sharp nor sheared (round or capped): the feet at least
@@ -378,15 +384,15 @@ def template_text():
                 w(f'  rb{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"kb{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
                 corner = f'(shear_{e} ? {corner} : {distance2(f"rb{b}_{l}")})'
             w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {corner} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
-            # the foot's source: the corner; with o_fan_prisms, at a sharp edge's fan the O
-            # curve's point off the tip (both feet then one point: the fan's blade arc collapses
-            # into the tip, its wall cells prisms), elsewhere where the template put the corner
-            # (the corner's own search). The choice is a search (fixed: it follows nothing; not
-            # the corner, which the optimizer moves), so that by default the
-            # source follows only its corner (an expression of off_{e} or o{e} would follow
-            # {e}, which the optimizer moves: 6-30 % more work on every O template's run)
+            # the foot's source: the corner; with o_fan_prisms (the default), at a sharp edge's
+            # fan (fan_{e}) the O curve's point off the tip (both feet then one point: the fan's
+            # blade arc collapses into the tip, its wall cells prisms). That point is a search
+            # (fixed: it follows nothing; not the corner, which the optimizer moves), and fan_{e}
+            # is decided on fixed helpers, so that elsewhere the source follows only its corner
+            # (an expression of off_{e} or o{e} would follow {e}, which the optimizer moves:
+            # 6-30 % more work on every O template's run)
             w(f'  u{b}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {corner} : {distance2(f"o{e}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
-            w(f'  t{b}_{l}: {{on_curve: o_{l}, at: "o_fan_prisms < 0.5 ? {v}_{l}.s : u{b}_{l}.s", fixed: true}}')
+            w(f'  t{b}_{l}: {{on_curve: o_{l}, at: "fan_{e}_{l} ? u{b}_{l}.s : {v}_{l}.s", fixed: true}}')
             w(f'  {b}_{l}: {{project: t{b}_{l}, onto: blade_{l}}}')
         # a step along the O curve from the unsheared corner of a sheared edge towards the edge
         w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*bisect_step : ob_f_{l}.s + dir_{l}*bisect_step", fixed: true}}')

@@ -596,7 +596,10 @@ TEST(OptimizerPassage, ShearedOGridReachesFortyDegrees)
  * the blade sides' `ends` law with flat 3 next to the fans' tiny end cells (side_fan)
  * stalled the search at a corner cell of M_R; the template gives sides ending at a fan
  * side_flat_fan (2): 22.1 degrees. The optimizer measures a coarsened copy of the grid at
- * density 4 (MaximumMeasuredNodes), so the run costs about what density 2 costs.
+ * density 4 (MaximumMeasuredNodes), so the run costs about what density 2 costs. Since the
+ * fans' wall cells are prisms (o_fan_prisms, stop 14) and MinAngle leaves out a prism's
+ * apex on the tip (the fan's 20 cells per layer at density 4 share the tip's turn: 3 degrees
+ * each), 23.4 degrees; counted, the apex held the run at 2.8.
  */
 TEST(OptimizerPassage, CompressorAtDensityFourKeepsItsAngle)
 {
@@ -609,5 +612,5 @@ TEST(OptimizerPassage, CompressorAtDensityFourKeepsItsAngle)
   settings.densityMultiplier = 4.0;
   const OptimizerResult result = optimizeModel(loaded.model, loaded.geometry, settings);
   EXPECT_TRUE(result.after.feasible);
-  EXPECT_GT(result.after.minAngle, 20.0);
+  EXPECT_GT(result.after.minAngle, 22.0);
 }

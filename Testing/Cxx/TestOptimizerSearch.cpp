@@ -85,7 +85,8 @@ TEST(GridObjective, WedgeCellsTakeCoreRules)
   {
     EXPECT_NEAR(angles[c], quality[0].minAngle[c], 1e-9) << "cell " << c;
   }
-  EXPECT_NEAR(angles[0], 20.0, 1e-9); // the wedge's apex angle
+  // the wedge's apex angle (20) is left out: its triangles' base angles, 80
+  EXPECT_NEAR(angles[0], 80.0, 1e-9);
 }
 
 TEST(GridObjective, SmoothMinimumBounds)

@@ -271,6 +271,22 @@ TEST(Quality, CollapsedCells)
   // Mean widths: (1 + sqrt 2) / 2 along s, 0.5 along t (two collapsed edges), 1 along u.
   EXPECT_NEAR(hexAspectRatio(prism), 1.0 + std::sqrt(2.0), 1e-14);
 
+  // A thin prism (a fan's wall cell on a sharp tip): its apex on the collapsed edge, 10
+  // degrees, is left out (geometry: the cells round the edge share its turn); the smallest
+  // angle is the triangles' base angle, 85, the largest the side faces' right angles.
+  Corners thin = unitCube();
+  const double apex = 10.0 * std::acos(-1.0) / 180.0;
+  for (int v : { 1, 2, 5, 6 })
+  {
+    thin[v] = Vec3(std::cos(v == 1 || v == 5 ? -apex / 2 : apex / 2),
+      std::sin(v == 1 || v == 5 ? -apex / 2 : apex / 2), thin[v].z());
+  }
+  thin[3] = thin[0];
+  thin[7] = thin[4];
+  hexFaceAngles(thin, minAngle, maxAngle);
+  EXPECT_NEAR(minAngle, 85.0, 1e-12);
+  EXPECT_NEAR(maxAngle, 90.0, 1e-12);
+
   // Nearly collapsed (1e-15 of the cell size) counts as collapsed for angles too.
   Corners almost = prism;
   almost[3] += Vec3(1e-15, 0, 0);

@@ -55,23 +55,22 @@ ALLOWED_FAILURES = {
     "axial_passage_oh_distributor": {"determinant"},
     "axial_passage_oh_rotor37": {"determinant"},
     "axial_passage_oh_turbine": {"determinant"},
-    # The transonic compressor's sharp edges keep their O corners on the tip: the edge
-    # blocks are fans whose blade cells are the feet of their outer cells on an edge of
-    # 0.8 micrometre, which leaves concave cells and faces whose decomposition tets are
-    # poor (the template's grid, reported; every cell is valid: Mesh OK).
-    # Since the blade sides' nodes are the feet of their O arcs' nodes (issue 8, stop 13)
-    # the sides' first cells by a sharp tip are feet on the fan too, then the flank's:
-    # in-block jumps that fail interpolation weights (48 faces placed, 26 optimized).
-    "axial_passage_oh_compressor": {"determinant", "concave", "face tets",
-                                    "interpolation weight"},
-    # Optimized: the same thin wall cells, and on the compressor the fans' concave cells;
-    # the turbine's optimized trailing-edge corner leaves 12 faces (O_te and O_a, feet by
-    # the cap) under the interpolation weight since stop 13.
+    # The transonic compressor's sharp edges (4-9 degree wedges) keep their O corners on the
+    # tip: the edge blocks are fans, their feet one point on the tip and their wall cells
+    # prisms (o_fan_prisms, the default since stop 14: no concave cell; as hexahedra whose
+    # blade faces were the feet on a tip 0.8 micrometre long, 134 placed and 94 optimized).
+    # Placed, face tets in D_M's cells by the outlet (the trailing edge's small cells
+    # carried there by `match`: 0.08 mm across, 5 mm long and high, faces warped along the
+    # span); the optimizer moves them away.
+    "axial_passage_oh_compressor": {"determinant", "face tets"},
+    # Optimized: the same thin wall cells; on the compressor the optimizer moves the fans'
+    # corners along the O curve off the tip's arc while their feet stay on the tip, so the
+    # sides' end cells beside the fans are 10-80 times their thin prisms (interpolation
+    # weight between O_le and O_b, O_a and O_te).
     "axial_passage_oh_distributor_optimized": {"determinant"},
     "axial_passage_oh_rotor37_optimized": {"determinant"},
-    "axial_passage_oh_turbine_optimized": {"determinant", "interpolation weight"},
-    "axial_passage_oh_compressor_optimized": {"determinant", "concave", "face tets",
-                                              "interpolation weight"},
+    "axial_passage_oh_turbine_optimized": {"determinant"},
+    "axial_passage_oh_compressor_optimized": {"determinant", "interpolation weight"},
     # Every H grid passes, optimized or not. The turbine's blade side b meets the
     # circumferential trailing-edge line at 10-12 degrees (block AR): its wall cells there
     # failed with 4 cells (aspect ratio 11-13; optimized: 3 at the outlet, 15-25) until the
@@ -79,13 +78,9 @@ ALLOWED_FAILURES = {
 }
 
 
-# No more concave cells than these where concave cells are allowed: the compressor's fans'
-# wall cells on its sharp tips (their blade faces are the feet of the fan's outer nodes on a
-# tip a micrometre long, so a face's plane warped by 1e-4 rad along the span passes the
-# centre of the blade face: O_le and O_te, j = 0). 134 placed, 94 optimized since the sides'
-# blade nodes are the feet of their O arcs' (issue 8, stop 13; 97 and 22 before).
-CONCAVE_CELLS_AT_MOST = {"axial_passage_oh_compressor": 134,
-                         "axial_passage_oh_compressor_optimized": 94}
+# No more failed faces than these where a check other than the determinant may fail.
+FAILED_AT_MOST = {"axial_passage_oh_compressor": {"face tets": 21},
+                  "axial_passage_oh_compressor_optimized": {"interpolation weight": 39}}
 
 # GridQuality follows OpenFOAM v1912's face centres (triangle fan weighted by area), so
 # per cell it agrees with checkMesh to round-off: about 1e-10 degrees on the passage grids,
@@ -213,14 +208,16 @@ class CheckMeshTest(unittest.TestCase):
                         kinds.add("interpolation weight")
                     elif "Concave cells" in line:
                         kinds.add("concave")
-                        count = int(re.search(r"(\d+)\s*$", line).group(1))
-                        self.assertLessEqual(count, CONCAVE_CELLS_AT_MOST[name], line)
                     elif "small volume ratio" in line:
                         kinds.add("volume ratio")
                     elif "face tets" in line:
                         kinds.add("face tets")
                     else:
                         kinds.add(line)
+                    for kind, most in FAILED_AT_MOST.get(name, {}).items():
+                        if kind in line:
+                            count = re.search(r"(\d+)\s*$", line) or re.search(r":\s*(\d+)", line)
+                            self.assertLessEqual(int(count.group(1)), most, line)
                 self.assertLessEqual(kinds, ALLOWED_FAILURES.get(name, set()), failed)
 
     def test_cell_quality_equals_grid_quality(self):
@@ -237,75 +234,45 @@ class CheckMeshTest(unittest.TestCase):
                 difference = np.abs(theirs - ours)
                 self.assertLess(np.max(difference), CELL_QUALITY_BOUND, int(np.argmax(difference)))
 
-    def test_compressor_fans_as_prisms(self):
-        """The compressor with o_fan_prisms: 1: at its sharp edges both feet of each fan
-        (edge blocks O_le, O_te) are one point on the tip, the fan's blade arc collapses into
-        it, and the writer writes the fans' wall cells as prisms. checkMesh finds no concave
-        cell (97 placed, 22 optimized by default); optimized, the thin-wall determinant is
-        the only failed check; checkMesh and GridQuality agree cell by cell. GridQuality's
-        MinAngle of a prism is its apex on the tip: the angle there between the radial lines
-        of the fan's neighbouring nodes (10.8 degrees placed, where the default grid's
-        hexahedra with blade faces of 1e-7 m show 75)."""
+    def test_compressor_fans_are_prisms(self):
+        """The compressor at default parameters (o_fan_prisms 1): at its sharp edges both
+        feet of each fan (edge blocks O_le, O_te) are one point on the tip, the fan's blade
+        arc collapses into it, and the writer writes the fans' wall cells as prisms
+        (checkMesh: no concave cell, test_all_checks). GridQuality's MinAngle of a prism
+        leaves out its apex on the tip (the angle between the radial lines of the fan's
+        neighbouring nodes: geometry, the fan's cells share the tip's turn): it is the
+        smallest of the other corners, here the triangles' base angles and the side faces'."""
         fans = ("O_le", "O_te")
-        for optimize in (False, True):
-            with self.subTest(optimize=optimize):
-                grid = blockforge.mesh_template(
-                    template("axial_passage_oh"), input_file=MACHINES[2][1], optimize=optimize,
-                    parameters={"o_fan_prisms": 1}).GetOutputDataObject(0)
+        for name in ("axial_passage_oh_compressor", "axial_passage_oh_compressor_optimized"):
+            with self.subTest(case=name):
+                grid = self.results[name]["grid"]
+                summary = self.results[name]["all"]
                 blocks = foamtools.blocks_of(grid)
+                apex = []
                 for fan in fans:
                     block, dims = blocks[fan]
                     points = np.array(dsa.WrapDataObject(block).Points).reshape(
                         dims[2], dims[1], dims[0], 3)
                     # the blade row of every layer is one point, bit for bit
                     self.assertTrue(np.all(points[:, 0] == points[:, 0, :1]), fan)
-                case = bftest.output_path(os.path.join("openfoam", f"compressor_fan_prisms_{int(optimize)}"))
-                shutil.rmtree(case, ignore_errors=True)
-                writers.write_solver_grid(grid, os.path.join(case, "fans.foam"))
-                status, plain = foamtools.run_foam(["checkMesh"], case)
-                self.assertTrue(foamtools.check_mesh_summary(plain)["ok"], plain[-3000:])
-                status, text = foamtools.run_foam(
-                    ["checkMesh", "-allGeometry", "-allTopology", "-writeFields",
-                     "(nonOrthoAngle skewness)"], case)
-                summary = foamtools.check_mesh_summary(text)
+                    radial = points[:, 1] - points[:, 0]
+                    length = np.linalg.norm(radial, axis=-1)
+                    unit = radial / length[..., None]
+                    angle = np.degrees(np.arccos(np.clip((unit[:, 1:] * unit[:, :-1]).sum(-1), -1, 1)))
+                    apex.append(angle.ravel())
                 ni, _, nk = blocks["O_le"][1]
                 prisms = 2 * (ni - 1) * (nk - 1)  # the wall cells of both fans
                 self.assertEqual(summary["prisms"], prisms)
                 cells = sum(b.GetNumberOfCells() for b in bftest.leaves(grid))
                 self.assertEqual(summary["hexahedra"], cells - prisms)
-                failed = summary["failed"]
-                self.assertFalse([line for line in failed if "Concave" in line], failed)
-                # left (stop 13): the thin wall cells' determinant; the interpolation weights
-                # of the side cells next to the fans (issue 8's matched O arcs: the sides'
-                # first cells on the blade are the fans' feet); placed, also face tets in
-                # D_M's corner cells by the outlet (the fans' small cells carried there by
-                # `match`)
-                allowed = {"determinant", "interpolation weight"}
-                if not optimize:
-                    allowed.add("face tets")
-                for line in failed:
-                    self.assertTrue(any(kind in line and kind in allowed
-                                        for kind in ("determinant", "face tets",
-                                                     "interpolation weight")), line)
-                constant = os.path.join(case, "constant")
-                for field, array in (("nonOrthoAngle", "NonOrthogonality"), ("skewness", "Skewness")):
-                    theirs = foamtools.read_cell_field(os.path.join(constant, field))
-                    ours = block_cell_array(grid, array)
-                    self.assertLess(np.max(np.abs(theirs - ours)), CELL_QUALITY_BOUND, field)
-                # A prism's smallest angle is the apex of its triangles: on the tip, between
-                # the radial lines to the fan's neighbouring nodes of the first layer.
-                apex = []
-                for fan in fans:
-                    block, dims = blocks[fan]
-                    points = np.array(dsa.WrapDataObject(block).Points).reshape(
-                        dims[2], dims[1], dims[0], 3)
-                    radial = points[:, 1] - points[:, 0]
-                    radial /= np.linalg.norm(radial, axis=-1)[..., None]
-                    angle = np.degrees(np.arccos(np.clip((radial[:, 1:] * radial[:, :-1]).sum(-1), -1, 1)))
-                    apex.append(np.minimum(angle[1:], angle[:-1]).ravel())  # per cell: its two layers
-                self.assertAlmostEqual(float(foamtools.row_cells(grid, fans, "MinAngle").min()),
-                                       float(np.concatenate(apex).min()), delta=1e-9)
-                self.assertGreater(float(foamtools.row_cells(grid, fans, "ScaledJacobian").min()), 0.8)
+                fan_min = float(foamtools.row_cells(grid, fans, "MinAngle").min())
+                # the apex (12.7-13.2 degrees placed, 7.9-23.2 optimized) is not the cells'
+                # MinAngle (76.3 placed, 28.9 optimized: the optimizer's smallest is 26.5)
+                self.assertLess(float(np.concatenate(apex).min()), 15.0)
+                self.assertGreater(fan_min, 25.0)
+                self.assertLess(fan_min, 80.0)
+                # ScaledJacobian 0.96 placed, 0.48 optimized
+                self.assertGreater(float(foamtools.row_cells(grid, fans, "ScaledJacobian").min()), 0.4)
 
 
 if __name__ == "__main__":

@@ -7,8 +7,10 @@
  * The smallest of a cell's 24 face corner angles is the arc cosine of the largest corner
  * cosine, so the kernel takes dot products of unit edge vectors (every grid edge is
  * normalised once and shared by the cells around it) and one acos per cell. Cells with a
- * collapsed edge (wedges written as hexahedra) take Core's hexFaceAngles, the definition
- * GridQuality reports, so both agree.
+ * collapsed edge (wedges and fans written as hexahedra) take Core's hexFaceAngles, the
+ * definition GridQuality reports, so both agree: it leaves out a prism's apex at the
+ * collapsed edge (the compressor's fans share the tip's turn among 5-20 cells per layer:
+ * counted, the objective would sit on a constant of 13 to 3 degrees).
  */
 #pragma once
 
