@@ -175,7 +175,11 @@ void joinFeet(const BlockModel& model, MeshTopology& topology, const FootJoin& j
 {
   UniqueEdge* edges[2] = { &topology.edges[join.edge[0]], &topology.edges[join.edge[1]] };
   const UniqueEdge& radial = topology.edges[join.radial];
-  if (radial.params.size() < 2 || !(radial.length > 0.0))
+  // A fan whose feet are one point (its blade arc collapsed, axial_passage_oh's prisms on a
+  // sharp tip) has no wall width to join: cut to it, the side's first foot would vanish
+  // and fold the block at the corner.
+  if (radial.params.size() < 2 || !(radial.length > 0.0) || !(edges[0]->length > 0.0) ||
+    !(edges[1]->length > 0.0))
   {
     return;
   }
