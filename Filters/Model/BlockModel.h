@@ -283,11 +283,16 @@ struct Patch
   SourceLocation where;
 };
 
-/// Block faces whose grids lie on a surface carrier (format 2 `faces:` section).
+/// Block faces whose grids lie on a surface carrier (format 2 `faces:` section), or
+/// (followOpposite, carrier -1) whose grids follow the opposite face of their block: the
+/// Coons patch of the face's own edges plus the opposite face's departure from the Coons
+/// patch of its edges, so that an O-grid's outer face keeps the blade face's bulge between
+/// hub and shroud (`{follow: opposite, faces: [...]}`).
 struct SurfaceFaces
 {
   std::string name;
   int carrier = -1;
+  bool followOpposite = false;
   std::vector<BlockFace> faces;
   SourceLocation where;
 };

@@ -731,10 +731,22 @@ private:
   void readFaces(const YAML::Node& node)
   {
     SurfaceFaces set;
-    const auto keys = entries(node, "face set", { "on_surface", "faces" }, set.name, set.where);
+    const auto keys = entries(node, "face set", { "on_surface", "follow", "faces" }, set.name, set.where);
     const std::string entityText = entity("face set", set.name);
-    const MapEntry& surface = required(keys, "on_surface", node, entityText);
-    set.carrier = carrierRef(surface.value, surface.line, entityText);
+    const MapEntry* follow = syntax::findEntry(keys, "follow");
+    if (follow)
+    {
+      if (!(follow->value.IsScalar() && follow->value.Scalar() == "opposite"))
+      {
+        fail(follow->line, entityText, "'follow' must be 'opposite'");
+      }
+      set.followOpposite = true;
+    }
+    else
+    {
+      const MapEntry& surface = required(keys, "on_surface", node, entityText);
+      set.carrier = carrierRef(surface.value, surface.line, entityText);
+    }
     const MapEntry& faces = required(keys, "faces", node, entityText);
     if (!faces.value.IsSequence())
     {
