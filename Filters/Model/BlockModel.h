@@ -10,6 +10,7 @@
 #pragma once
 
 #include "../Core/Distribution.h"
+#include "../Core/Transfinite.h"
 #include "../Core/Types.h"
 
 #include <Eigen/Core>
@@ -257,6 +258,10 @@ struct Block
   /// Distribution law of each local edge (Transfinite.h numbering), in the local edge
   /// direction (increasing i, j or k).
   std::array<DistributionLaw, 12> laws{};
+  /// How the interior blends the boundary in i, j and k (`interpolation: end_cells` or
+  /// `{j: end_cells}`, Transfinite.h): also the faces this block owns (the first block
+  /// using a face makes its grid).
+  std::array<Blending, 3> blending{ Blending::Linear, Blending::Linear, Blending::Linear };
   SourceLocation where;
 };
 

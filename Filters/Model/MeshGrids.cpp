@@ -99,7 +99,8 @@ MeshTopology buildMeshTopology(const BlockModel& model, const CarrierGeometry& g
     {
       fail(model.blocks[face.follows.block].where, blockEntity(model, face.follows.block),
         "face " + blockFaceText(model, face.follows.block, face.follows.face) +
-          " follows a face that follows another: the face it follows must be made otherwise");
+          " follows a face that follows another: the face a following face follows must lie on a "
+          "surface or come from its edges");
     }
   }
   // graded edges first: matched edges take their end cells from them, projected edges
@@ -315,6 +316,14 @@ void checkCornerCells(const BlockModel& model, const MeshTopology& topology, int
   }
 }
 
+/// The blending of the face's two directions (the block's, Transfinite.h).
+static std::array<Blending, 2> faceBlending(const BlockModel& model, int block, int face)
+{
+  const std::array<int, 2> directions = faceDirections(face);
+  const auto& blending = model.blocks[block].blending;
+  return { blending[directions[0]], blending[directions[1]] };
+}
+
 /// Face grid of `face` of `block` in the block's own orientation, from its four edges.
 void faceFromEdges(const BlockModel& model, const MeshTopology& topology, int block, int face,
   std::vector<double>& out)
@@ -325,7 +334,8 @@ void faceFromEdges(const BlockModel& model, const MeshTopology& topology, int bl
   const LocalEdge left = localEdge(model, topology, block, edges[2]);
   const LocalEdge right = localEdge(model, topology, block, edges[3]);
   out.resize(3 * static_cast<std::size_t>(bottom.count) * left.count);
-  transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data());
+  transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data(),
+    faceBlending(model, block, face));
 }
 
 void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& curves,
@@ -707,7 +717,8 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
     follow(k, k + 1);
   }
   out.resize(3 * static_cast<std::size_t>(na) * nb);
-  surfaceFaceGrid(surface, st, bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data());
+  surfaceFaceGrid(surface, st, bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data(),
+    SurfaceFaceMethod::Guarded, nullptr, faceBlending(model, block, face));
 }
 
 void copyFaceBoundary(const BlockModel& model, const MeshTopology& topology, int block, int face,
@@ -1131,6 +1142,7 @@ void meshBlockNodes(const BlockModel& model, const MeshTopology& topology, int b
     edges[e] = localEdge(model, topology, block, e);
     boundary.edgeParams[e] = edges[e].params();
   }
+  boundary.blending = model.blocks[block].blending;
   transfiniteBlock(boundary, links.nodes[0], links.nodes[1], links.nodes[2], out);
 }
 } // namespace model

@@ -353,8 +353,8 @@ void checkSurfaceFaces(const BlockModel& model, const CarrierGeometry& geometry,
       }
       if (set.followOpposite)
       {
-        // its grid comes from the face opposite it: that face must be one, and be made
-        // otherwise than by following (on a surface, or from its edges)
+        // its grid comes from the face opposite it: that face must be one (that it does not
+        // follow a face itself is checked with the mesher's topology, buildMeshTopology)
         const int opposite = topology.blocks[face.block].face[face.face ^ 1];
         if (opposite < 0)
         {
@@ -373,13 +373,6 @@ void checkSurfaceFaces(const BlockModel& model, const CarrierGeometry& geometry,
               fail(set.where, entityText,
                 "face " + blockFaceText(model, face.block, face.face) + " is also in face set '" +
                   other.name + "': a face follows the face opposite it or lies on a surface, not both");
-            }
-            if (other.followOpposite && unique == opposite)
-            {
-              fail(set.where, entityText,
-                "face " + blockFaceText(model, face.block, face.face ^ 1) +
-                  " follows a face itself: the face a following face follows must lie on a "
-                  "surface or come from its edges");
             }
           }
         }

@@ -613,7 +613,7 @@ private:
   {
     Block block;
     const auto keys =
-      entries(node, "block", { "vertices", "cells", "laws" }, block.name, block.where);
+      entries(node, "block", { "vertices", "cells", "laws", "interpolation" }, block.name, block.where);
     const std::string entityText = entity("block", block.name);
     const MapEntry& vertices = required(keys, "vertices", node, entityText);
     if (!vertices.value.IsSequence() || vertices.value.size() != 8)
@@ -636,6 +636,10 @@ private:
       {
         fail(cells.line, entityText, "cells must be at least 1");
       }
+    }
+    if (const MapEntry* interpolation = syntax::findEntry(keys, "interpolation"))
+    {
+      block.blending = syntax::parseBlending(interpolation->value, interpolation->line, entityText, Report);
     }
     const MapEntry& laws = required(keys, "laws", node, entityText);
     if (!laws.value.IsSequence() || laws.value.size() != 12)

@@ -363,6 +363,7 @@ std::string writeModelDocument(const BlockModel& model)
       syntax::emitLaw(out, law, model);
     }
     out << YAML::EndSeq;
+    syntax::emitBlending(out, block.blending);
     emitWhere(out, block.where, model);
     out << YAML::EndMap;
   }

@@ -343,7 +343,7 @@ void TemplateReader::readBlocks()
     }
     const auto keys =
       syntax::mapEntries(entry.value, entry.line, entityText, "the block", Report);
-    syntax::checkKeys(keys, { "vertices", "cells", "grading" }, entityText, Report);
+    syntax::checkKeys(keys, { "vertices", "cells", "grading", "interpolation" }, entityText, Report);
     Block block;
     block.name = entry.key;
     block.where = where(entry.line);
@@ -396,6 +396,10 @@ void TemplateReader::readBlocks()
     if (const MapEntry* grading = syntax::findEntry(keys, "grading"))
     {
       readGrading(*grading, entityText, block);
+    }
+    if (const MapEntry* interpolation = syntax::findEntry(keys, "interpolation"))
+    {
+      block.blending = syntax::parseBlending(interpolation->value, interpolation->line, entityText, Report);
     }
     Model.blocks.push_back(block);
   }

@@ -150,7 +150,7 @@ parameters:
   k_o: 1.15               # expansion ratio away from the blade in the O-grid
   k_span: 1.05            # expansion ratio away from hub and shroud (two-sided)
   side_arc_flat: 2        # the blade sides' O-grid arcs (law `match` from the O corners' cells, `flat`): between their small end cells the shape of the law `ends` with this flatness, not cells grown by o_match to a uniform middle (2.7 times the mean cell at density 0.5) ...
-  period_end: 0.13        # ... and the periodic lines beside them (law `ends`): end cells this fraction of their mean cell ...
+  period_end: 0.1         # ... and the periodic lines beside them (law `ends`): end cells this fraction of their mean cell ...
   period_flat: 3          # ... and that flat in between, so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
 """
@@ -160,14 +160,14 @@ FOOTER = """blocks:
   O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_a_h}, E5: {project_from: ol_a_s}}}}
   O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
   O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
-  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
   U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
-  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
   M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end, period_end], flat: period_flat}, E8: {ends: [period_end, period_end], flat: period_flat}}}}
   M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end, period_end], flat: period_flat}, E6: {ends: [period_end, period_end], flat: period_flat}}}}
-  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
   D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
-  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
 
 faces:
   hub_faces: {on_surface: hub, faces: [O_le.k0, O_a.k0, O_te.k0, O_b.k0, U_L.k0, U_M.k0, U_R.k0, M_L.k0, M_R.k0, D_L.k0, D_M.k0, D_R.k0]}
