@@ -151,7 +151,7 @@ parameters:
   k_span: 1.05            # expansion ratio away from hub and shroud (two-sided)
   side_arc_flat: 2        # the blade sides' O-grid arcs (law `match` from the O corners' cells, `flat`): between their small end cells the shape of the law `ends` with this flatness, not cells grown by o_match to a uniform middle (2.7 times the mean cell at density 0.5) ...
   period_end: 0.1         # ... and the periodic lines beside them (law `ends`): end cells this fraction of their mean cell ...
-  period_flat: 3          # ... and that flat in between, so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
+  period_flat: 2.8        # ... and that flat in between, so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
 """
 
@@ -173,7 +173,7 @@ faces:
   hub_faces: {on_surface: hub, faces: [O_le.k0, O_a.k0, O_te.k0, O_b.k0, U_L.k0, U_M.k0, U_R.k0, M_L.k0, M_R.k0, D_L.k0, D_M.k0, D_R.k0]}
   shroud_faces: {on_surface: shroud, faces: [O_le.k1, O_a.k1, O_te.k1, O_b.k1, U_L.k1, U_M.k1, U_R.k1, M_L.k1, M_R.k1, D_L.k1, D_M.k1, D_R.k1]}
   blade_faces: {on_surface: blade, faces: [O_le.j0, O_a.j0, O_te.j0, O_b.j0]}
-  o_faces: {follow: opposite, faces: [O_a.j1, O_b.j1]}   # the O-grid's outer faces keep the blade faces' bulge between hub and shroud
+  o_faces: {follow: opposite, faces: [O_le.j1, O_a.j1, O_te.j1, O_b.j1]}   # the O-grid's outer faces keep the blade faces' bulge between hub and shroud
 
 patches:
   hub: {type: wall, faces: [O_le.k0, O_a.k0, O_te.k0, O_b.k0, U_L.k0, U_M.k0, U_R.k0, M_L.k0, M_R.k0, D_L.k0, D_M.k0, D_R.k0]}

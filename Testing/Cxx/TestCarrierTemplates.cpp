@@ -1890,6 +1890,40 @@ TEST(CarrierTemplates, FollowingFaceKeepsTheOppositeFacesBulge)
       "follows must lie on a surface or come from its edges");
 }
 
+// A block's `interpolation` (Core/Transfinite.h Blending): read, written to the document,
+// used by the mesher (a block whose i-edges end in cells of 0.025, its i1 face bulging out
+// by 0.6: with end_cells in i the first cell of the middle i-line is 0.025 within 2e-3,
+// linear gives it the edges' fraction of that longer line, 0.04), and its errors.
+TEST(CarrierTemplates, InterpolationEndCells)
+{
+  const std::string edges = "edges:\n"
+                            "  bulge: {spline: [b, f], points: [[11.6, 0, 0.5]]}\n"
+                            "  bulge2: {spline: [c, g], points: [[11.6, 1, 0.5]]}\n";
+  const std::string law = "grading: {i: {ends: [0.1, 0.1]}}";
+  std::string text = featureText("", "", edges);
+  text = replaced(text, "cells: [4, 4, 4]}", "cells: [4, 4, 4], " + law + "}");
+  const auto firstCell = [](const BlockModel& model) {
+    const Grid grid = meshAll(model);
+    return (grid.at(0, 1, 2, 2) - grid.at(0, 0, 2, 2)).norm();
+  };
+  const BlockModel linear = parseFeature(text);
+  const BlockModel ends = parseFeature(replaced(text, law + "}", law + ", interpolation: {i: end_cells}}"));
+  EXPECT_EQ(ends.blocks[0].blending[0], Blending::EndCells);
+  EXPECT_EQ(ends.blocks[0].blending[1], Blending::Linear);
+  EXPECT_NEAR(firstCell(ends), 0.025, 2e-3);
+  EXPECT_NEAR(firstCell(linear), 0.04, 2e-3);
+  const BlockModel all = parseFeature(replaced(text, law + "}", law + ", interpolation: end_cells}"));
+  EXPECT_EQ(all.blocks[0].blending[2], Blending::EndCells);
+  // the document keeps it
+  EXPECT_TRUE(sameBits(meshAll(ends).xyz[0], meshAll(documentRoundTrip(ends)).xyz[0]));
+  EXPECT_EQ(documentRoundTrip(all).blocks[0].blending[1], Blending::EndCells);
+  const std::string wrong = replaced(text, law + "}", law + ", interpolation: smooth}");
+  EXPECT_EQ(errorOf([&] { parseFeature(wrong); }), featureLine(wrong, "  box:") +
+      "block 'box': 'interpolation' must be 'linear' (the default: interior lines take the edges' "
+      "fractions), 'end_cells' (interior lines keep the edges' end cells as lengths) or {i: .., "
+      "j: .., k: ..} of those");
+}
+
 // A min/max objective that is NaN somewhere, or that gives several values, is an error
 // naming the vertex (a NaN never compares smaller, so it would silently pick the window's
 // start).
