@@ -111,7 +111,15 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   blocks' and sides' cells and grow towards the inlet, outlet and periodic lines; the
 #   periodic lines beside the sides `ends` (period_end, period_flat), so that their nodes
 #   lie at nearly the fractions of the sides' matched outer arcs (the H blocks between
-#   them are not sheared along the blade).
+#   them are not sheared along the blade);
+# - the O-grid's outer faces follow the blade faces (faces `follow: opposite`): made from
+#   their edges alone they were the ruled surface between the hub and shroud offsets, and
+#   the O-grid half as thick at mid-span beside a bulging side (Rotor 37: its outer cells
+#   2.4 times smaller than the H block's beside them);
+# - U_L, U_R, D_L and D_R keep their edges' end cells along their interior lines
+#   (`interpolation: end_cells`): with the edges' fractions the turbine's D_L against D_M
+#   reached 3.5 (not U_M/D_M, where the O arc leaves its corner nearly along the H line,
+#   nor M_L/M_R, whose shear would gather in their middle cells).
 blockforge: 2
 name: axial_passage_oh
 description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.

@@ -52,7 +52,7 @@ using test::Pi;
  * the blade faces (`follow: opposite`; Rotor 37's O_a against M_L 2.39-2.47 -> 1.30-1.36 at
  * 0.5-4) and U_L, U_R, D_L, D_R keep their edges' end cells along their interior lines
  * (`interpolation: end_cells`): the turbine's D_L against D_M 3.14-3.53 -> 2.62-2.78, its
- * M_R against D_R 1.86 -> under 1.4, the compressor's U_L against U_M at 1-4 1.68-2.13 ->
+ * M_R against D_R 1.86 -> 1.05, the compressor's U_L against U_M at 1-4 1.68-2.13 ->
  * 1.66-1.89, its D_M against D_R 1.52-1.92 -> 1.55-1.72. The bounds, per machine, fail
  * when the grading gets worse (the turbine's 3.7 -> 2.9).
  */
