@@ -164,7 +164,8 @@ struct LoopIndex
 
 /// TFI of the boundary's (u, v) (two numbers per loop node) with the edges' parameters.
 std::vector<double> parameterTfi(const std::vector<Eigen::Vector2d>& uv, const LoopIndex& loop,
-  const EdgeNodes& bottom, const EdgeNodes& top, const EdgeNodes& left, const EdgeNodes& right)
+  const EdgeNodes& bottom, const EdgeNodes& top, const EdgeNodes& left, const EdgeNodes& right,
+  std::array<Blending, 2> blending)
 {
   auto fill = [&](int count, auto index) {
     std::vector<double> xyz(3 * count);
@@ -184,7 +185,8 @@ std::vector<double> parameterTfi(const std::vector<Eigen::Vector2d>& uv, const L
   const std::vector<double> pl = fill(nb, [&](int b) { return loop.left(b); });
   std::vector<double> grid(3 * static_cast<std::size_t>(na) * nb);
   transfiniteFace(EdgeNodes{ pb.data(), bottom.params, na }, EdgeNodes{ pt.data(), top.params, na },
-    EdgeNodes{ pl.data(), left.params, nb }, EdgeNodes{ pr.data(), right.params, nb }, grid.data());
+    EdgeNodes{ pl.data(), left.params, nb }, EdgeNodes{ pr.data(), right.params, nb }, grid.data(),
+    blending);
   return grid;
 }
 
@@ -250,7 +252,7 @@ struct SideMeasure
 
 void surfaceFaceGrid(const ParametricSurface& surface, const std::vector<Eigen::Vector2d>& loopST,
   const EdgeNodes& bottom, const EdgeNodes& top, const EdgeNodes& left, const EdgeNodes& right,
-  double* out, SurfaceFaceMethod method, SurfaceFaceReport* report)
+  double* out, SurfaceFaceMethod method, SurfaceFaceReport* report, std::array<Blending, 2> blending)
 {
   const int na = bottom.count, nb = left.count;
   const LoopIndex loop{ na, nb };
@@ -261,9 +263,9 @@ void surfaceFaceGrid(const ParametricSurface& surface, const std::vector<Eigen::
       std::to_string(loop.size()));
   }
   const std::size_t count = static_cast<std::size_t>(na) * nb;
-  std::vector<double> parameters = parameterTfi(loopST, loop, bottom, top, left, right);
+  std::vector<double> parameters = parameterTfi(loopST, loop, bottom, top, left, right, blending);
   std::vector<double> targets(3 * count);
-  transfiniteFace(bottom, top, left, right, targets.data());
+  transfiniteFace(bottom, top, left, right, targets.data(), blending);
   // Every node's (s, t): boundary nodes from the loop, interior nodes placed below.
   std::vector<Eigen::Vector2d> st(count);
   for (std::size_t i = 0; i < count; ++i)
@@ -357,7 +359,7 @@ void surfaceFaceGrid(const ParametricSurface& surface, const std::vector<Eigen::
   {
     even[k] = Eigen::Vector2d(sigma.forward(loopST[k][0]), tau.forward(loopST[k][1]));
   }
-  const std::vector<double> evenGrid = parameterTfi(even, loop, bottom, top, left, right);
+  const std::vector<double> evenGrid = parameterTfi(even, loop, bottom, top, left, right, { Blending::Linear, Blending::Linear }); // linear: the grid that does not fold
   std::vector<Eigen::Vector2d> safe(st);
   for (int b = 1; b + 1 < nb; ++b)
   {

@@ -83,10 +83,11 @@ struct SurfaceFaceReport
  * 2 (na - 1) + 2 (nb - 1) nodes), unwrapped across seams so neighbours are close; the
  * edges give the 3-D boundary nodes and their distribution parameters. `out` (na * nb * 3)
  * gets the interior nodes (each evaluated by the surface); its boundary nodes are the
- * edges' own (copied). Deterministic, the same bits with or without threads.
+ * edges' own (copied). `blending` is that of both interpolations (Transfinite.h). Deterministic, the same bits with or without threads.
  */
 void surfaceFaceGrid(const ParametricSurface& surface, const std::vector<Eigen::Vector2d>& loop,
   const EdgeNodes& bottom, const EdgeNodes& top, const EdgeNodes& left, const EdgeNodes& right,
   double* out, SurfaceFaceMethod method = SurfaceFaceMethod::Guarded,
-  SurfaceFaceReport* report = nullptr);
+  SurfaceFaceReport* report = nullptr,
+  std::array<Blending, 2> blending = { Blending::Linear, Blending::Linear });
 } // namespace blockforge

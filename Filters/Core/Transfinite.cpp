@@ -16,6 +16,12 @@ namespace blockforge
 {
 namespace
 {
+/// The blending weight of parameter x (Blending).
+inline double weight(double x, Blending blending)
+{
+  return blending == Blending::EndCells ? x * x * (3.0 - 2.0 * x) : x;
+}
+
 inline void copyNode(const double* from, double* to)
 {
   to[0] = from[0];
@@ -92,11 +98,28 @@ void copyBoundary(const BlockFaces& faces, int ni, int nj, int nk, double* out)
  * block; the innermost loop over i reads four contiguous rows and writes one.
  */
 void interiorSeparable(const BlockFaces& F, const std::array<const double*, 12>& params, int ni,
-  int nj, int kBegin, int kEnd, const double* uFaceDifference, double* out)
+  int nj, int nk, int kBegin, int kEnd, const double* uFaceDifference,
+  const std::array<Blending, 3>& blending, double* out)
 {
   const double* sOfI = params[0];
   const double* tOfJ = params[3];
   const double* uOfK = params[8];
+  std::vector<double> sWeights, tWeights, uWeights;
+  const auto weights = [](const double* p, int n, Blending b, std::vector<double>& w) {
+    if (b == Blending::Linear)
+    {
+      return p;
+    }
+    w.resize(n);
+    for (int i = 0; i < n; ++i)
+    {
+      w[i] = weight(p[i], b);
+    }
+    return static_cast<const double*>(w.data());
+  };
+  sOfI = weights(params[0], ni, blending[0], sWeights);
+  tOfJ = weights(params[3], nj, blending[1], tWeights);
+  uOfK = weights(params[8], nk, blending[2], uWeights);
 
   const double* V0 = F.u0(0, 0);
   const double* V1 = F.u0(ni - 1, 0);
@@ -185,7 +208,7 @@ void interiorSeparable(const BlockFaces& F, const std::array<const double*, 12>&
  * count is bounded so the result is deterministic.
  */
 void interiorCoupled(const BlockFaces& F, const std::array<const double*, 12>& p, int ni, int nj,
-  int kBegin, int kEnd, double* out)
+  int kBegin, int kEnd, const std::array<Blending, 3>& blending, double* out)
 {
   constexpr int maxSweeps = 50;
   constexpr double tolerance = 1e-15;
@@ -235,6 +258,9 @@ void interiorCoupled(const BlockFaces& F, const std::array<const double*, 12>& p
             break;
           }
         }
+        s = weight(s, blending[0]);
+        t = weight(t, blending[1]);
+        u = weight(u, blending[2]);
         const double s1 = 1 - s, t1 = 1 - t, u1 = 1 - u;
         const double* E0 = F.u0(i, 0);
         const double* E2 = F.u0(i, nj - 1);
@@ -263,7 +289,7 @@ void interiorCoupled(const BlockFaces& F, const std::array<const double*, 12>& p
 } // namespace
 
 void transfiniteFace(const EdgeNodes& bottom, const EdgeNodes& top, const EdgeNodes& left,
-  const EdgeNodes& right, double* out)
+  const EdgeNodes& right, double* out, std::array<Blending, 2> blending)
 {
   const int ni = bottom.count;
   const int nj = left.count;
@@ -302,8 +328,8 @@ void transfiniteFace(const EdgeNodes& bottom, const EdgeNodes& top, const EdgeNo
       const double sB = bottom.params[i];
       const double ds = top.params[i] - sB;
       const double denominator = 1.0 - ds * dt;
-      const double s = (sB + tL * ds) / denominator;
-      const double t = (tL + sB * dt) / denominator;
+      const double s = weight((sB + tL * ds) / denominator, blending[0]);
+      const double t = weight((tL + sB * dt) / denominator, blending[1]);
       const double* B = bottom.xyz + 3 * i;
       const double* T = top.xyz + 3 * i;
       for (int c = 0; c < 3; ++c)
@@ -383,11 +409,12 @@ void transfiniteBlock(const BlockBoundary& boundary, int ni, int nj, int nk, dou
       const int kEnd = 1 + static_cast<int>(layers * (chunk + 1) / chunks);
       if (separable)
       {
-        interiorSeparable(faces, p, ni, nj, kBegin, kEnd, uFaceDifference.data(), out);
+        interiorSeparable(
+          faces, p, ni, nj, nk, kBegin, kEnd, uFaceDifference.data(), boundary.blending, out);
       }
       else
       {
-        interiorCoupled(faces, p, ni, nj, kBegin, kEnd, out);
+        interiorCoupled(faces, p, ni, nj, kBegin, kEnd, boundary.blending, out);
       }
     });
 }

@@ -27,6 +27,22 @@
 
 namespace blockforge
 {
+/**
+ * How the interior blends its boundary. Linear: the weights are the node parameters
+ * (paper eqs. 3 and 6), so an interior grid line takes the fractions of the edges beside it:
+ * where it is shorter or longer than their blend, its end cells are too. EndCells: the
+ * weights are the parameters' smoothstep x^2 (3 - 2x), flat at both ends, so an interior
+ * line's end cells are the blend of the edges' end cells as lengths (the difference in
+ * length goes to its middle cells): two blocks whose edges end in matched cells keep
+ * matching cells across their interface all along it. Both interpolate the boundary
+ * exactly. Each direction has its own (s, t, u; a face's two).
+ */
+enum class Blending
+{
+  Linear,
+  EndCells
+};
+
 /// Nodes of one edge and their relative positions (distribution parameters) in [0, 1].
 struct EdgeNodes
 {
@@ -44,13 +60,15 @@ struct EdgeNodes
  * ni * nj * 3 doubles.
  */
 void transfiniteFace(const EdgeNodes& bottom, const EdgeNodes& top, const EdgeNodes& left,
-  const EdgeNodes& right, double* out);
+  const EdgeNodes& right, double* out,
+  std::array<Blending, 2> blending = { Blending::Linear, Blending::Linear });
 
 /// Boundary of one block in its local orientation (see the file comment).
 struct BlockBoundary
 {
   std::array<const double*, 6> faces{};    ///< face grids, interleaved xyz
   std::array<const double*, 12> edgeParams{}; ///< distribution parameters of each edge
+  std::array<Blending, 3> blending{ Blending::Linear, Blending::Linear, Blending::Linear };
 };
 
 /**

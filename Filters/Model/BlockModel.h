@@ -10,6 +10,7 @@
 #pragma once
 
 #include "../Core/Distribution.h"
+#include "../Core/Transfinite.h"
 #include "../Core/Types.h"
 
 #include <Eigen/Core>
@@ -261,6 +262,10 @@ struct Block
   /// Distribution law of each local edge (Transfinite.h numbering), in the local edge
   /// direction (increasing i, j or k).
   std::array<DistributionLaw, 12> laws{};
+  /// How the interior blends the boundary in i, j and k (`interpolation: end_cells` or
+  /// `{j: end_cells}`, Transfinite.h): also the faces this block owns (the first block
+  /// using a face makes its grid).
+  std::array<Blending, 3> blending{ Blending::Linear, Blending::Linear, Blending::Linear };
   SourceLocation where;
 };
 
@@ -287,11 +292,16 @@ struct Patch
   SourceLocation where;
 };
 
-/// Block faces whose grids lie on a surface carrier (format 2 `faces:` section).
+/// Block faces whose grids lie on a surface carrier (format 2 `faces:` section), or
+/// (followOpposite, carrier -1) whose grids follow the opposite face of their block: the
+/// Coons patch of the face's own edges plus the opposite face's departure from the Coons
+/// patch of its edges, so that an O-grid's outer face keeps the blade face's bulge between
+/// hub and shroud (`{follow: opposite, faces: [...]}`).
 struct SurfaceFaces
 {
   std::string name;
   int carrier = -1;
+  bool followOpposite = false;
   std::vector<BlockFace> faces;
   SourceLocation where;
 };

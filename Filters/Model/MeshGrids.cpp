@@ -74,6 +74,38 @@ MeshTopology buildMeshTopology(const BlockModel& model, const CarrierGeometry& g
     static_cast<BlockLinks&>(mesh) = links;
     topology.blocks.push_back(std::move(mesh));
   }
+  // faces that follow the face opposite them in their block (made after it)
+  for (const SurfaceFaces& set : model.surfaceFaces)
+  {
+    if (!set.followOpposite)
+    {
+      continue;
+    }
+    for (const BlockFace& named : set.faces)
+    {
+      const MeshLinks& links = topology.blocks[named.block];
+      const int unique = links.face[named.face];
+      const int opposite = links.face[named.face ^ 1];
+      if (unique < 0 || opposite < 0)
+      {
+        fail(set.where, "face set '" + set.name + "'",
+          "face " + blockFaceText(model, named.block, named.face) +
+            " or the face opposite it is collapsed: a following face needs both");
+      }
+      topology.faces[unique].follows = named;
+      topology.faces[unique].opposite = opposite;
+    }
+  }
+  for (const UniqueFace& face : topology.faces)
+  {
+    if (face.opposite >= 0 && topology.faces[face.opposite].opposite >= 0)
+    {
+      fail(model.blocks[face.follows.block].where, blockEntity(model, face.follows.block),
+        "face " + blockFaceText(model, face.follows.block, face.follows.face) +
+          " follows a face that follows another: the face a following face follows must lie on a "
+          "surface or come from its edges");
+    }
+  }
   // graded edges first: matched edges take their end cells from them, projected edges
   // their nodes
   buildMatchGroups(model, topology);
@@ -287,6 +319,14 @@ void checkCornerCells(const BlockModel& model, const MeshTopology& topology, int
   }
 }
 
+/// The blending of the face's two directions (the block's, Transfinite.h).
+static std::array<Blending, 2> faceBlending(const BlockModel& model, int block, int face)
+{
+  const std::array<int, 2> directions = faceDirections(face);
+  const auto& blending = model.blocks[block].blending;
+  return { blending[directions[0]], blending[directions[1]] };
+}
+
 /// Face grid of `face` of `block` in the block's own orientation, from its four edges.
 void faceFromEdges(const BlockModel& model, const MeshTopology& topology, int block, int face,
   std::vector<double>& out)
@@ -297,7 +337,8 @@ void faceFromEdges(const BlockModel& model, const MeshTopology& topology, int bl
   const LocalEdge left = localEdge(model, topology, block, edges[2]);
   const LocalEdge right = localEdge(model, topology, block, edges[3]);
   out.resize(3 * static_cast<std::size_t>(bottom.count) * left.count);
-  transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data());
+  transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data(),
+    faceBlending(model, block, face));
 }
 
 void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& curves,
@@ -679,7 +720,8 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
     follow(k, k + 1);
   }
   out.resize(3 * static_cast<std::size_t>(na) * nb);
-  surfaceFaceGrid(surface, st, bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data());
+  surfaceFaceGrid(surface, st, bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data(),
+    SurfaceFaceMethod::Guarded, nullptr, faceBlending(model, block, face));
 }
 
 void copyFaceBoundary(const BlockModel& model, const MeshTopology& topology, int block, int face,
@@ -730,6 +772,10 @@ std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopolo
   std::map<int, int> carriers;
   for (const SurfaceFaces& set : model.surfaceFaces)
   {
+    if (set.followOpposite)
+    {
+      continue;
+    }
     for (const BlockFace& face : set.faces)
     {
       const int unique = topology.blocks[face.block].face[face.face];
@@ -787,6 +833,73 @@ void snapLineFace(std::vector<double>& xyz, int na, int nb)
 }
 } // namespace
 
+namespace
+{
+/// The grid of unique face `unique` in the orientation of `block`'s local face `local`.
+void localFaceGrid(const MeshTopology& topology, int block, int local, int unique,
+  std::vector<double>& out)
+{
+  const MeshLinks& links = topology.blocks[block];
+  const UniqueFace& face = topology.faces[unique];
+  const int na = links.nodes[faceDirections(local)[0]], nb = links.nodes[faceDirections(local)[1]];
+  out.resize(3 * static_cast<std::size_t>(na) * nb);
+  for (int b = 0; b < nb; ++b)
+  {
+    for (int a = 0; a < na; ++a)
+    {
+      int ownerA = 0, ownerB = 0;
+      links.transform[local].map(a, b, face.na, face.nb, ownerA, ownerB);
+      std::copy_n(&face.xyz[3 * (static_cast<std::size_t>(ownerB) * face.na + ownerA)], 3,
+        &out[3 * (static_cast<std::size_t>(b) * na + a)]);
+    }
+  }
+}
+
+/**
+ * A face that follows the face opposite it in its block: the Coons patch of its own edges
+ * plus, at every interior node, the opposite face's departure from the Coons patch of the
+ * opposite face's edges. Why: an O-grid's outer face made from its edges alone is the
+ * ruled surface between the hub and shroud offsets, while the blade face between them
+ * bulges (Rotor 37's suction side by 1 mm of the O-grid's 1.65 mm at mid-span): the O-grid
+ * was 0.4 times as thick there and its outer cells 2.4 times smaller than the H block's
+ * beside them. Boundary nodes are the edges' own (bit for bit); two blocks' faces that
+ * both come from their edges are unchanged.
+ */
+void followOppositeFace(const BlockModel& model, MeshTopology& topology, int f)
+{
+  UniqueFace& face = topology.faces[f];
+  const int block = face.follows.block, local = face.follows.face;
+  std::vector<double> own, opposite, oppositeCoons;
+  faceFromEdges(model, topology, block, local, own);
+  faceFromEdges(model, topology, block, local ^ 1, oppositeCoons);
+  localFaceGrid(topology, block, local ^ 1, face.opposite, opposite);
+  const MeshLinks& links = topology.blocks[block];
+  const int na = links.nodes[faceDirections(local)[0]], nb = links.nodes[faceDirections(local)[1]];
+  for (int b = 1; b + 1 < nb; ++b)
+  {
+    for (int a = 1; a + 1 < na; ++a)
+    {
+      const std::size_t n = 3 * (static_cast<std::size_t>(b) * na + a);
+      for (int c = 0; c < 3; ++c)
+      {
+        own[n + c] += opposite[n + c] - oppositeCoons[n + c];
+      }
+    }
+  }
+  face.xyz.resize(3 * static_cast<std::size_t>(face.na) * face.nb);
+  for (int b = 0; b < nb; ++b)
+  {
+    for (int a = 0; a < na; ++a)
+    {
+      int ownerA = 0, ownerB = 0;
+      links.transform[local].map(a, b, face.na, face.nb, ownerA, ownerB);
+      std::copy_n(&own[3 * (static_cast<std::size_t>(b) * na + a)], 3,
+        &face.xyz[3 * (static_cast<std::size_t>(ownerB) * face.na + ownerA)]);
+    }
+  }
+}
+} // namespace
+
 void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
   const std::map<int, int>& onSurface, MeshTopology& topology, int f, ProjectionCache* cache)
 {
@@ -795,7 +908,11 @@ void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
   try
   {
     const auto surface = onSurface.find(f);
-    if (surface != onSurface.end())
+    if (face.opposite >= 0)
+    {
+      followOppositeFace(model, topology, f);
+    }
+    else if (surface != onSurface.end())
     {
       surfaceFace(model, topology, geometry, surface->second, owner.block, owner.face, face.xyz, cache);
     }
@@ -854,7 +971,31 @@ BoundaryNeeds boundaryNeeds(const MeshTopology& topology, const std::vector<Edge
       }
     }
   }
-  // A face grid is made from its owner's four edges.
+  // A following face is made from the face opposite it.
+  for (std::size_t f = 0; f < topology.faces.size(); ++f)
+  {
+    if (needs.faces[f] && topology.faces[f].opposite >= 0)
+    {
+      needs.faces[topology.faces[f].opposite] = 1;
+    }
+  }
+  // A face grid is made from its owner's four edges (a following face also from the four
+  // edges of the face opposite it, in the same block).
+  for (std::size_t f = 0; f < topology.faces.size(); ++f)
+  {
+    if (needs.faces[f] && topology.faces[f].opposite >= 0)
+    {
+      const BlockFace& named = topology.faces[f].follows;
+      for (const int local : faceEdges(named.face ^ 1))
+      {
+        const int edge = topology.blocks[named.block].edge[local];
+        if (edge >= 0)
+        {
+          needs.edges[edge] = 1;
+        }
+      }
+    }
+  }
   for (std::size_t f = 0; f < topology.faces.size(); ++f)
   {
     if (!needs.faces[f])
@@ -938,7 +1079,14 @@ void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geomet
   // runner is installed, with the same bits, and the error of the first failing face in
   // face order.
   forEachChunk(static_cast<long>(topology.faces.size()), [&](long f) {
-    if (!isImage[f] && faceNeeded(static_cast<std::size_t>(f)))
+    if (!isImage[f] && faceNeeded(static_cast<std::size_t>(f)) && topology.faces[f].opposite < 0)
+    {
+      computeFaceGrid(model, geometry, onSurface, topology, static_cast<int>(f));
+    }
+  });
+  // then the faces that follow those opposite them
+  forEachChunk(static_cast<long>(topology.faces.size()), [&](long f) {
+    if (!isImage[f] && faceNeeded(static_cast<std::size_t>(f)) && topology.faces[f].opposite >= 0)
     {
       computeFaceGrid(model, geometry, onSurface, topology, static_cast<int>(f));
     }
@@ -997,6 +1145,7 @@ void meshBlockNodes(const BlockModel& model, const MeshTopology& topology, int b
     edges[e] = localEdge(model, topology, block, e);
     boundary.edgeParams[e] = edges[e].params();
   }
+  boundary.blending = model.blocks[block].blending;
   transfiniteBlock(boundary, links.nodes[0], links.nodes[1], links.nodes[2], out);
 }
 } // namespace model

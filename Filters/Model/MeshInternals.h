@@ -133,6 +133,10 @@ struct UniqueEdge : TopologyEdge
 struct UniqueFace : TopologyFace
 {
   std::vector<double> xyz;
+  /// A face of a `follow: opposite` set: the block face that names it and the unique face
+  /// opposite it in that block (made first); opposite -1 for every other face.
+  BlockFace follows;
+  int opposite = -1;
 };
 
 struct MeshLinks : BlockLinks
@@ -322,7 +326,8 @@ void periodicFace(const BlockModel& model, const MeshTopology& topology, const P
   std::vector<double>& out);
 /// Unique face -> surface carrier of the model's surface face sets.
 std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopology& topology);
-/// The grid of unique face f (not a periodic image), on its surface carrier if it has one.
+/// The grid of unique face f (not a periodic image), on its surface carrier if it has one;
+/// a following face (UniqueFace::opposite) after the face it follows.
 void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
   const std::map<int, int>& onSurface, MeshTopology& topology, int f,
   ProjectionCache* cache = nullptr);

@@ -430,8 +430,19 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
   // balances better than whole faces of unequal cost.
   for (std::size_t f = 0; f < Topo.faces.size(); ++f)
   {
-    if (changedFace[f] && !IsImage[f])
+    if (changedFace[f] && !IsImage[f] && Topo.faces[f].opposite < 0)
     {
+      saveFace(static_cast<int>(f));
+      computeFaceGrid(model, Geometry, OnSurface, Topo, static_cast<int>(f), &Projections);
+    }
+  }
+  // Faces that follow the face opposite them: after it, also when only it changed.
+  for (std::size_t f = 0; f < Topo.faces.size(); ++f)
+  {
+    const int opposite = Topo.faces[f].opposite;
+    if (opposite >= 0 && (changedFace[f] || changedFace[opposite]) && !IsImage[f])
+    {
+      changedFace[f] = 1;
       saveFace(static_cast<int>(f));
       computeFaceGrid(model, Geometry, OnSurface, Topo, static_cast<int>(f), &Projections);
     }

@@ -341,7 +341,8 @@ void checkSurfaceFaces(const BlockModel& model, const CarrierGeometry& geometry,
   for (const SurfaceFaces& set : model.surfaceFaces)
   {
     const std::string entityText = entity("face set", set.name);
-    if (set.carrier < 0 || set.carrier >= carrierCount || !geometry.isSurface(set.carrier))
+    if (!set.followOpposite &&
+      (set.carrier < 0 || set.carrier >= carrierCount || !geometry.isSurface(set.carrier)))
     {
       fail(set.where, entityText, "needs a surface carrier");
     }
@@ -356,6 +357,33 @@ void checkSurfaceFaces(const BlockModel& model, const CarrierGeometry& geometry,
       {
         fail(set.where, entityText,
           "face " + blockFaceText(model, face.block, face.face) + " is collapsed to a line or a point");
+      }
+      if (set.followOpposite)
+      {
+        // its grid comes from the face opposite it: that face must be one (that it does not
+        // follow a face itself is checked with the mesher's topology, buildMeshTopology)
+        const int opposite = topology.blocks[face.block].face[face.face ^ 1];
+        if (opposite < 0)
+        {
+          fail(set.where, entityText,
+            "face " + blockFaceText(model, face.block, face.face ^ 1) +
+              ", opposite the following face " + blockFaceText(model, face.block, face.face) +
+              ", is collapsed to a line or a point");
+        }
+        for (const SurfaceFaces& other : model.surfaceFaces)
+        {
+          for (const BlockFace& named : other.faces)
+          {
+            const int unique = topology.blocks[named.block].face[named.face];
+            if (unique == topology.blocks[face.block].face[face.face] && &other != &set)
+            {
+              fail(set.where, entityText,
+                "face " + blockFaceText(model, face.block, face.face) + " is also in face set '" +
+                  other.name + "': a face follows the face opposite it or lies on a surface, not both");
+            }
+          }
+        }
+        continue;
       }
       for (int corner : faceVertexIds(model.blocks[face.block], face.face))
       {

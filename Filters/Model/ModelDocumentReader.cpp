@@ -613,7 +613,7 @@ private:
   {
     Block block;
     const auto keys =
-      entries(node, "block", { "vertices", "cells", "min_cells", "laws" }, block.name, block.where);
+      entries(node, "block", { "vertices", "cells", "min_cells", "laws", "interpolation" }, block.name, block.where);
     const std::string entityText = entity("block", block.name);
     const MapEntry& vertices = required(keys, "vertices", node, entityText);
     if (!vertices.value.IsSequence() || vertices.value.size() != 8)
@@ -651,6 +651,10 @@ private:
           fail(least->line, entityText, "min_cells must be at least 1");
         }
       }
+    }
+    if (const MapEntry* interpolation = syntax::findEntry(keys, "interpolation"))
+    {
+      block.blending = syntax::parseBlending(interpolation->value, interpolation->line, entityText, Report);
     }
     const MapEntry& laws = required(keys, "laws", node, entityText);
     if (!laws.value.IsSequence() || laws.value.size() != 12)
@@ -746,10 +750,22 @@ private:
   void readFaces(const YAML::Node& node)
   {
     SurfaceFaces set;
-    const auto keys = entries(node, "face set", { "on_surface", "faces" }, set.name, set.where);
+    const auto keys = entries(node, "face set", { "on_surface", "follow", "faces" }, set.name, set.where);
     const std::string entityText = entity("face set", set.name);
-    const MapEntry& surface = required(keys, "on_surface", node, entityText);
-    set.carrier = carrierRef(surface.value, surface.line, entityText);
+    const MapEntry* follow = syntax::findEntry(keys, "follow");
+    if (follow)
+    {
+      if (!(follow->value.IsScalar() && follow->value.Scalar() == "opposite"))
+      {
+        fail(follow->line, entityText, "'follow' must be 'opposite'");
+      }
+      set.followOpposite = true;
+    }
+    else
+    {
+      const MapEntry& surface = required(keys, "on_surface", node, entityText);
+      set.carrier = carrierRef(surface.value, surface.line, entityText);
+    }
     const MapEntry& faces = required(keys, "faces", node, entityText);
     if (!faces.value.IsSequence())
     {

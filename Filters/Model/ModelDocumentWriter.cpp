@@ -372,6 +372,7 @@ std::string writeModelDocument(const BlockModel& model)
       syntax::emitLaw(out, law, model);
     }
     out << YAML::EndSeq;
+    syntax::emitBlending(out, block.blending);
     emitWhere(out, block.where, model);
     out << YAML::EndMap;
   }
@@ -385,7 +386,14 @@ std::string writeModelDocument(const BlockModel& model)
       const std::string user = entity("face set", set.name);
       out << YAML::BeginMap;
       out << YAML::Key << "name" << YAML::Value << set.name;
-      out << YAML::Key << "on_surface" << YAML::Value << carrierName(set.carrier, user);
+      if (set.followOpposite)
+      {
+        out << YAML::Key << "follow" << YAML::Value << "opposite";
+      }
+      else
+      {
+        out << YAML::Key << "on_surface" << YAML::Value << carrierName(set.carrier, user);
+      }
       out << YAML::Key << "faces" << YAML::Value << YAML::Flow << YAML::BeginSeq;
       for (const BlockFace& face : set.faces)
       {

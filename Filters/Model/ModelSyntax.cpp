@@ -270,6 +270,61 @@ const char* const LawSyntax =
   "{project_from: edge, fade: k} (or fade: [k_first, k_last])";
 }
 
+std::array<Blending, 3> parseBlending(
+  const YAML::Node& node, int line, const std::string& entityText, const Reporter& reporter)
+{
+  const int here = lineOf(node) ? lineOf(node) : line;
+  const auto one = [&](const YAML::Node& value, int at) {
+    if (value.IsScalar() && value.Scalar() == "linear")
+    {
+      return Blending::Linear;
+    }
+    if (value.IsScalar() && value.Scalar() == "end_cells")
+    {
+      return Blending::EndCells;
+    }
+    reporter.fail(at, entityText,
+      "'interpolation' must be 'linear' (the default: interior lines take the edges' "
+      "fractions), 'end_cells' (interior lines keep the edges' end cells as lengths) or "
+      "{i: .., j: .., k: ..} of those");
+  };
+  if (!node.IsMap())
+  {
+    const Blending all = one(node, here);
+    return { all, all, all };
+  }
+  const auto keys = mapEntries(node, here, entityText, "'interpolation'", reporter);
+  checkKeys(keys, { "i", "j", "k" }, entityText, reporter);
+  std::array<Blending, 3> blending{ Blending::Linear, Blending::Linear, Blending::Linear };
+  for (int d = 0; d < 3; ++d)
+  {
+    if (const MapEntry* entry = findEntry(keys, std::string(1, static_cast<char>('i' + d))))
+    {
+      blending[d] = one(entry->value, entry->line);
+    }
+  }
+  return blending;
+}
+
+void emitBlending(YAML::Emitter& out, const std::array<Blending, 3>& blending)
+{
+  const auto name = [](Blending b) { return b == Blending::EndCells ? "end_cells" : "linear"; };
+  if (blending[0] == blending[1] && blending[1] == blending[2])
+  {
+    if (blending[0] != Blending::Linear)
+    {
+      out << YAML::Key << "interpolation" << YAML::Value << name(blending[0]);
+    }
+    return;
+  }
+  out << YAML::Key << "interpolation" << YAML::Value << YAML::Flow << YAML::BeginMap;
+  for (int d = 0; d < 3; ++d)
+  {
+    out << YAML::Key << std::string(1, static_cast<char>('i' + d)) << YAML::Value << name(blending[d]);
+  }
+  out << YAML::EndMap;
+}
+
 DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entityText,
   const std::string& what, const NumberReader& number, const Reporter& reporter,
   const EdgeReader& edges)

@@ -96,6 +96,12 @@ using EdgeReader = std::function<int(const YAML::Node& node, int line, const std
 DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& entity,
   const std::string& what, const NumberReader& number, const Reporter& reporter,
   const EdgeReader& edges = EdgeReader());
+/// A block's `interpolation` (Blending, Core/Transfinite.h) in i, j and k: `linear` or
+/// `end_cells` for all three, or `{i: .., j: .., k: ..}` (a direction not given: linear).
+std::array<Blending, 3> parseBlending(
+  const YAML::Node& node, int line, const std::string& entity, const Reporter& reporter);
+/// Writes a block's `interpolation` as parseBlending reads it (nothing when all linear).
+void emitBlending(YAML::Emitter& out, const std::array<Blending, 3>& blending);
 /// Writes a law in the syntax parseLaw reads, numbers with formatNumber, edges by their
 /// names in `model`.
 void emitLaw(YAML::Emitter& out, const DistributionLaw& law, const BlockModel& model);

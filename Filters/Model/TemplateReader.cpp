@@ -343,7 +343,7 @@ void TemplateReader::readBlocks()
     }
     const auto keys =
       syntax::mapEntries(entry.value, entry.line, entityText, "the block", Report);
-    syntax::checkKeys(keys, { "vertices", "cells", "min_cells", "grading" }, entityText, Report);
+    syntax::checkKeys(keys, { "vertices", "cells", "min_cells", "grading", "interpolation" }, entityText, Report);
     Block block;
     block.name = entry.key;
     block.where = where(entry.line);
@@ -422,6 +422,10 @@ void TemplateReader::readBlocks()
     if (const MapEntry* grading = syntax::findEntry(keys, "grading"))
     {
       readGrading(*grading, entityText, block);
+    }
+    if (const MapEntry* interpolation = syntax::findEntry(keys, "interpolation"))
+    {
+      block.blending = syntax::parseBlending(interpolation->value, interpolation->line, entityText, Report);
     }
     Model.blocks.push_back(block);
   }
@@ -837,7 +841,8 @@ void TemplateReader::readEdgeV2(const MapEntry& entry, const std::string& entity
   addEdge(edge, entry.line, entityText);
 }
 
-/// Faces whose grids lie on surfaces: {on_surface: S, faces: [block.face | [4 vertices]]}.
+/// Faces whose grids lie on surfaces: {on_surface: S, faces: [block.face | [4 vertices]]};
+/// or that follow the face opposite them in their block: {follow: opposite, faces: [...]}.
 void TemplateReader::readFaces()
 {
   const MapEntry* faces = section("faces");
@@ -855,13 +860,24 @@ void TemplateReader::readFaces()
       fail(entry.line, entityText, "expected {on_surface: S, faces: [block.face, ...]}");
     }
     const auto keys = syntax::mapEntries(entry.value, entry.line, entityText, "the face set", Report);
-    syntax::checkKeys(keys, { "on_surface", "faces" }, entityText, Report);
+    syntax::checkKeys(keys, { "on_surface", "follow", "faces" }, entityText, Report);
     const MapEntry* surface = syntax::findEntry(keys, "on_surface");
+    const MapEntry* follow = syntax::findEntry(keys, "follow");
     const MapEntry* list = syntax::findEntry(keys, "faces");
-    if (!surface)
+    if (!surface && !follow)
     {
       fail(entry.line, entityText,
-        "needs 'on_surface: <surface carrier>' (periodic faces come from periodic patches)");
+        "needs 'on_surface: <surface carrier>' or 'follow: opposite' (periodic faces come "
+        "from periodic patches)");
+    }
+    if (surface && follow)
+    {
+      fail(follow->line, entityText, "has both 'on_surface' and 'follow': give one");
+    }
+    if (follow && !(follow->value.IsScalar() && follow->value.Scalar() == "opposite"))
+    {
+      fail(follow->line, entityText,
+        "'follow' must be 'opposite' (each face follows the face opposite it in its block)");
     }
     if (!list || !list->value.IsSequence() || list->value.size() == 0)
     {
@@ -871,10 +887,18 @@ void TemplateReader::readFaces()
     SurfaceFaces set;
     set.name = entry.key;
     set.where = where(entry.line);
-    set.carrier = carrierRef(surface->value, surface->line, entityText, "on_surface", Want::Surface);
+    if (surface)
+    {
+      set.carrier = carrierRef(surface->value, surface->line, entityText, "on_surface", Want::Surface);
+    }
+    set.followOpposite = follow != nullptr;
     for (std::size_t f = 0; f < list->value.size(); ++f)
     {
       const YAML::Node item = list->value[f];
+      if (item.IsSequence() && follow)
+      {
+        fail(list->line, entityText, "a following face must be given as block.face (its block says which face is opposite)");
+      }
       if (item.IsSequence())
       {
         set.faces.push_back(faceByVertices(item, list->line, entityText));

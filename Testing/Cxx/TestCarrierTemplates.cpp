@@ -1828,6 +1828,102 @@ TEST(CarrierTemplates, FollowEdgeIsItsSourceMoved)
       "edge 'along': a follow edge takes its shape from its source edge, not from 'at'");
 }
 
+// A face that follows the face opposite it ({follow: opposite}): its interior is the Coons
+// patch of its own edges plus the opposite face's departure from the Coons patch of that
+// face's edges. Here the box's i0 face lies on a dome whose boundary is the flat square
+// x = 10 (the Coons patch of its edges is that plane) and whose middle bulges to x = 9.7;
+// the i1 face's edges are the i0 face's moved by +1 in x, so i1 is i0 moved by +1 in x,
+// bulge and all (without the face set it is the flat square x = 11).
+TEST(CarrierTemplates, FollowingFaceKeepsTheOppositeFacesBulge)
+{
+  const std::string head = "carriers:\n"
+                           "  c0: {interpolate: [[10, 0, 0], [10, 0.5, 0], [10, 1, 0]], degree: 2}\n"
+                           "  c1: {interpolate: [[10, 0, 0.5], [9.7, 0.5, 0.5], [10, 1, 0.5]], degree: 2}\n"
+                           "  c2: {interpolate: [[10, 0, 1], [10, 0.5, 1], [10, 1, 1]], degree: 2}\n"
+                           "  dome: {gordon: [c0, c1, c2], blending: spline, at: [0, 0.5, 1]}\n";
+  const std::string faces = "faces:\n"
+                            "  wall: {on_surface: dome, faces: [box.i0]}\n"
+                            "  outer: {follow: opposite, faces: [box.i1]}\n";
+  const std::string text = featureText(head, "", faces);
+  const BlockModel model = parseFeature(text);
+  for (const double density : { 1.0, 2.0 })
+  {
+    SCOPED_TRACE(density);
+    const Grid grid = meshAll(model, density);
+    const auto& n = grid.nodes[0];
+    double worst = 0.0, bulge = 0.0;
+    for (int k = 0; k < n[2]; ++k)
+    {
+      for (int j = 0; j < n[1]; ++j)
+      {
+        const Vec3 wall = grid.at(0, 0, j, k), outer = grid.at(0, n[0] - 1, j, k);
+        worst = std::max(worst, (outer - wall - Vec3(1, 0, 0)).norm());
+        bulge = std::max(bulge, 10.0 - wall.x());
+      }
+    }
+    EXPECT_LT(worst, 1e-12);
+    EXPECT_GT(bulge, 0.25); // the wall bulges, so the check means something
+  }
+  // without the set the outer face is the flat square
+  const Grid flat = meshAll(parseFeature(featureText(head, "",
+    "faces:\n  wall: {on_surface: dome, faces: [box.i0]}\n")));
+  const auto& n = flat.nodes[0];
+  EXPECT_EQ(flat.at(0, n[0] - 1, n[1] / 2, n[2] / 2).x(), 11.0);
+  // the document keeps it
+  const Grid grid = meshAll(model);
+  const Grid again = meshAll(documentRoundTrip(model));
+  EXPECT_TRUE(sameBits(grid.xyz[0], again.xyz[0]));
+  // errors
+  auto errorFor = [&](const std::string& faceLines) {
+    return errorOf([&] { parseFeature(featureText(head, "", "faces:\n" + faceLines)); });
+  };
+  const std::string same = "  outer: {follow: same, faces: [box.i1]}\n";
+  EXPECT_EQ(errorFor(same), featureLine(featureText(head, "", "faces:\n" + same), "  outer:") +
+      "face set 'outer': 'follow' must be 'opposite' (each face follows the face opposite it in "
+      "its block)");
+  const std::string both = "  outer: {follow: opposite, on_surface: dome, faces: [box.i1]}\n";
+  EXPECT_EQ(errorFor(both), featureLine(featureText(head, "", "faces:\n" + both), "  outer:") +
+      "face set 'outer': has both 'on_surface' and 'follow': give one");
+  const std::string chain = "  outer: {follow: opposite, faces: [box.i1, box.i0]}\n";
+  EXPECT_EQ(errorFor(chain), featureLine(featureText(head, "", "faces:\n" + chain), "  box:") +
+      "block 'box': face box.i0 follows a face that follows another: the face a following face "
+      "follows must lie on a surface or come from its edges");
+}
+
+// A block's `interpolation` (Core/Transfinite.h Blending): read, written to the document,
+// used by the mesher (a block whose i-edges end in cells of 0.025, its i1 face bulging out
+// by 0.6: with end_cells in i the first cell of the middle i-line is 0.025 within 2e-3,
+// linear gives it the edges' fraction of that longer line, 0.04), and its errors.
+TEST(CarrierTemplates, InterpolationEndCells)
+{
+  const std::string edges = "edges:\n"
+                            "  bulge: {spline: [b, f], points: [[11.6, 0, 0.5]]}\n"
+                            "  bulge2: {spline: [c, g], points: [[11.6, 1, 0.5]]}\n";
+  const std::string law = "grading: {i: {ends: [0.1, 0.1]}}";
+  std::string text = featureText("", "", edges);
+  text = replaced(text, "cells: [4, 4, 4]}", "cells: [4, 4, 4], " + law + "}");
+  const auto firstCell = [](const BlockModel& model) {
+    const Grid grid = meshAll(model);
+    return (grid.at(0, 1, 2, 2) - grid.at(0, 0, 2, 2)).norm();
+  };
+  const BlockModel linear = parseFeature(text);
+  const BlockModel ends = parseFeature(replaced(text, law + "}", law + ", interpolation: {i: end_cells}}"));
+  EXPECT_EQ(ends.blocks[0].blending[0], Blending::EndCells);
+  EXPECT_EQ(ends.blocks[0].blending[1], Blending::Linear);
+  EXPECT_NEAR(firstCell(ends), 0.025, 2e-3);
+  EXPECT_NEAR(firstCell(linear), 0.04, 2e-3);
+  const BlockModel all = parseFeature(replaced(text, law + "}", law + ", interpolation: end_cells}"));
+  EXPECT_EQ(all.blocks[0].blending[2], Blending::EndCells);
+  // the document keeps it
+  EXPECT_TRUE(sameBits(meshAll(ends).xyz[0], meshAll(documentRoundTrip(ends)).xyz[0]));
+  EXPECT_EQ(documentRoundTrip(all).blocks[0].blending[1], Blending::EndCells);
+  const std::string wrong = replaced(text, law + "}", law + ", interpolation: smooth}");
+  EXPECT_EQ(errorOf([&] { parseFeature(wrong); }), featureLine(wrong, "  box:") +
+      "block 'box': 'interpolation' must be 'linear' (the default: interior lines take the edges' "
+      "fractions), 'end_cells' (interior lines keep the edges' end cells as lengths) or {i: .., "
+      "j: .., k: ..} of those");
+}
+
 // A min/max objective that is NaN somewhere, or that gives several values, is an error
 // naming the vertex (a NaN never compares smaller, so it would silently pick the window's
 // start).

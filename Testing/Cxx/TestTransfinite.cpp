@@ -219,6 +219,139 @@ TEST(TransfiniteFace, ReproducesAffineMapWithDifferentParametersOnOppositeEdges)
   }
 }
 
+// Blending::EndCells: a face whose bottom edge (length 1) and top edge (length 2) both
+// start and end with cells of 0.01 (as matched edges do), its right side bulging out by
+// 0.5 in the middle, so the rows there are longer than the blend of the bottom and top.
+// Linear blending gives a row the blended fractions of its own length: the middle row
+// starts with 0.0075 of a row 0.5 longer than the blend, 0.0137; end-cell blending keeps
+// 0.01 within 2e-4 on every row (the first node's weight is h(s) ~ 2e-4, not s). The
+// edges are the face's bit for bit either way, and a unit square stays the unit square.
+TEST(TransfiniteFace, EndCellBlendingKeepsTheEdgesEndCells)
+{
+  const int ni = 21, nj = 9;
+  const auto ends = [&](double length) {
+    // first and last cells 0.01, uniform between
+    std::vector<double> p(ni);
+    const double middle = (length - 0.02) / (ni - 3);
+    for (int i = 0; i < ni; ++i)
+    {
+      p[i] = i == 0 ? 0.0 : (i == ni - 1 ? 1.0 : (0.01 + (i - 1) * middle) / length);
+    }
+    return p;
+  };
+  const std::vector<double> uniform = graded(nj, 1.0);
+  const auto line = [](const Vec3& a, const Vec3& b, const std::vector<double>& params) {
+    Edge e;
+    e.params = params;
+    for (double p : params)
+    {
+      const Vec3 x = a + p * (b - a);
+      e.xyz.insert(e.xyz.end(), { x.x(), x.y(), x.z() });
+    }
+    return e;
+  };
+  const Edge bottom = line({ 0, 0, 0 }, { 1, 0, 0 }, ends(1.0));
+  const Edge top = line({ -0.5, 1, 0 }, { 1.5, 1, 0 }, ends(2.0));
+  const Edge left = line({ 0, 0, 0 }, { -0.5, 1, 0 }, uniform);
+  Edge right = line({ 1, 0, 0 }, { 1.5, 1, 0 }, uniform);
+  for (int j = 0; j < nj; ++j)
+  {
+    right.xyz[3 * j] += 2.0 * uniform[j] * (1.0 - uniform[j]); // bulge 0.5 in the middle
+  }
+  std::vector<double> linear(3 * ni * nj), endCells(3 * ni * nj);
+  transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), linear.data());
+  transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), endCells.data(),
+    { Blending::EndCells, Blending::EndCells });
+  for (int j = 1; j + 1 < nj; ++j)
+  {
+    const double first = (node(endCells, 1 + ni * j) - node(endCells, ni * j)).norm();
+    const double last = (node(endCells, ni - 1 + ni * j) - node(endCells, ni - 2 + ni * j)).norm();
+    EXPECT_NEAR(first, 0.01, 2e-4) << j;
+    EXPECT_NEAR(last, 0.01, 2e-4) << j;
+  }
+  EXPECT_NEAR((node(linear, 1 + ni * 4) - node(linear, ni * 4)).norm(), 0.0137, 2e-4);
+  for (int i = 0; i < ni; ++i)
+  {
+    EXPECT_EQ(0, std::memcmp(&endCells[3 * i], &bottom.xyz[3 * i], 3 * sizeof(double)));
+    EXPECT_EQ(0, std::memcmp(&endCells[3 * (i + ni * (nj - 1))], &top.xyz[3 * i], 3 * sizeof(double)));
+  }
+  // the unit square with uniform edges: the same nodes either way (the weights move the
+  // interior only where the boundary is not bilinear)
+  const std::vector<double> u = graded(5, 1.0);
+  const Edge b2 = line({ 0, 0, 0 }, { 1, 0, 0 }, u), t2 = line({ 0, 1, 0 }, { 1, 1, 0 }, u);
+  const Edge l2 = line({ 0, 0, 0 }, { 0, 1, 0 }, u), r2 = line({ 1, 0, 0 }, { 1, 1, 0 }, u);
+  std::vector<double> square(3 * 25);
+  transfiniteFace(b2.nodes(), t2.nodes(), l2.nodes(), r2.nodes(), square.data(),
+    { Blending::EndCells, Blending::EndCells });
+  for (int j = 0; j < 5; ++j)
+  {
+    for (int i = 0; i < 5; ++i)
+    {
+      EXPECT_LT((node(square, i + 5 * j) - Vec3(0.25 * i, 0.25 * j, 0)).norm(), 1e-15);
+    }
+  }
+}
+
+// The block interior with end-cell blending in one direction: a block whose i-edges end in
+// cells of 0.01 on a bottom of length 1 and a top of length 2 (k = 0 and k = 1), its i1
+// face bulging out by 0.5 half-way up, faces from those edges with the same blending:
+// every interior i-line starts with 0.01 within 2e-4 (linear: 0.0137 half-way up).
+TEST(TransfiniteBlock, EndCellBlendingKeepsTheEdgesEndCells)
+{
+  const int ni = 21, n = 5;
+  std::vector<double> bottom(ni), top(ni);
+  for (int i = 0; i < ni; ++i)
+  {
+    const double middle1 = 0.98 / (ni - 3), middle2 = 1.98 / (ni - 3);
+    bottom[i] = i == 0 ? 0.0 : (i == ni - 1 ? 1.0 : 0.01 + (i - 1) * middle1);
+    top[i] = i == 0 ? 0.0 : (i == ni - 1 ? 1.0 : (0.01 + (i - 1) * middle2) / 2.0);
+  }
+  const std::vector<double> uniform = graded(n, 1.0);
+  // x = s (1 + u) - u/2 + 2 s u (1 - u) (the i-edges at u = 1 twice as long, the face s = 1
+  // bulging), y = t, z = u
+  const PointMap map = [](double s, double t, double u) {
+    return Vec3(s * (1 + u) - 0.5 * u + 2.0 * s * u * (1 - u), t, u);
+  };
+  std::array<std::vector<double>, 12> params;
+  params[0] = params[2] = bottom;
+  params[4] = params[6] = top;
+  for (int e : { 1, 3, 5, 7, 8, 9, 10, 11 })
+  {
+    params[e] = uniform;
+  }
+  TestBlock b = buildBlock(map, params);
+  // faces and interior again with end-cell blending in i
+  const int faceEdges[6][4] = { { 3, 7, 8, 11 }, { 1, 5, 9, 10 }, { 0, 4, 8, 9 }, { 2, 6, 11, 10 },
+    { 0, 2, 3, 1 }, { 4, 6, 7, 5 } };
+  const int faceFirst[6] = { 1, 1, 0, 0, 0, 0 }; // direction of each face's first index
+  for (int f = 0; f < 6; ++f)
+  {
+    const auto& fe = faceEdges[f];
+    const Blending s = faceFirst[f] == 0 ? Blending::EndCells : Blending::Linear;
+    transfiniteFace(b.edges[fe[0]].nodes(), b.edges[fe[1]].nodes(), b.edges[fe[2]].nodes(),
+      b.edges[fe[3]].nodes(), b.faces[f].data(), { s, Blending::Linear });
+  }
+  BlockBoundary boundary = b.boundary();
+  boundary.blending = { Blending::EndCells, Blending::Linear, Blending::Linear };
+  std::vector<double> nodes(b.nodes.size());
+  transfiniteBlock(boundary, ni, n, n, nodes.data());
+  double worst = 0.0, linearMiddle = 0.0;
+  for (int k = 1; k + 1 < n; ++k)
+  {
+    for (int j = 1; j + 1 < n; ++j)
+    {
+      const long row = static_cast<long>(ni) * (j + static_cast<long>(n) * k);
+      worst = std::max(worst, std::abs((node(nodes, row + 1) - node(nodes, row)).norm() - 0.01));
+      if (k == 2)
+      {
+        linearMiddle = (node(b.nodes, row + 1) - node(b.nodes, row)).norm();
+      }
+    }
+  }
+  EXPECT_LT(worst, 2e-4);
+  EXPECT_NEAR(linearMiddle, 0.0137, 2e-4); // linear: the middle fraction of the longer middle
+}
+
 TEST(TransfiniteFace, RejectsMismatchedEdges)
 {
   const PointMap map = affineMap();

@@ -217,6 +217,10 @@ ControlProblem::ControlProblem(const BlockModel& model, const CarrierGeometry& g
   std::map<std::pair<int, int>, int> faceCarrier;
   for (const model::SurfaceFaces& set : base.surfaceFaces)
   {
+    if (set.followOpposite)
+    {
+      continue; // not on a carrier
+    }
     for (const model::BlockFace& face : set.faces)
     {
       faceCarrier[{ face.block, face.face }] = set.carrier;
