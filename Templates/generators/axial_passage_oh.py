@@ -168,7 +168,7 @@ parameters:
   k_span: 1.05            # expansion ratio away from hub and shroud (two-sided)
   side_arc_flat: 2        # the blade sides' O-grid arcs (law `match` from the O corners' cells, `flat`): between their small end cells the shape of the law `ends` with this flatness, not cells grown by o_match to a uniform middle (2.7 times the mean cell at density 0.5) ...
   period_end: 0.1         # ... and the periodic lines beside them (law `ends`): end cells this fraction of their mean cell ...
-  period_flat: 2.8        # ... and that flat in between, so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
+  period_flat: 3.0        # ... and that flat in between, so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
 """
 

@@ -565,12 +565,17 @@ TEST(OptimizerPassage, RejectedTrialsPutBackGiveTheSameSearch)
  * stays at 34.7 and 31.8 degrees: the shear is what lifts it. The bounds guard today's
  * values: 47.86 and 46.98 since the sides' O arcs `match` the O corners' cells (issue 8:
  * neighbour ratio on Rotor 37 at density 4 22.9 -> 4.1), 53.26 and 48.50 before (the
- * distributor's bound 48.5 -> 47.5, Rotor 37's 44.5 -> 46.5).
+ * distributor's bound 48.5 -> 47.5, Rotor 37's 44.5 -> 46.5). Stop 14 (the O-grid's outer
+ * faces follow the blade faces, end-cell interpolation in the H blocks beside the wake and
+ * inlet blocks, the blade faces' cell-size guard): 47.22 and 47.29, bounds 47.0 and 47.0;
+ * the end point of the search moves by 1-2 degrees with any change of the grid (period_flat
+ * 2.4 / 2.6 / 2.8 / 3.0 / 3.2: distributor 47.08 / 46.05 / 47.46 / 47.22 / 47.43, Rotor 37
+ * 47.45 / 46.61 / 44.17 / 47.29 / 47.32), so the bounds sit a little under today's values.
  */
 TEST(OptimizerPassage, ShearedOGridReachesFortyDegrees)
 {
   for (const auto& [machine, bound] :
-    { std::pair<const char*, double>{ "distributor", 47.5 }, { "rotor37/turbogrid", 46.5 } })
+    { std::pair<const char*, double>{ "distributor", 47.0 }, { "rotor37/turbogrid", 47.0 } })
   {
     SCOPED_TRACE(machine);
     Loaded loaded;
