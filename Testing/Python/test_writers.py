@@ -291,7 +291,7 @@ class NativeCommandLineTest(unittest.TestCase):
         --no-optimize; either way they write the same bytes."""
         folder = bftest.output_path("native_vs_python")
         shutil.rmtree(folder, ignore_errors=True)
-        arguments = [AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "n_span=8"]
+        arguments = [AXIAL_OH, "-i", DISTRIBUTOR_INF]
         for switch in ([], ["--no-optimize"]):
             run_folder = os.path.join(folder, "no_optimize" if switch else "optimize")
             for label, command in (("python", [sys.executable, "-m", "blockforge"]),
@@ -326,7 +326,7 @@ class NativeCommandLineTest(unittest.TestCase):
         smallest angle), which raises it on the distributor's O-grid."""
         folder = bftest.output_path("objective")
         shutil.rmtree(folder, ignore_errors=True)
-        arguments = [AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "n_span=8"]
+        arguments = [AXIAL_OH, "-i", DISTRIBUTOR_INF]
         largest = {}
         for objective in ("min-angle", "non-orthogonality"):
             for label, command in (("python", [sys.executable, "-m", "blockforge"]),
@@ -342,9 +342,10 @@ class NativeCommandLineTest(unittest.TestCase):
             self.assertTrue(filecmp.cmp(os.path.join(folder, objective, "python", "grid.xyz"),
                                         os.path.join(folder, objective, "native", "grid.xyz"),
                                         shallow=False), objective)
-        # 5 degrees lower until the O-grid's sides matched its corners' cells (issue 8); now
-        # 52.23 against 53.66 (n_span 8)
-        self.assertLess(largest["non-orthogonality"], largest["min-angle"] - 1.0, largest)
+        # At the template's defaults (stop 14): 51.97 against 66.98 (64.37 as placed). With
+        # n_span 8, as this test ran until stop 13 to save time, the grids of stop 14 give
+        # 51.55 against 51.25: there the min-angle run does not raise it.
+        self.assertLess(largest["non-orthogonality"], largest["min-angle"] - 5.0, largest)
         run = subprocess.run([CLI, CYLINDER, "--objective", "smoothness", "-o", "x.foam"],
                              capture_output=True, text=True)
         self.assertEqual(run.returncode, 2)
@@ -406,7 +407,7 @@ class NativeCommandLineTest(unittest.TestCase):
         write the same bytes; a budget that is not a positive whole number is refused."""
         folder = bftest.output_path("max_evaluations")
         shutil.rmtree(folder, ignore_errors=True)
-        arguments = [AXIAL_OH, "-i", DISTRIBUTOR_INF, "-p", "n_span=8"]
+        arguments = [AXIAL_OH, "-i", DISTRIBUTOR_INF]
         for label, command in (("python", [sys.executable, "-m", "blockforge"]),
                                ("native", [CLI])):
             run = subprocess.run(command + arguments + ["--max-evaluations", "12", "-o",
