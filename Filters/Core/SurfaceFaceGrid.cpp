@@ -190,6 +190,21 @@ std::vector<double> parameterTfi(const std::vector<Eigen::Vector2d>& uv, const L
   return grid;
 }
 
+/// The node indices of cell (a, b)'s corners in a grid na nodes wide, counter-clockwise.
+void cellCorners(int na, int a, int b, std::size_t corner[4])
+{
+  corner[0] = static_cast<std::size_t>(b) * na + a;
+  corner[1] = corner[0] + 1;
+  corner[3] = static_cast<std::size_t>(b + 1) * na + a;
+  corner[2] = corner[3] + 1;
+}
+
+/// Length of the parameter step e in the first fundamental form g = (ps.ps, ps.pt, pt.pt).
+double metricLength(const Eigen::Vector3d& g, const Eigen::Vector2d& e)
+{
+  return std::sqrt(std::max(0.0, g[0] * e[0] * e[0] + 2 * g[1] * e[0] * e[1] + g[2] * e[1] * e[1]));
+}
+
 /// Scaled Jacobians of the four corners of every cell in (s, t), measured with the first
 /// fundamental form `metric` of the cell (a = ps.ps, b = ps.pt, c = pt.pt) and oriented
 /// by `orientation` (+1 or -1: the sign of the boundary loop's area in (s, t)).
@@ -201,14 +216,11 @@ struct CornerMeasure
 
   void operator()(const std::vector<Eigen::Vector2d>& st, int a, int b, double out[4]) const
   {
-    const std::size_t corner[4] = { static_cast<std::size_t>(b) * na + a,
-      static_cast<std::size_t>(b) * na + a + 1, static_cast<std::size_t>(b + 1) * na + a + 1,
-      static_cast<std::size_t>(b + 1) * na + a };
+    std::size_t corner[4];
+    cellCorners(na, a, b, corner);
     const Eigen::Vector3d& g = metric[static_cast<std::size_t>(b) * (na - 1) + a];
     const double area = std::sqrt(std::max(0.0, g[0] * g[2] - g[1] * g[1]));
-    auto length = [&](const Eigen::Vector2d& e) {
-      return std::sqrt(std::max(0.0, g[0] * e[0] * e[0] + 2 * g[1] * e[0] * e[1] + g[2] * e[1] * e[1]));
-    };
+    auto length = [&](const Eigen::Vector2d& e) { return metricLength(g, e); };
     for (int k = 0; k < 4; ++k)
     {
       const Eigen::Vector2d e1 = st[corner[(k + 1) % 4]] - st[corner[k]];
@@ -237,14 +249,13 @@ struct SideMeasure
 
   void operator()(const std::vector<Eigen::Vector2d>& st, int a, int b, double out[4]) const
   {
-    const std::size_t corner[4] = { static_cast<std::size_t>(b) * na + a,
-      static_cast<std::size_t>(b) * na + a + 1, static_cast<std::size_t>(b + 1) * na + a + 1,
-      static_cast<std::size_t>(b + 1) * na + a };
+    std::size_t corner[4];
+    cellCorners(na, a, b, corner);
     const Eigen::Vector3d& g = metric[static_cast<std::size_t>(b) * (na - 1) + a];
     for (int k = 0; k < 4; ++k)
     {
       const Eigen::Vector2d e = st[corner[(k + 1) % 4]] - st[corner[k]];
-      out[k] = std::sqrt(std::max(0.0, g[0] * e[0] * e[0] + 2 * g[1] * e[0] * e[1] + g[2] * e[1] * e[1]));
+      out[k] = metricLength(g, e);
     }
   }
 };
