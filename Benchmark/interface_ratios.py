@@ -62,17 +62,23 @@ def hex_corners(g):
 
 
 def scaled_jacobian(g):
-    """Smallest corner scaled Jacobian of every cell (VTK hexahedron order)."""
+    """Smallest corner scaled Jacobian of every cell (VTK hexahedron order) and whether the
+    cell is collapsed (an edge of zero length: the writers' prisms, e.g. axial_passage_oh's
+    fans on a sharp tip). A corner on a zero-length edge spans no volume and is left out, as
+    GridQuality leaves a prism's apex out; counted, every prism read as inverted."""
     c = hex_corners(g)
+    collapsed = None
     neighbours = [(1, 3, 4), (2, 0, 5), (3, 1, 6), (0, 2, 7), (7, 5, 0), (4, 6, 1), (5, 7, 2), (6, 4, 3)]
     result = None
     for v, (a, b, d) in enumerate(neighbours):
         e1, e2, e3 = c[a] - c[v], c[b] - c[v], c[d] - c[v]
         det = np.einsum('...i,...i', e1, np.cross(e2, e3))
         norms = np.linalg.norm(e1, axis=-1) * np.linalg.norm(e2, axis=-1) * np.linalg.norm(e3, axis=-1)
-        value = det / np.maximum(norms, 1e-300)
+        value = np.where(norms > 0.0, det / np.maximum(norms, 1e-300), np.inf)
+        flat = norms == 0.0
         result = value if result is None else np.minimum(result, value)
-    return result
+        collapsed = flat if collapsed is None else collapsed | flat
+    return result, collapsed
 
 
 def min_angle(g):
@@ -140,10 +146,12 @@ def main(argv):
     names = block_names(argv[0], len(blocks))
     points = np.concatenate([g.reshape(-1, 3) for g in blocks])
     size = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
-    jacobian = np.concatenate([scaled_jacobian(g).ravel() for g in blocks])
+    measured = [scaled_jacobian(g) for g in blocks]
+    jacobian = np.concatenate([value.ravel() for value, _ in measured])
+    collapsed = int(sum(flat.sum() for _, flat in measured))
     angles = np.concatenate([min_angle(g).ravel() for g in blocks])
     classes = np.histogram(angles, bins=[0, 20, 40, 60, 80, 90.0001])[0]
-    print(f'cells {jacobian.size}  min ScaledJacobian {jacobian.min():.4f}  inverted {(jacobian <= 0).sum()}  '
+    print(f'cells {jacobian.size}  min ScaledJacobian {jacobian.min():.4f}  inverted {(jacobian <= 0).sum()}  collapsed {collapsed}  '
           f'min angle {angles.min():.1f}  MinAngle classes {" / ".join(map(str, classes))}')
     pairs = sorted(interface_ratios(blocks, size).items(), key=lambda item: -item[1])
     for (a, b), ratio in pairs[:listed]:
