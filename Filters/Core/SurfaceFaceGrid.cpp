@@ -383,20 +383,28 @@ void surfaceFaceGrid(const ParametricSurface& surface, const std::vector<Eigen::
   // Each corner must be at least as good as the bound or the parameter grid's corner, and
   // each side within SizeJump of the parameter grid's side (same cell metric).
   const SideMeasure sides{ na, nb, metric };
+  // whether a side of cell (a, b) of `grid` is more than `factor` times longer or shorter
+  // than the parameter grid's
+  auto sideBeyond = [&](const std::vector<Eigen::Vector2d>& grid, int a, int b, double factor) {
+    double length[4], reference[4];
+    sides(grid, a, b, length);
+    sides(safe, a, b, reference);
+    for (int k = 0; k < 4; ++k)
+    {
+      if (reference[k] > 0.0 && (length[k] > factor * reference[k] || reference[k] > factor * length[k]))
+      {
+        return true;
+      }
+    }
+    return false;
+  };
   // a face where some cell side slid beyond SizeTrigger holds every side within SizeJump
   bool slid = false;
   for (int b = 0; b + 1 < nb && !slid; ++b)
   {
     for (int a = 0; a + 1 < na && !slid; ++a)
     {
-      double length[4], reference[4];
-      sides(st, a, b, length);
-      sides(safe, a, b, reference);
-      for (int k = 0; k < 4; ++k)
-      {
-        slid = slid || (reference[k] > 0.0 && (length[k] > SizeTrigger * reference[k] ||
-                                                reference[k] > SizeTrigger * length[k]));
-      }
+      slid = sideBeyond(st, a, b, SizeTrigger);
     }
   }
   auto cellFails = [&](const std::vector<Eigen::Vector2d>& grid, int a, int b, const double* bound) {
@@ -406,21 +414,7 @@ void surfaceFaceGrid(const ParametricSurface& surface, const std::vector<Eigen::
     {
       return true;
     }
-    if (!slid)
-    {
-      return false;
-    }
-    double length[4], reference[4];
-    sides(grid, a, b, length);
-    sides(safe, a, b, reference);
-    for (int k = 0; k < 4; ++k)
-    {
-      if (reference[k] > 0.0 && (length[k] > SizeJump * reference[k] || reference[k] > SizeJump * length[k]))
-      {
-        return true;
-      }
-    }
-    return false;
+    return slid && sideBeyond(grid, a, b, SizeJump);
   };
   std::vector<double> least(4 * cells);
   for (int b = 0; b + 1 < nb; ++b)

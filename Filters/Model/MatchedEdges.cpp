@@ -104,13 +104,6 @@ void joinAcross(const MeshTopology& topology, const BlockFace& first, const Bloc
   }
 }
 
-/// Length of the cell at one end of an edge from its node parameters.
-double endCell(const UniqueEdge& edge, int end)
-{
-  const std::vector<double>& p = edge.params;
-  const std::size_t n = p.size();
-  return edge.length * (end == 0 ? p[1] - p[0] : p[n - 1] - p[n - 2]);
-}
 /// The groups of the ends joined in `parent` that hold a matched edge's end.
 void groupMatchedEnds(MeshTopology& topology, std::vector<int>& parent)
 {

@@ -831,10 +831,7 @@ void snapLineFace(std::vector<double>& xyz, int na, int nb)
     return;
   }
 }
-} // namespace
 
-namespace
-{
 /// The grid of unique face `unique` in the orientation of `block`'s local face `local`.
 void localFaceGrid(const MeshTopology& topology, int block, int local, int unique,
   std::vector<double>& out)
@@ -971,20 +968,13 @@ BoundaryNeeds boundaryNeeds(const MeshTopology& topology, const std::vector<Edge
       }
     }
   }
-  // A following face is made from the face opposite it.
+  // A following face is made from the face opposite it and from that face's four edges in
+  // the same block (besides its own edges, below); the face it follows follows none.
   for (std::size_t f = 0; f < topology.faces.size(); ++f)
   {
     if (needs.faces[f] && topology.faces[f].opposite >= 0)
     {
       needs.faces[topology.faces[f].opposite] = 1;
-    }
-  }
-  // A face grid is made from its owner's four edges (a following face also from the four
-  // edges of the face opposite it, in the same block).
-  for (std::size_t f = 0; f < topology.faces.size(); ++f)
-  {
-    if (needs.faces[f] && topology.faces[f].opposite >= 0)
-    {
       const BlockFace& named = topology.faces[f].follows;
       for (const int local : faceEdges(named.face ^ 1))
       {
@@ -996,6 +986,7 @@ BoundaryNeeds boundaryNeeds(const MeshTopology& topology, const std::vector<Edge
       }
     }
   }
+  // A face grid is made from its owner's four edges.
   for (std::size_t f = 0; f < topology.faces.size(); ++f)
   {
     if (!needs.faces[f])
@@ -1124,20 +1115,8 @@ void meshBlockNodes(const BlockModel& model, const MeshTopology& topology, int b
     }
     // Another block owns the face: copy its nodes into this block's orientation, so the
     // shared nodes are the very same doubles.
-    const int na = links.nodes[faceDirections(f)[0]], nb = links.nodes[faceDirections(f)[1]];
-    std::vector<double>& grid = faceStorage[f];
-    grid.resize(3 * static_cast<std::size_t>(na) * nb);
-    for (int b = 0; b < nb; ++b)
-    {
-      for (int a = 0; a < na; ++a)
-      {
-        int ownerA = 0, ownerB = 0;
-        links.transform[f].map(a, b, face.na, face.nb, ownerA, ownerB);
-        std::copy_n(&face.xyz[3 * (static_cast<std::size_t>(ownerB) * face.na + ownerA)], 3,
-          &grid[3 * (static_cast<std::size_t>(b) * na + a)]);
-      }
-    }
-    boundary.faces[f] = grid.data();
+    localFaceGrid(topology, block, f, unique, faceStorage[f]);
+    boundary.faces[f] = faceStorage[f].data();
   }
   std::array<LocalEdge, 12> edges;
   for (int e = 0; e < 12; ++e)

@@ -203,6 +203,14 @@ void buildProjections(const BlockModel& model, MeshTopology& topology);
  * join nothing.
  */
 void joinProjectedMatchEnds(const BlockModel& model, MeshTopology& topology);
+/// Length of the cell at one end of an edge (end 0: at its vertex a) from its node
+/// parameters.
+inline double endCell(const UniqueEdge& edge, int end)
+{
+  const std::vector<double>& p = edge.params;
+  const std::size_t n = p.size();
+  return edge.length * (end == 0 ? p[1] - p[0] : p[n - 1] - p[n - 2]);
+}
 /// Whether `edge` runs against `source` (its a end nearer the source's b end): their nearer
 /// ends decide, so a projected edge takes its source's nodes in the right order.
 bool runsAgainst(const BlockModel& model, const UniqueEdge& edge, const UniqueEdge& source);

@@ -624,33 +624,25 @@ private:
     {
       block.vertices[v] = vertexRef(vertices.value[v], vertices.line, entityText);
     }
-    const MapEntry& cells = required(keys, "cells", node, entityText);
-    if (!cells.value.IsSequence() || cells.value.size() != 3)
-    {
-      fail(cells.line, entityText, "'cells' needs three counts");
-    }
-    for (int d = 0; d < 3; ++d)
-    {
-      block.cells[d] = integer(cells.value[d], cells.line, entityText, "cells");
-      if (block.cells[d] < 1)
+    // `cells` and `min_cells` alike: three counts of at least 1
+    const auto readCounts = [&](const MapEntry& counts, const std::string& key, std::array<int, 3>& out) {
+      if (!counts.value.IsSequence() || counts.value.size() != 3)
       {
-        fail(cells.line, entityText, "cells must be at least 1");
-      }
-    }
-    if (const MapEntry* least = syntax::findEntry(keys, "min_cells"))
-    {
-      if (!least->value.IsSequence() || least->value.size() != 3)
-      {
-        fail(least->line, entityText, "'min_cells' needs three counts");
+        fail(counts.line, entityText, "'" + key + "' needs three counts");
       }
       for (int d = 0; d < 3; ++d)
       {
-        block.minCells[d] = integer(least->value[d], least->line, entityText, "min_cells");
-        if (block.minCells[d] < 1)
+        out[d] = integer(counts.value[d], counts.line, entityText, key);
+        if (out[d] < 1)
         {
-          fail(least->line, entityText, "min_cells must be at least 1");
+          fail(counts.line, entityText, key + " must be at least 1");
         }
       }
+    };
+    readCounts(required(keys, "cells", node, entityText), "cells", block.cells);
+    if (const MapEntry* least = syntax::findEntry(keys, "min_cells"))
+    {
+      readCounts(*least, "min_cells", block.minCells);
     }
     if (const MapEntry* interpolation = syntax::findEntry(keys, "interpolation"))
     {

@@ -148,12 +148,6 @@ std::vector<FootJoin> footJoins(const BlockModel& model, const MeshTopology& top
   return joins;
 }
 
-double cellAtEnd(const UniqueEdge& edge, int end)
-{
-  const std::vector<double>& p = edge.params;
-  const std::size_t n = p.size();
-  return edge.length * (end == 0 ? p[1] - p[0] : p[n - 1] - p[n - 2]);
-}
 
 /**
  * The feet at a blade corner (FootJoin): the wall cells on both sides of the radial edge
@@ -183,14 +177,14 @@ void joinFeet(const BlockModel& model, MeshTopology& topology, const FootJoin& j
   {
     return;
   }
-  const double layer = cellAtEnd(radial, radial.a == join.vertex ? 0 : 1) / radial.length / 2;
+  const double layer = endCell(radial, radial.a == join.vertex ? 0 : 1) / radial.length / 2;
   double foot[2], outer[2], width[2];
   for (int k = 0; k < 2; ++k)
   {
-    foot[k] = cellAtEnd(*edges[k], join.end[k]);
+    foot[k] = endCell(*edges[k], join.end[k]);
     const UniqueEdge& source = topology.edges[edges[k]->projectedFrom];
     const bool crossed = runsAgainst(model, *edges[k], source);
-    outer[k] = cellAtEnd(source, crossed ? 1 - join.end[k] : join.end[k]);
+    outer[k] = endCell(source, crossed ? 1 - join.end[k] : join.end[k]);
     width[k] = foot[k] + (outer[k] - foot[k]) * layer;
   }
   const int large = width[0] > width[1] ? 0 : 1, small = 1 - large;

@@ -370,53 +370,36 @@ void TemplateReader::readBlocks()
     {
       fail(entry.line, entityText, "missing 'cells: [ni, nj, nk]'");
     }
-    if (!cells->value.IsSequence() || cells->value.size() != 3)
-    {
-      fail(lineOrFallback(cells->value, cells->line), entityText,
-        "'cells' expects three counts [ni, nj, nk]");
-    }
+    // `cells` and `min_cells` alike: three whole counts from 1 to MaxCellsPerDirection
     static const char* const directionNames[3] = { "i", "j", "k" };
-    for (int d = 0; d < 3; ++d)
-    {
-      const YAML::Node node = cells->value[d];
-      const double value =
-        number(node, cells->line, entityText, std::string("cells ") + directionNames[d]);
-      const double whole = std::round(value);
-      if (std::abs(value - whole) > 1e-9 * std::max(1.0, std::abs(value)) || whole < 1 ||
-        whole > MaxCellsPerDirection)
+    const auto readCounts = [&](const MapEntry& counts, const std::string& key, std::array<int, 3>& out) {
+      if (!counts.value.IsSequence() || counts.value.size() != 3)
       {
-        fail(lineOrFallback(node, cells->line), entityText,
-          std::string("cells must be whole numbers from 1 to 1000000, but ") +
-            directionNames[d] + " = '" + node.Scalar() + "' = " +
-            syntax::formatNumber(value));
-      }
-      block.cells[d] = static_cast<int>(whole);
-    }
-    // the fewest cells a density multiplier below 1 leaves (optional; a count above
-    // `cells` means `cells`, so a parameter lowering `cells` needs no matching edit)
-    if (const MapEntry* least = syntax::findEntry(keys, "min_cells"))
-    {
-      if (!least->value.IsSequence() || least->value.size() != 3)
-      {
-        fail(lineOrFallback(least->value, least->line), entityText,
-          "'min_cells' expects three counts [ni, nj, nk]");
+        fail(lineOrFallback(counts.value, counts.line), entityText,
+          "'" + key + "' expects three counts [ni, nj, nk]");
       }
       for (int d = 0; d < 3; ++d)
       {
-        const YAML::Node node = least->value[d];
+        const YAML::Node node = counts.value[d];
         const double value =
-          number(node, least->line, entityText, std::string("min_cells ") + directionNames[d]);
+          number(node, counts.line, entityText, key + " " + directionNames[d]);
         const double whole = std::round(value);
         if (std::abs(value - whole) > 1e-9 * std::max(1.0, std::abs(value)) || whole < 1 ||
           whole > MaxCellsPerDirection)
         {
-          fail(lineOrFallback(node, least->line), entityText,
-            std::string("min_cells must be whole numbers from 1 to 1000000, but ") +
-              directionNames[d] + " = '" + node.Scalar() + "' = " +
-              syntax::formatNumber(value));
+          fail(lineOrFallback(node, counts.line), entityText,
+            key + " must be whole numbers from 1 to 1000000, but " + directionNames[d] + " = '" +
+              node.Scalar() + "' = " + syntax::formatNumber(value));
         }
-        block.minCells[d] = static_cast<int>(whole);
+        out[d] = static_cast<int>(whole);
       }
+    };
+    readCounts(*cells, "cells", block.cells);
+    // the fewest cells a density multiplier below 1 leaves (optional; a count above
+    // `cells` means `cells`, so a parameter lowering `cells` needs no matching edit)
+    if (const MapEntry* least = syntax::findEntry(keys, "min_cells"))
+    {
+      readCounts(*least, "min_cells", block.minCells);
     }
 
     if (const MapEntry* grading = syntax::findEntry(keys, "grading"))
