@@ -954,8 +954,10 @@ BoundaryNeeds boundaryNeeds(const MeshTopology& topology, const std::vector<Edge
       }
     }
   }
-  // A periodic image face is its source face rotated: the source is needed too (chains
-  // of images, if a template makes one, are followed to their end).
+  // A periodic image face is its source face rotated: the source is needed too. A
+  // following face is made from the face opposite it and from that face's four edges in
+  // the same block (besides its own edges, below); the face it follows may be an image,
+  // and an image's source may follow: grown until nothing is added.
   for (bool grown = true; grown;)
   {
     grown = false;
@@ -967,21 +969,21 @@ BoundaryNeeds boundaryNeeds(const MeshTopology& topology, const std::vector<Edge
         grown = true;
       }
     }
-  }
-  // A following face is made from the face opposite it and from that face's four edges in
-  // the same block (besides its own edges, below); the face it follows follows none.
-  for (std::size_t f = 0; f < topology.faces.size(); ++f)
-  {
-    if (needs.faces[f] && topology.faces[f].opposite >= 0)
+    for (std::size_t f = 0; f < topology.faces.size(); ++f)
     {
-      needs.faces[topology.faces[f].opposite] = 1;
-      const BlockFace& named = topology.faces[f].follows;
-      for (const int local : faceEdges(named.face ^ 1))
+      const int opposite = topology.faces[f].opposite;
+      if (needs.faces[f] && opposite >= 0)
       {
-        const int edge = topology.blocks[named.block].edge[local];
-        if (edge >= 0)
+        grown = grown || !needs.faces[opposite];
+        needs.faces[opposite] = 1;
+        const BlockFace& named = topology.faces[f].follows;
+        for (const int local : faceEdges(named.face ^ 1))
         {
-          needs.edges[edge] = 1;
+          const int edge = topology.blocks[named.block].edge[local];
+          if (edge >= 0)
+          {
+            needs.edges[edge] = 1;
+          }
         }
       }
     }
@@ -1075,20 +1077,26 @@ void computeAllBoundaries(const BlockModel& model, const CarrierGeometry& geomet
       computeFaceGrid(model, geometry, onSurface, topology, static_cast<int>(f));
     }
   });
-  // then the faces that follow those opposite them
+  // then the periodic images of those (a following face may be opposite one), the faces
+  // that follow those opposite them, and the images of these
+  const auto copyImages = [&](bool ofFollowingFaces) {
+    for (const PeriodicPair& entry : images)
+    {
+      if (faceNeeded(static_cast<std::size_t>(entry.image)) &&
+        (topology.faces[entry.source].opposite >= 0) == ofFollowingFaces)
+      {
+        periodicFace(model, topology, entry, topology.faces[entry.image].xyz);
+      }
+    }
+  };
+  copyImages(false);
   forEachChunk(static_cast<long>(topology.faces.size()), [&](long f) {
     if (!isImage[f] && faceNeeded(static_cast<std::size_t>(f)) && topology.faces[f].opposite >= 0)
     {
       computeFaceGrid(model, geometry, onSurface, topology, static_cast<int>(f));
     }
   });
-  for (const PeriodicPair& entry : images)
-  {
-    if (faceNeeded(static_cast<std::size_t>(entry.image)))
-    {
-      periodicFace(model, topology, entry, topology.faces[entry.image].xyz);
-    }
-  }
+  copyImages(true);
 }
 
 void meshBlockNodes(const BlockModel& model, const MeshTopology& topology, int block, double* out)

@@ -436,7 +436,21 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
       computeFaceGrid(model, Geometry, OnSurface, Topo, static_cast<int>(f), &Projections);
     }
   }
-  // Faces that follow the face opposite them: after it, also when only it changed.
+  // The periodic images of those, then the faces that follow the face opposite them (after
+  // it, also when only it changed; it may be an image), then the images of these.
+  const auto copyImages = [&](bool ofFollowingFaces) {
+    for (const PeriodicPair& pair : Topo.connectivity.periodic)
+    {
+      if ((changedFace[pair.source] || changedFace[pair.image]) &&
+        (Topo.faces[pair.source].opposite >= 0) == ofFollowingFaces)
+      {
+        changedFace[pair.image] = 1;
+        saveFace(pair.image);
+        periodicFace(model, Topo, pair, Topo.faces[pair.image].xyz);
+      }
+    }
+  };
+  copyImages(false);
   for (std::size_t f = 0; f < Topo.faces.size(); ++f)
   {
     const int opposite = Topo.faces[f].opposite;
@@ -447,15 +461,7 @@ void MeshPlan::Impl::run(const std::vector<int>& moved)
       computeFaceGrid(model, Geometry, OnSurface, Topo, static_cast<int>(f), &Projections);
     }
   }
-  for (const PeriodicPair& pair : Topo.connectivity.periodic)
-  {
-    if (changedFace[pair.source] || changedFace[pair.image])
-    {
-      changedFace[pair.image] = 1;
-      saveFace(pair.image);
-      periodicFace(model, Topo, pair, Topo.faces[pair.image].xyz);
-    }
-  }
+  copyImages(true);
   for (std::size_t f = 0; f < Topo.faces.size(); ++f)
   {
     if (changedFace[f])

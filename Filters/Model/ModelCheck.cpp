@@ -431,6 +431,44 @@ void checkMinCells(const BlockModel& model, const Topology& topology)
   }
 }
 
+/// A periodic image is its partner's face rotated, made after the faces it may be opposite
+/// to: an image cannot follow, and a face cannot follow the image of a following face.
+void checkFollowingImages(const BlockModel& model, const MeshTopology& topology)
+{
+  std::vector<int> imageSource(topology.faces.size(), -1);
+  for (const PeriodicPair& pair : topology.connectivity.periodic)
+  {
+    imageSource[pair.image] = pair.source;
+  }
+  for (const SurfaceFaces& set : model.surfaceFaces)
+  {
+    if (!set.followOpposite)
+    {
+      continue;
+    }
+    const std::string entityText = entity("face set", set.name);
+    for (const BlockFace& face : set.faces)
+    {
+      const MeshLinks& links = topology.blocks[face.block];
+      if (imageSource[links.face[face.face]] >= 0)
+      {
+        fail(set.where, entityText,
+          "face " + blockFaceText(model, face.block, face.face) +
+            " is a periodic image (its partner's face rotated): it cannot follow the face "
+            "opposite it; let the partner's block follow instead");
+      }
+      const int source = imageSource[links.face[face.face ^ 1]];
+      if (source >= 0 && topology.faces[source].opposite >= 0)
+      {
+        fail(set.where, entityText,
+          "face " + blockFaceText(model, face.block, face.face) +
+            " follows the periodic image of a face that follows another: the face a following "
+            "face follows must lie on a surface or come from its edges");
+      }
+    }
+  }
+}
+
 void checkModelWith(const BlockModel& model, const CarrierGeometry& geometry)
 {
   const double size = modelSize(model);
@@ -443,6 +481,7 @@ void checkModelWith(const BlockModel& model, const CarrierGeometry& geometry)
   checkOrientation(model, curves, size);
   checkPatches(model, topology.connectivity);
   findPeriodicPairs(model, topology.connectivity); // the rotated copies must match node for node
+  checkFollowingImages(model, topology);
 }
 
 void checkModel(const BlockModel& model)

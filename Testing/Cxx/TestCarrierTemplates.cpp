@@ -1890,6 +1890,70 @@ TEST(CarrierTemplates, FollowingFaceKeepsTheOppositeFacesBulge)
       "follows must lie on a surface or come from its edges");
 }
 
+// A face may follow the face opposite it when that face is a periodic image: the image is
+// rotated from its partner before the following faces are made (a stale or empty image
+// read otherwise). annular_sector with its periodic_low face in_1.j0 on a surface bulging
+// by 0.03 into the block: in_3.j0 follows in_3.j1, the bulge's image, so its interior is
+// its flat Coons patch plus the image's departure from its own (within 1e-12), in a whole
+// run and in a run meshing in_3 alone (an MPI rank's share). An image cannot follow, and a
+// face cannot follow the image of a following face.
+TEST(CarrierTemplates, FollowingFaceOppositeAPeriodicImage)
+{
+  std::string base = test::readText(test::sourcePath("Templates/annular_sector.yaml"));
+  base.replace(base.find("blockforge: 1"), 13, "blockforge: 2");
+  const std::string carriers =
+    "carriers:\n"
+    "  c0: {interpolate: [[0.5, 0, 0], [0.625, 0, 0], [0.75, 0, 0]], degree: 2}\n"
+    "  c1: {interpolate: [[0.5, 0, 0.2], [0.625, 0.03, 0.2], [0.75, 0, 0.2]], degree: 2}\n"
+    "  c2: {interpolate: [[0.5, 0, 0.4], [0.625, 0, 0.4], [0.75, 0, 0.4]], degree: 2}\n"
+    "  bulge: {gordon: [c0, c1, c2], blending: spline, at: [0, 0.5, 1]}\n";
+  base.insert(base.find("\nvertices:") + 1, carriers);
+  const std::string wall = "faces:\n  wall: {on_surface: bulge, faces: [in_1.j0]}\n";
+  const auto parse = [&](const std::string& faces) {
+    return model::parseTemplate(base + faces, "sector.yaml", {}, nullptr);
+  };
+  const BlockModel following = parse(wall + "  outer: {follow: opposite, faces: [in_3.j0]}\n");
+  const int in3 = following.findBlock("in_3");
+  ASSERT_GE(in3, 0);
+  for (const double density : { 1.0, 2.0 })
+  {
+    SCOPED_TRACE(density);
+    const Grid plain = meshAll(parse(""), density);
+    const Grid bulged = meshAll(parse(wall), density);
+    const Grid grid = meshAll(following, density);
+    const auto& n = grid.nodes[in3];
+    double worst = 0.0, bulge = 0.0;
+    for (int k = 1; k + 1 < n[2]; ++k)
+    {
+      for (int i = 1; i + 1 < n[0]; ++i)
+      {
+        const Vec3 departure = bulged.at(in3, i, n[1] - 1, k) - plain.at(in3, i, n[1] - 1, k);
+        bulge = std::max(bulge, departure.norm());
+        worst = std::max(worst, (grid.at(in3, i, 0, k) - plain.at(in3, i, 0, k) - departure).norm());
+      }
+    }
+    EXPECT_GT(bulge, 0.02); // the image bulges, so the check means something
+    EXPECT_LT(worst, 1e-12);
+    // in_3 alone (its image's source, in_1.j0, is another block's face)
+    model::MultiBlockMesher mesher(following, density);
+    mesher.computeBoundaries({ in3 });
+    std::vector<double> alone(grid.xyz[in3].size());
+    mesher.meshBlock(in3, alone.data());
+    EXPECT_TRUE(sameBits(alone, grid.xyz[in3]));
+  }
+  const auto errorFor = [&](const std::string& faces) {
+    return errorOf([&] { meshAll(parse(wall + faces)); });
+  };
+  EXPECT_NE(errorFor("  outer: {follow: opposite, faces: [in_3.j1]}\n")
+              .find("face set 'outer': face in_3.j1 is a periodic image (its partner's face rotated): "
+                    "it cannot follow the face opposite it"),
+    std::string::npos);
+  EXPECT_NE(errorOf([&] {
+    meshAll(parse("faces:\n  outer: {follow: opposite, faces: [in_1.j0, in_3.j0]}\n"));
+  }).find("face set 'outer': face in_3.j0 follows the periodic image of a face that follows another"),
+    std::string::npos);
+}
+
 // A block's `interpolation` (Core/Transfinite.h Blending): read, written to the document,
 // used by the mesher (a block whose i-edges end in cells of 0.025, its i1 face bulging out
 // by 0.6: with end_cells in i the first cell of the middle i-line is 0.025 within 2e-3,
