@@ -149,6 +149,112 @@ std::vector<FootJoin> footJoins(const BlockModel& model, const MeshTopology& top
 }
 
 
+/// Beside a fan (gradeBesideFan): the side's first wall cell at most this many times the
+/// fan's, across the interface (the neighbour size ratio, issue 8's 1.5 with a margin for
+/// the estimate) ...
+constexpr double FanSideRatio = 1.35;
+/// ... and its next wall cells grow by at most this from cell to cell until they meet the
+/// projected feet: inside the block, where checkMesh's interpolation weight (0.05) fails
+/// between cells whose centres lie more than 19 times as far from their face.
+constexpr double FanSideGrowth = 8.0;
+
+/// The end cell length of `edge` at vertex `v` (one of its ends).
+double cellAtVertex(const UniqueEdge& edge, int v)
+{
+  return endCell(edge, edge.a == v ? 0 : 1);
+}
+
+/**
+ * The feet of a side beside a fan whose feet are one point (FootJoin with one edge
+ * collapsed: axial_passage_oh's prisms on a sharp tip). The wall cells are measured as
+ * joinFeet measures them: the fan's is e + (o - e) h / W with e = 0, a sliver of its outer
+ * cell o. The side's first outer node past the fan still lies on the O curve's arc round
+ * the tip, so its foot is the tip too (widened there to a 25th of the next cell), and its
+ * second on the flank, its foot as long as its outer cell: the side's first wall cell was
+ * 2.5-3.5 times the fan's (the compressor's O_le|O_b at densities 0.5-4), and the next
+ * 16-25 times that. Here the side's first foot is cut to FanSideRatio times the fan's wall
+ * cell, the next ones grow from it by at most FanSideGrowth per cell (their outer cells
+ * counted as above) until they reach the projected feet, which are kept from there on. The
+ * radial lines of the cells in between lean towards the tip (round a sharp tip the normal
+ * of a point on the O curve's arc has its foot on the tip, so those have no orthogonal foot).
+ */
+void gradeBesideFan(MeshTopology& topology, const FootJoin& join, int fan)
+{
+  const int side = 1 - fan;
+  UniqueEdge& edge = topology.edges[join.edge[side]];
+  const UniqueEdge& radial = topology.edges[join.radial];
+  const int outerVertex = radial.a == join.vertex ? radial.b : radial.a;
+  const UniqueEdge& fanSource = topology.edges[topology.edges[join.edge[fan]].projectedFrom];
+  const UniqueEdge& source = topology.edges[edge.projectedFrom];
+  const int cells = static_cast<int>(edge.params.size()) - 1;
+  if (cells < 3 || (fanSource.a != outerVertex && fanSource.b != outerVertex) ||
+    (source.a != outerVertex && source.b != outerVertex) || source.params.size() != edge.params.size())
+  {
+    return;
+  }
+  const double layer = cellAtVertex(radial, join.vertex) / radial.length / 2;
+  if (!(layer > 0.0 && layer < 0.5))
+  {
+    return;
+  }
+  const double fanWidth = cellAtVertex(fanSource, outerVertex) * layer;
+  // lengths from the join's vertex: the side's feet as projected (P) and its outer cells
+  const bool fromA = join.end[side] == 0;
+  const bool sourceFromA = source.a == outerVertex;
+  std::vector<double> P(cells + 1), outer(cells + 1, 0.0);
+  for (int m = 0; m <= cells; ++m)
+  {
+    P[m] = edge.length * (fromA ? edge.params[m] : 1.0 - edge.params[cells - m]);
+    if (m > 0)
+    {
+      const std::vector<double>& q = source.params;
+      outer[m] = source.length *
+        (sourceFromA ? q[m] - q[m - 1] : q[cells - m + 1] - q[cells - m]);
+    }
+  }
+  const double first = (FanSideRatio * fanWidth - outer[1] * layer) / (1.0 - layer);
+  if (!(first > 0.0) || !(first < P[1]))
+  {
+    return; // the outer cells differ more than that, or the first foot is narrow enough
+  }
+  std::vector<double> Q(cells + 1, 0.0);
+  Q[1] = first;
+  double width = first * (1.0 - layer) + outer[1] * layer;
+  int m = 2;
+  for (; m < cells - 1; ++m)
+  {
+    const double step = std::max((FanSideGrowth * width - outer[m] * layer) / (1.0 - layer), 0.0);
+    const double candidate = Q[m - 1] + step;
+    if (candidate >= P[m] && P[m] > Q[m - 1])
+    {
+      Q[m] = P[m];
+      break;
+    }
+    if (!(step > 0.0))
+    {
+      return;
+    }
+    Q[m] = candidate;
+    width = step * (1.0 - layer) + outer[m] * layer;
+  }
+  if (m >= cells - 1 || m > cells / 2)
+  {
+    return; // not reached within half the side: left as projected
+  }
+  std::vector<double>& p = edge.params;
+  for (int k = 1; k < m; ++k)
+  {
+    if (fromA)
+    {
+      p[k] = Q[k] / edge.length;
+    }
+    else
+    {
+      p[cells - k] = 1.0 - Q[k] / edge.length;
+    }
+  }
+}
+
 /**
  * The feet at a blade corner (FootJoin): the wall cells on both sides of the radial edge
  * there are measured as the neighbour size ratio measures them, the mean of the foot (the
@@ -169,11 +275,19 @@ void joinFeet(const BlockModel& model, MeshTopology& topology, const FootJoin& j
 {
   UniqueEdge* edges[2] = { &topology.edges[join.edge[0]], &topology.edges[join.edge[1]] };
   const UniqueEdge& radial = topology.edges[join.radial];
+  if (radial.params.size() < 2 || !(radial.length > 0.0))
+  {
+    return;
+  }
   // A fan whose feet are one point (its blade arc collapsed, axial_passage_oh's prisms on a
   // sharp tip) has no wall width to join: cut to it, the side's first foot would vanish
-  // and fold the block at the corner.
-  if (radial.params.size() < 2 || !(radial.length > 0.0) || !(edges[0]->length > 0.0) ||
-    !(edges[1]->length > 0.0))
+  // and fold the block at the corner. The side's feet are graded up from the fan's instead.
+  if (!(edges[0]->length > 0.0) != !(edges[1]->length > 0.0))
+  {
+    gradeBesideFan(topology, join, edges[0]->length > 0.0 ? 1 : 0);
+    return;
+  }
+  if (!(edges[0]->length > 0.0) || !(edges[1]->length > 0.0))
   {
     return;
   }
