@@ -156,7 +156,7 @@ constexpr double FanSideRatio = 1.35;
 /// ... and its next wall cells grow by at most this from cell to cell until they meet the
 /// projected feet: inside the block, where checkMesh's interpolation weight (0.05) fails
 /// between cells whose centres lie more than 19 times as far from their face.
-constexpr double FanSideGrowth = 8.0;
+constexpr double FanSideGrowth = 10.0;
 
 /// The end cell length of `edge` at vertex `v` (one of its ends).
 double cellAtVertex(const UniqueEdge& edge, int v)
@@ -213,31 +213,57 @@ void gradeBesideFan(MeshTopology& topology, const FootJoin& join, int fan)
     }
   }
   const double first = (FanSideRatio * fanWidth - outer[1] * layer) / (1.0 - layer);
-  if (!(first > 0.0) || !(first < P[1]))
+  if (!(first > 0.0))
   {
-    return; // the outer cells differ more than that, or the first foot is narrow enough
+    return; // the outer cells differ more than that
   }
+  // Cells 1..M: the feet whose wall cells grow by a common factor g <= FanSideGrowth
+  // from the first, landing on the projected foot M (never shrinking); the smallest M for
+  // which such a g exists and the projected cell after M is within FanSideGrowth of cell M.
+  const auto widthOf = [&](double foot, int k) { return foot * (1.0 - layer) + outer[k] * layer; };
+  const double firstWidth = widthOf(first, 1);
   std::vector<double> Q(cells + 1, 0.0);
-  Q[1] = first;
-  double width = first * (1.0 - layer) + outer[1] * layer;
-  int m = 2;
-  for (; m < cells - 1; ++m)
-  {
-    const double step = std::max((FanSideGrowth * width - outer[m] * layer) / (1.0 - layer), 0.0);
-    const double candidate = Q[m - 1] + step;
-    if (candidate >= P[m] && P[m] > Q[m - 1])
+  const auto fill = [&](double g, int last) { // Q[1..last] for factor g; returns Q[last]
+    double foot = first, width = firstWidth;
+    Q[1] = first;
+    for (int k = 2; k <= last; ++k)
     {
-      Q[m] = P[m];
+      width *= g;
+      foot = std::max((width - outer[k] * layer) / (1.0 - layer), foot);
+      Q[k] = Q[k - 1] + foot;
+    }
+    return Q[last];
+  };
+  // smooth[k]: the projected wall cells from k to the middle of the side grow by at most
+  // FanSideGrowth from cell to cell (the feet still on the tip are not)
+  const int half = cells / 2;
+  std::vector<char> smooth(cells + 2, 1);
+  for (int k = half; k >= 1; --k)
+  {
+    smooth[k] = smooth[k + 1] &&
+      widthOf(P[k + 1] - P[k], k + 1) <= FanSideGrowth * widthOf(P[k] - P[k - 1], k);
+  }
+  int m = 2;
+  for (; m <= half; ++m)
+  {
+    if (!smooth[m] || !(fill(1.0, m) <= P[m]) || !(fill(FanSideGrowth, m) >= P[m]))
+    {
+      continue;
+    }
+    double low = 1.0, high = FanSideGrowth;
+    for (int round = 0; round < 60; ++round)
+    {
+      const double g = 0.5 * (low + high);
+      (fill(g, m) < P[m] ? low : high) = g;
+    }
+    fill(high, m);
+    if (P[m] > Q[m - 1] &&
+      widthOf(P[m + 1] - P[m], m + 1) <= FanSideGrowth * widthOf(P[m] - Q[m - 1], m))
+    {
       break;
     }
-    if (!(step > 0.0))
-    {
-      return;
-    }
-    Q[m] = candidate;
-    width = step * (1.0 - layer) + outer[m] * layer;
   }
-  if (m >= cells - 1 || m > cells / 2)
+  if (m > half)
   {
     return; // not reached within half the side: left as projected
   }
