@@ -124,13 +124,31 @@ std::vector<FootJoin> footJoins(const BlockModel& model, const MeshTopology& top
   {
     const UniqueEdge& edge = topology.edges[u];
     byVertices[{ std::min(edge.a, edge.b), std::max(edge.a, edge.b) }] = u;
+  }
+  const auto joined = [&](int v, int s) {
+    return byVertices.count({ std::min(v, s), std::max(v, s) }) > 0;
+  };
+  for (int u = 0; u < static_cast<int>(topology.edges.size()); ++u)
+  {
+    const UniqueEdge& edge = topology.edges[u];
     if (edge.projectedFrom < 0 || edge.a == edge.b)
     {
       continue;
     }
+    // a collapsed edge (its ends one point: a fan's feet on a sharp tip) cannot tell by
+    // position which source end is whose: the one joined to its vertex by an edge
+    const UniqueEdge& source = topology.edges[edge.projectedFrom];
+    const bool collapsed = model.vertices[edge.a].position == model.vertices[edge.b].position;
     for (int end = 0; end < 2; ++end)
     {
-      ends[{ end == 0 ? edge.a : edge.b, sourceEndVertex(model, topology, u, end) }].push_back({ u, end });
+      const int v = end == 0 ? edge.a : edge.b;
+      int s = sourceEndVertex(model, topology, u, end);
+      const int other = s == source.a ? source.b : source.a;
+      if (collapsed && !joined(v, s) && joined(v, other))
+      {
+        s = other;
+      }
+      ends[{ v, s }].push_back({ u, end });
     }
   }
   std::vector<FootJoin> joins;
