@@ -719,6 +719,65 @@ void surfaceFace(const BlockModel& model, const MeshTopology& topology, const Ca
   {
     follow(k, k + 1);
   }
+  // A node still off the surface between two neighbours on it: next to a sharp tip (a fan's
+  // feet) Gauss-Newton from either neighbour runs past the tip onto the other flank, a few
+  // micrometres from the node (the compressor's hub foot beside its leading-edge fan, 9 um
+  // from the tip, folded its side's wall cell at mid-span). Searched along the parameter
+  // segment between the neighbours (golden section on the distance), then polished.
+  for (int k = 0; k < loopSize; ++k)
+  {
+    const int before = (k + loopSize - 1) % loopSize, after = (k + 1) % loopSize;
+    if (!(away[k] > onSurface) || away[before] > onSurface || away[after] > onSurface)
+    {
+      continue;
+    }
+    Eigen::Vector2d from = st[before], to = st[after];
+    for (int d = 0; d < 2; ++d)
+    {
+      if (closed[d])
+      {
+        from[d] += std::round(st[k][d] - from[d]);
+        to[d] += std::round(st[k][d] - to[d]);
+      }
+    }
+    const auto distance = [&](double x) {
+      const Eigen::Vector2d p = from + x * (to - from);
+      return (geometry.point(carrier, p[0], p[1]) - loop[k]).norm();
+    };
+    const double golden = 0.5 * (std::sqrt(5.0) - 1.0);
+    double lo = 0.0, hi = 1.0;
+    double x1 = hi - golden * (hi - lo), x2 = lo + golden * (hi - lo);
+    double f1 = distance(x1), f2 = distance(x2);
+    for (int round = 0; round < 60; ++round)
+    {
+      if (f1 < f2)
+      {
+        hi = x2;
+        x2 = x1;
+        f2 = f1;
+        x1 = hi - golden * (hi - lo);
+        f1 = distance(x1);
+      }
+      else
+      {
+        lo = x1;
+        x1 = x2;
+        f1 = f2;
+        x2 = lo + golden * (hi - lo);
+        f2 = distance(x2);
+      }
+    }
+    const Eigen::Vector2d p = from + 0.5 * (lo + hi) * (to - from);
+    double s = p[0], t = p[1];
+    Vec3 start;
+    closestNear(surface, loop[k], s, t, start);
+    const double near = (geometry.point(carrier, s, t) - loop[k]).norm();
+    if (near + onSurface < away[k])
+    {
+      st[k] = Eigen::Vector2d(s, t);
+      away[k] = near;
+    }
+  }
   out.resize(3 * static_cast<std::size_t>(na) * nb);
   surfaceFaceGrid(surface, st, bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), out.data(),
     SurfaceFaceMethod::Guarded, nullptr, faceBlending(model, block, face));

@@ -124,13 +124,31 @@ std::vector<FootJoin> footJoins(const BlockModel& model, const MeshTopology& top
   {
     const UniqueEdge& edge = topology.edges[u];
     byVertices[{ std::min(edge.a, edge.b), std::max(edge.a, edge.b) }] = u;
+  }
+  const auto joined = [&](int v, int s) {
+    return byVertices.count({ std::min(v, s), std::max(v, s) }) > 0;
+  };
+  for (int u = 0; u < static_cast<int>(topology.edges.size()); ++u)
+  {
+    const UniqueEdge& edge = topology.edges[u];
     if (edge.projectedFrom < 0 || edge.a == edge.b)
     {
       continue;
     }
+    // a collapsed edge (its ends one point: a fan's feet on a sharp tip) cannot tell by
+    // position which source end is whose: the one joined to its vertex by an edge
+    const UniqueEdge& source = topology.edges[edge.projectedFrom];
+    const bool collapsed = model.vertices[edge.a].position == model.vertices[edge.b].position;
     for (int end = 0; end < 2; ++end)
     {
-      ends[{ end == 0 ? edge.a : edge.b, sourceEndVertex(model, topology, u, end) }].push_back({ u, end });
+      const int v = end == 0 ? edge.a : edge.b;
+      int s = sourceEndVertex(model, topology, u, end);
+      const int other = s == source.a ? source.b : source.a;
+      if (collapsed && !joined(v, s) && joined(v, other))
+      {
+        s = other;
+      }
+      ends[{ v, s }].push_back({ u, end });
     }
   }
   std::vector<FootJoin> joins;
@@ -148,6 +166,138 @@ std::vector<FootJoin> footJoins(const BlockModel& model, const MeshTopology& top
   return joins;
 }
 
+
+/// Beside a fan (gradeBesideFan): the side's first wall cell at most this many times the
+/// fan's, across the interface (the neighbour size ratio, issue 8's 1.5 with a margin for
+/// the estimate) ...
+constexpr double FanSideRatio = 1.35;
+/// ... and its next wall cells grow by at most this from cell to cell until they meet the
+/// projected feet: inside the block, where checkMesh's interpolation weight (0.05) fails
+/// between cells whose centres lie more than 19 times as far from their face.
+constexpr double FanSideGrowth = 10.0;
+
+/// The end cell length of `edge` at vertex `v` (one of its ends).
+double cellAtVertex(const UniqueEdge& edge, int v)
+{
+  return endCell(edge, edge.a == v ? 0 : 1);
+}
+
+/**
+ * The feet of a side beside a fan whose feet are one point (FootJoin with one edge
+ * collapsed: axial_passage_oh's prisms on a sharp tip). The wall cells are measured as
+ * joinFeet measures them: the fan's is e + (o - e) h / W with e = 0, a sliver of its outer
+ * cell o. The side's first outer node past the fan still lies on the O curve's arc round
+ * the tip, so its foot is the tip too (widened there to a 25th of the next cell), and its
+ * second on the flank, its foot as long as its outer cell: the side's first wall cell was
+ * 2.5-3.5 times the fan's (the compressor's O_le|O_b at densities 0.5-4), and the next
+ * 16-25 times that. Here the side's first foot is cut to FanSideRatio times the fan's wall
+ * cell, the next ones grow from it by at most FanSideGrowth per cell (their outer cells
+ * counted as above) until they reach the projected feet, which are kept from there on. The
+ * radial lines of the cells in between lean towards the tip (round a sharp tip the normal
+ * of a point on the O curve's arc has its foot on the tip, so those have no orthogonal foot).
+ */
+void gradeBesideFan(MeshTopology& topology, const FootJoin& join, int fan)
+{
+  const int side = 1 - fan;
+  UniqueEdge& edge = topology.edges[join.edge[side]];
+  const UniqueEdge& radial = topology.edges[join.radial];
+  const int outerVertex = radial.a == join.vertex ? radial.b : radial.a;
+  const UniqueEdge& fanSource = topology.edges[topology.edges[join.edge[fan]].projectedFrom];
+  const UniqueEdge& source = topology.edges[edge.projectedFrom];
+  const int cells = static_cast<int>(edge.params.size()) - 1;
+  if (cells < 3 || (fanSource.a != outerVertex && fanSource.b != outerVertex) ||
+    (source.a != outerVertex && source.b != outerVertex) || source.params.size() != edge.params.size())
+  {
+    return;
+  }
+  const double layer = cellAtVertex(radial, join.vertex) / radial.length / 2;
+  if (!(layer > 0.0 && layer < 0.5))
+  {
+    return;
+  }
+  const double fanWidth = cellAtVertex(fanSource, outerVertex) * layer;
+  // lengths from the join's vertex: the side's feet as projected (P) and its outer cells
+  const bool fromA = join.end[side] == 0;
+  const bool sourceFromA = source.a == outerVertex;
+  std::vector<double> P(cells + 1), outer(cells + 1, 0.0);
+  for (int m = 0; m <= cells; ++m)
+  {
+    P[m] = edge.length * (fromA ? edge.params[m] : 1.0 - edge.params[cells - m]);
+    if (m > 0)
+    {
+      const std::vector<double>& q = source.params;
+      outer[m] = source.length *
+        (sourceFromA ? q[m] - q[m - 1] : q[cells - m + 1] - q[cells - m]);
+    }
+  }
+  const double first = (FanSideRatio * fanWidth - outer[1] * layer) / (1.0 - layer);
+  if (!(first > 0.0))
+  {
+    return; // the outer cells differ more than that
+  }
+  // Cells 1..M: the feet whose wall cells grow by a common factor g <= FanSideGrowth
+  // from the first, landing on the projected foot M (never shrinking); the smallest M for
+  // which such a g exists and the projected cell after M is within FanSideGrowth of cell M.
+  const auto widthOf = [&](double foot, int k) { return foot * (1.0 - layer) + outer[k] * layer; };
+  const double firstWidth = widthOf(first, 1);
+  std::vector<double> Q(cells + 1, 0.0);
+  const auto fill = [&](double g, int last) { // Q[1..last] for factor g; returns Q[last]
+    double foot = first, width = firstWidth;
+    Q[1] = first;
+    for (int k = 2; k <= last; ++k)
+    {
+      width *= g;
+      foot = std::max((width - outer[k] * layer) / (1.0 - layer), foot);
+      Q[k] = Q[k - 1] + foot;
+    }
+    return Q[last];
+  };
+  // smooth[k]: the projected wall cells from k to the middle of the side grow by at most
+  // FanSideGrowth from cell to cell (the feet still on the tip are not)
+  const int half = cells / 2;
+  std::vector<char> smooth(cells + 2, 1);
+  for (int k = half; k >= 1; --k)
+  {
+    smooth[k] = smooth[k + 1] &&
+      widthOf(P[k + 1] - P[k], k + 1) <= FanSideGrowth * widthOf(P[k] - P[k - 1], k);
+  }
+  int m = 2;
+  for (; m <= half; ++m)
+  {
+    if (!smooth[m] || !(fill(1.0, m) <= P[m]) || !(fill(FanSideGrowth, m) >= P[m]))
+    {
+      continue;
+    }
+    double low = 1.0, high = FanSideGrowth;
+    for (int round = 0; round < 60; ++round)
+    {
+      const double g = 0.5 * (low + high);
+      (fill(g, m) < P[m] ? low : high) = g;
+    }
+    fill(high, m);
+    if (P[m] > Q[m - 1] &&
+      widthOf(P[m + 1] - P[m], m + 1) <= FanSideGrowth * widthOf(P[m] - Q[m - 1], m))
+    {
+      break;
+    }
+  }
+  if (m > half)
+  {
+    return; // not reached within half the side: left as projected
+  }
+  std::vector<double>& p = edge.params;
+  for (int k = 1; k < m; ++k)
+  {
+    if (fromA)
+    {
+      p[k] = Q[k] / edge.length;
+    }
+    else
+    {
+      p[cells - k] = 1.0 - Q[k] / edge.length;
+    }
+  }
+}
 
 /**
  * The feet at a blade corner (FootJoin): the wall cells on both sides of the radial edge
@@ -169,11 +319,19 @@ void joinFeet(const BlockModel& model, MeshTopology& topology, const FootJoin& j
 {
   UniqueEdge* edges[2] = { &topology.edges[join.edge[0]], &topology.edges[join.edge[1]] };
   const UniqueEdge& radial = topology.edges[join.radial];
+  if (radial.params.size() < 2 || !(radial.length > 0.0))
+  {
+    return;
+  }
   // A fan whose feet are one point (its blade arc collapsed, axial_passage_oh's prisms on a
   // sharp tip) has no wall width to join: cut to it, the side's first foot would vanish
-  // and fold the block at the corner.
-  if (radial.params.size() < 2 || !(radial.length > 0.0) || !(edges[0]->length > 0.0) ||
-    !(edges[1]->length > 0.0))
+  // and fold the block at the corner. The side's feet are graded up from the fan's instead.
+  if (!(edges[0]->length > 0.0) != !(edges[1]->length > 0.0))
+  {
+    gradeBesideFan(topology, join, edges[0]->length > 0.0 ? 1 : 0);
+    return;
+  }
+  if (!(edges[0]->length > 0.0) || !(edges[1]->length > 0.0))
   {
     return;
   }

@@ -647,3 +647,97 @@ TEST(ProjectedEdges, JoinedFeetFollowMovesAsAFreshMesherDoes)
   const test::Grid back = test::meshAll(model);
   EXPECT_TRUE(test::sameBits(plan.blockNodes(1), back.xyz[1]));
 }
+
+namespace
+{
+/**
+ * A fan on a sharp tip beside a flank: the tip at the origin, the blade along +x (its flank
+ * y = 0). R is the fan: its blade edge collapsed onto the tip (p0 = p1, two vertices on one
+ * point, as axial_passage_oh's prisms), its outer edge the arc of radius 0.5 about the tip
+ * from angle 220 to 90 deg; A runs along the flank from the tip to x = 2, its outer line
+ * y = 0.5 matched to R's arc's cell at (0, 0.5). Both blade edges are projected from the
+ * outer ones; j is graded geometric 1.3 away from the wall, 1 high.
+ */
+std::string fanBesideFlank()
+{
+  std::string text = "blockforge: 1\nvertices:\n";
+  for (const char* z : { "0", "1" })
+  {
+    const std::string k = z;
+    text += "  p0" + k + ": [0, 0, " + k + "]\n  p1" + k + ": [0, 0, " + k + "]\n  s" + k +
+      ": [0, 0.5, " + k + "]\n  t" + k + ": [-0.38302222155948906, -0.32139380484326968, " + k +
+      "]\n  w0" + k + ": [2, 0, " + k + "]\n  w3" + k + ": [2, 0.5, " + k + "]\n";
+  }
+  text += "edges:\n";
+  for (const char* z : { "0", "1" })
+  {
+    const std::string k = z;
+    text += "  fan" + k + ": {arc: [t" + k + ", s" + k + "], centre: [0, 0, " + k + "]}\n" +
+      "  side" + k + ": {line: [s" + k + ", w3" + k + "]}\n" +
+      "  flank" + k + ": {line: [p1" + k + ", w0" + k + "]}\n";
+  }
+  text += "blocks:\n"
+          "  R: {vertices: [p00, p10, s0, t0, p01, p11, s1, t1], cells: [8, 5, 1], grading: "
+          "{j: {geometric: 1.3}, edges: {E1: {project_from: fan0}, E5: {project_from: fan1}, "
+          "E3: match, E7: match}}}\n"
+          "  A: {vertices: [p10, w00, w30, s0, p11, w01, w31, s1], cells: [12, 5, 1], grading: "
+          "{j: {geometric: 1.3}, edges: {E1: {project_from: side0}, E5: {project_from: side1}, "
+          "E3: match, E7: match}}}\n";
+  return text;
+}
+} // namespace
+
+TEST(ProjectedEdges, FeetBesideAFanGrowFromItsWallCell)
+{
+  // The fan's wall cells are slivers of its outer cells (its feet are one point), while
+  // A's first foot, the normal foot of its first outer node, is as long as that node's
+  // cell: projected alone, A's first wall cell is about 11 times R's (as the compressor's
+  // sides beside their fans: 2.2-3.5 with their feet widened on the tip). Graded up from
+  // the fan (gradeBesideFan), A's first wall cell is 1.35 times R's across the interface
+  // and A's next wall cells grow by at most 10 from cell to cell (the estimate's outer part
+  // a little more) until they land on the normal feet, which A keeps from there on.
+  const BlockModel model = parseTemplate(fanBesideFlank(), "fan_flank.yaml");
+  for (const double density : { 1.0, 2.0, 4.0 })
+  {
+    SCOPED_TRACE(density);
+    const test::Grid grid = test::meshAll(model, density);
+    const int nr = grid.nodes[0][0], na = grid.nodes[1][0], outer = grid.nodes[1][1] - 1;
+    // R's feet are the tip
+    EXPECT_EQ(node(grid, 0, nr - 1, 0, 0), node(grid, 0, 0, 0, 0));
+    const auto centre = [&](int b, int i) -> Vec3 {
+      return 0.25 * (node(grid, b, i, 0, 0) + node(grid, b, i, 1, 0) + node(grid, b, i, 0, 1) +
+                      node(grid, b, i, 1, 1));
+    };
+    const double fan = (centre(0, nr - 1) - centre(0, nr - 2)).norm();
+    std::vector<double> side;
+    for (int i = 0; i + 1 < na; ++i)
+    {
+      side.push_back((centre(1, i + 1) - centre(1, i)).norm());
+    }
+    std::printf("density %g: wall cells R %.4g, A %.4g (ratio %.3f), A's next %.4g %.4g %.4g\n",
+      density, fan, side[0], side[0] / fan, side[1], side[2], side[3]);
+    EXPECT_LT(side[0] / fan, 1.5);
+    EXPECT_GT(side[0] / fan, 1.2);
+    int landed = -1;
+    for (int i = 1; i < na; ++i)
+    {
+      const double foot = node(grid, 1, i, 0, 0).x(), above = node(grid, 1, i, outer, 0).x();
+      EXPECT_GT(foot, node(grid, 1, i - 1, 0, 0).x()) << i;
+      EXPECT_NEAR(node(grid, 1, i, 0, 0).y(), 0.0, 1e-12) << i;
+      if (landed < 0 && std::abs(foot - above) < 1e-12)
+      {
+        landed = i;
+      }
+      if (landed >= 0)
+      {
+        EXPECT_NEAR(foot, above, 1e-12) << i; // the normal feet from there on
+      }
+    }
+    EXPECT_GE(landed, 2);
+    EXPECT_LE(landed, na / 2);
+    for (int i = 1; i < landed + 1; ++i)
+    {
+      EXPECT_LT(side[i] / side[i - 1], 11.0) << i;
+    }
+  }
+}
