@@ -88,6 +88,11 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
   }
 }
 
+void ControlProblem::refuseWeakFaces(bool refuse)
+{
+  P->RefuseWeakFaces = refuse;
+}
+
 bool ControlProblem::mayGain(std::size_t variable, const GridMeasures& current) const
 {
   if (Variables.at(variable).inert)

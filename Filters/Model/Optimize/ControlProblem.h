@@ -110,6 +110,13 @@ public:
   /// Control points held because they would move the domain's boundary, for the log.
   const std::vector<std::string>& boundaryLocked() const { return Locked; }
 
+  /**
+   * Whether a configuration whose grid fails more of checkMesh's interpolation-weight and
+   * volume-ratio faces (FaceChecks.h) than the start's is infeasible (the default), or only
+   * measured (GridMeasures::weakFaces).
+   */
+  void refuseWeakFaces(bool refuse);
+
   /// Places the configuration, meshes it and measures its final cells. Never throws: a
   /// configuration the mesher refuses is infeasible, with the reason in `failure`.
   GridMeasures evaluate(const std::vector<double>& x);

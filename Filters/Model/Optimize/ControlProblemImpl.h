@@ -78,6 +78,7 @@ struct ControlProblem::Impl
   std::vector<std::pair<int, std::unique_ptr<BlockCells>>> CellsBefore;
   std::unique_ptr<InterfaceFaces> Interfaces;
   long long StartWeakFaces = 0;
+  bool RefuseWeakFaces = true;
 
   /// Forgets the measured angles of the blocks the last plan update recomputed.
   void forgetUpdated()
@@ -142,7 +143,7 @@ struct ControlProblem::Impl
       return measures;
     }
     measures.weakFaces = weakFaces();
-    if (measures.weakFaces > StartWeakFaces)
+    if (RefuseWeakFaces && measures.weakFaces > StartWeakFaces)
     {
       measures.feasible = false;
       measures.objective = infeasibleObjective(measures.weakFaces - StartWeakFaces);
