@@ -35,17 +35,6 @@ inline bool collapsed(const Vec3& area, const Vec3& a, const Vec3& b, const Vec3
 }
 } // namespace
 
-bool weakFace(const Vec3& area, const Vec3& centre, const Vec3& owner, const Vec3& neighbour,
-  double ownerVolume, double neighbourVolume)
-{
-  const double toOwner = std::abs(area.dot(centre - owner));
-  const double toNeighbour = std::abs(area.dot(neighbour - centre));
-  const double weight = std::min(toOwner, toNeighbour) / (toOwner + toNeighbour + quality::vSmall);
-  const double ratio = std::min(ownerVolume, neighbourVolume) /
-    (std::max(ownerVolume, neighbourVolume) + quality::vSmall);
-  return weight < MinimumFaceWeight || ratio < MinimumVolumeRatio;
-}
-
 BlockCells::BlockCells(const BlockGrid& grid)
 {
   const int ni = grid.ni, nj = grid.nj, nk = grid.nk;

@@ -19,6 +19,8 @@
 
 #include "GridObjective.h"
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -30,9 +32,18 @@ namespace optimize
 constexpr double MinimumFaceWeight = 0.05;
 constexpr double MinimumVolumeRatio = 0.01;
 
-/// Whether a face fails the interpolation weight or the volume ratio.
-bool weakFace(const Vec3& area, const Vec3& centre, const Vec3& owner, const Vec3& neighbour,
-  double ownerVolume, double neighbourVolume);
+/// Whether a face fails the interpolation weight or the volume ratio (area vector, face
+/// centre, the two cells' centres and volumes).
+inline bool weakFace(const Vec3& area, const Vec3& centre, const Vec3& owner, const Vec3& neighbour,
+  double ownerVolume, double neighbourVolume)
+{
+  constexpr double vSmall = 1.0e-300; // OpenFOAM's VSMALL
+  const double toOwner = std::abs(area.dot(centre - owner));
+  const double toNeighbour = std::abs(area.dot(neighbour - centre));
+  return std::min(toOwner, toNeighbour) < MinimumFaceWeight * (toOwner + toNeighbour + vSmall) ||
+    std::min(ownerVolume, neighbourVolume) <
+    MinimumVolumeRatio * (std::max(ownerVolume, neighbourVolume) + vSmall);
+}
 
 /// OpenFOAM's cell centres and volumes of one block grid, and how many faces between its
 /// own cells fail (weakFace).
