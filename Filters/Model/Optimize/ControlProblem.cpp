@@ -52,7 +52,7 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
     }
     if (P->Objective.kind != ObjectiveKind::NonOrthogonality && feasibility.feasible())
     {
-      return P->measureChanged();
+      return P->refuseWeakFaces(P->measureChanged());
     }
     if (!feasibility.feasible())
     {
@@ -72,7 +72,8 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
       P->Objective.kind == ObjectiveKind::NonOrthogonality
       ? P->Plan->topology().periodicSideLinks()
       : std::vector<PeriodicSideLink>();
-    return measureGrid(blocks, periodic, P->Objective);
+    P->Cells.clear(); // (this objective does not keep the blocks' angles either)
+    return P->refuseWeakFaces(measureGrid(blocks, periodic, P->Objective));
   }
   catch (const std::exception& error)
   {
@@ -85,6 +86,11 @@ GridMeasures ControlProblem::evaluate(const std::vector<double>& x)
     failed.failure = error.what();
     return failed;
   }
+}
+
+void ControlProblem::refuseWeakFaces(bool refuse)
+{
+  P->RefuseWeakFaces = refuse;
 }
 
 bool ControlProblem::mayGain(std::size_t variable, const GridMeasures& current) const
@@ -131,6 +137,11 @@ void ControlProblem::reject()
     P->Angles[block] = std::move(angles);
   }
   P->AnglesBefore.clear();
+  for (auto& [block, cells] : P->CellsBefore)
+  {
+    P->Cells[block] = std::move(cells);
+  }
+  P->CellsBefore.clear();
   P->SizeRatios = P->SizeRatiosBefore;
 }
 

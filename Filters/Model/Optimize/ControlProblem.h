@@ -29,6 +29,11 @@
  * nodes of side a shifted against those of side b (measured on the OH template: Rotor 37
  * 23.6 -> 30.8 degrees with the end cells skewed 3 times, Benchmark/OPTIMIZER_LIMITS.md).
  *
+ * A configuration is infeasible when its grid folds, or when it fails more of checkMesh's
+ * interpolation-weight and volume-ratio faces than the start's grid (FaceChecks.h; e.g. a
+ * fan's corner moved off the tip's arc while its feet stay on the tip): the smallest angle
+ * does not see a wall cell beside one 20 times its width.
+ *
  * Everything that follows a moved vertex follows it: vertices placed from it (rules),
  * the parameters of carrier edges ending at it, and surface curves drawn through it.
  * Evaluations run on a mesh plan (MeshPlan.h) kept between them, which recomputes only
@@ -109,6 +114,13 @@ public:
   std::vector<double> high() const;
   /// Control points held because they would move the domain's boundary, for the log.
   const std::vector<std::string>& boundaryLocked() const { return Locked; }
+
+  /**
+   * Whether a configuration whose grid fails more of checkMesh's interpolation-weight and
+   * volume-ratio faces (FaceChecks.h) than the start's is infeasible (the default), or only
+   * measured (GridMeasures::weakFaces).
+   */
+  void refuseWeakFaces(bool refuse);
 
   /// Places the configuration, meshes it and measures its final cells. Never throws: a
   /// configuration the mesher refuses is infeasible, with the reason in `failure`.

@@ -4,6 +4,7 @@
 #define BLOCKFORGE_CONTROL_PROBLEM_IMPL_H
 
 #include "ControlProblem.h"
+#include "FaceChecks.h"
 
 #include "../../Core/InvertedCells.h"
 
@@ -70,23 +71,87 @@ struct ControlProblem::Impl
   /// recomputed, as they were before it (what reject() puts back with the plan's undo).
   std::vector<std::pair<int, std::unique_ptr<BlockAngles>>> AnglesBefore;
   std::vector<double> SizeRatiosBefore;
+  /// Cell centres, volumes and weak faces (FaceChecks.h) of every block as of the last
+  /// feasible evaluation, kept and put back as the angles are; the faces between blocks;
+  /// and the weak faces of the start's grid, the most a configuration may have.
+  std::vector<std::unique_ptr<BlockCells>> Cells;
+  std::vector<std::pair<int, std::unique_ptr<BlockCells>>> CellsBefore;
+  std::unique_ptr<InterfaceFaces> Interfaces;
+  long long StartWeakFaces = 0;
+  bool RefuseWeakFaces = true;
 
   /// Forgets the measured angles of the blocks the last plan update recomputed.
   void forgetUpdated()
   {
     AnglesBefore.clear();
+    CellsBefore.clear();
     if (!Plan)
     {
       Angles.clear();
+      Cells.clear();
       return;
     }
     Angles.resize(Plan->blockCount());
+    Cells.resize(Plan->blockCount());
     SizeRatios.resize(Plan->blockCount(), 1.0);
     SizeRatiosBefore = SizeRatios;
     for (int b : Plan->updatedBlocks())
     {
       AnglesBefore.emplace_back(b, std::move(Angles[b]));
+      CellsBefore.emplace_back(b, std::move(Cells[b]));
     }
+  }
+
+  /// The grids of the plan's blocks.
+  std::vector<BlockGrid> planGrids() const
+  {
+    std::vector<BlockGrid> grids;
+    for (int b = 0; b < Plan->blockCount(); ++b)
+    {
+      const std::array<int, 3> n = Plan->nodeCounts(b);
+      grids.push_back({ Plan->blockNodes(b).data(), n[0], n[1], n[2] });
+    }
+    return grids;
+  }
+
+  /// Faces of the plan's grid that fail checkMesh's interpolation weight or volume ratio
+  /// (FaceChecks.h), measuring the cells of the blocks that changed only.
+  long long weakFaces()
+  {
+    const std::vector<BlockGrid> grids = planGrids();
+    Cells.resize(grids.size());
+    std::vector<const BlockCells*> cells;
+    long long weak = 0;
+    for (std::size_t b = 0; b < grids.size(); ++b)
+    {
+      if (!Cells[b])
+      {
+        Cells[b].reset(new BlockCells(grids[b]));
+      }
+      cells.push_back(Cells[b].get());
+      weak += Cells[b]->weakFaces();
+    }
+    return weak + Interfaces->weakFaces(grids, cells);
+  }
+
+  /// A feasible measure with more weak faces than the start becomes infeasible: the
+  /// optimizer refuses configurations that fail more of checkMesh's face checks.
+  GridMeasures refuseWeakFaces(GridMeasures measures)
+  {
+    if (!measures.feasible)
+    {
+      return measures;
+    }
+    measures.weakFaces = weakFaces();
+    if (RefuseWeakFaces && measures.weakFaces > StartWeakFaces)
+    {
+      measures.feasible = false;
+      measures.objective = infeasibleObjective(measures.weakFaces - StartWeakFaces);
+      measures.failure = std::to_string(measures.weakFaces) +
+        " faces fail checkMesh's interpolation weight or volume ratio (" +
+        std::to_string(StartWeakFaces) + " at the start)";
+    }
+    return measures;
   }
 
   /// The angle objectives of the plan's grid, measuring only the blocks that changed
@@ -217,6 +282,11 @@ struct ControlProblem::Impl
     if (!Plan)
     {
       Plan.reset(new model::MeshPlan(Base, Geometry, Density));
+      // the start's weak faces: the most a configuration may have
+      const std::vector<BlockGrid> grids = planGrids();
+      Interfaces.reset(new InterfaceFaces(grids, Plan->topology().periodicSideLinks()));
+      Cells.clear();
+      StartWeakFaces = weakFaces();
       Current.clear();
       for (const ControlVariable& variable : Variables)
       {

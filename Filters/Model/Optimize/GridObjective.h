@@ -118,6 +118,9 @@ struct GridMeasures
   /// minimum's window (cornerSum counts it); a step that changes only blocks outside the
   /// window cannot raise the smooth minimum. Empty for other objectives.
   std::vector<char> activeBlocks;
+  /// Faces failing checkMesh's interpolation weight or volume ratio (FaceChecks.h); a
+  /// configuration with more than its start is infeasible. 0 when not measured.
+  long long weakFaces = 0;
   double objective = 0.0;         ///< the value minimised (lower is better)
   std::string failure;            ///< why it is not feasible
 };
