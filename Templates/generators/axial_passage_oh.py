@@ -123,8 +123,13 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   2.4 times smaller than the H block's beside them);
 # - U_L, U_R, D_L and D_R keep their edges' end cells along their interior lines
 #   (`interpolation: end_cells`): with the edges' fractions the turbine's D_L against D_M
-#   reached 3.5 (not U_M/D_M, where the O arc leaves its corner nearly along the H line,
-#   nor M_L/M_R, whose shear would gather in their middle cells).
+#   reached 3.5 (not M_L/M_R, whose shear would gather in their middle cells);
+# - U_M and D_M blend their lines from the O-grid to the inlet / outlet `adaptive`: linear
+#   while those lines are within 20 % of their edges' lengths (Rotor 37, the distributor and
+#   the compressor: the same grids), towards end_cells where a round nose or tail makes the
+#   middle lines much shorter than the sides (the turbine's U_M: half as long, its cells at
+#   the O arc 1.8 times smaller than O_le's outer cells; end_cells throughout made the
+#   compressor's U_L|U_M 1.89 -> 2.28, where the O arc leaves its corner along the H line).
 blockforge: 2
 name: axial_passage_oh
 description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.
@@ -178,12 +183,12 @@ FOOTER = """blocks:
   O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
   O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, 1], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
   U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
-  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: {j: adaptive}}
   U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
   M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end, period_end], flat: period_flat}, E8: {ends: [period_end, period_end], flat: period_flat}}}}
   M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end, period_end], flat: period_flat}, E6: {ends: [period_end, period_end], flat: period_flat}}}}
   D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
-  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: {j: adaptive}}
   D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
 
 faces:
