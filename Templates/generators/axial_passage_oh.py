@@ -54,7 +54,7 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   lines normal to blade and O-grid), unless the edge block would still be a fan more than
 #   o_fan times wider outside than on the blade (a sharp wedge, whose edge block is left a
 #   fan on the tip: arc-length nodes on a short blade arc under a wide fan fold it).
-# - A trailing edge neither sharp nor sheared (the turbine's capped one): the feet stay o_back
+# - A trailing edge neither sharp nor sheared (a round or capped one, shear_camber 0 on the turbine): the feet stay o_back
 #   along the blade from the edge, the corners their normal offsets on the flanks, so that the
 #   edge block holds the whole fan round the tip or the cap's corners and meets the sides
 #   with cells on the flanks (corners on the fan make the edge block's first cells the feet of
@@ -83,11 +83,12 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   Only at round edges (round_le/te: the O arc between the o_corner points at most o_fan
 #   times the blade arc between their feet): the edge block of a sharp edge is a fan on its
 #   tip, which a corner moved along one side folds. At the default 45deg the distributor's
-#   trailing edge and Rotor 37's edges are sheared; the compressor (sharp) and the turbine
-#   (stagger below 45 deg) are not (o_shear 0: no edge is). With shear_camber 1 the stagger
-#   is the larger of that and the camber's at the edge itself (the turbine's trailing edge,
-#   exit about 60 deg, is then sheared; not the default: at density 0.5 the blade cells of
-#   O_a against O_te's 3.89 times, and without min_down its wake block folded there).
+#   trailing edge and Rotor 37's edges are sheared; the compressor (sharp) is not (o_shear 0:
+#   no edge is). With shear_camber 1 (the default) the stagger is the larger of that and the
+#   camber's at the edge itself: the turbine's capped trailing edge (exit about 60 deg, its
+#   stagger from mid-camber below 45 deg) is sheared too; unsheared, its corners sat on the
+#   flanks (o_back) and the wake block D_M had 7 / 14.5 deg at oa_r / ob_r, its first column
+#   pinched to 0.4 of D_L's beside it (D_L against D_M 2.6-2.8).
 # - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
