@@ -278,9 +278,16 @@ def template_text():
             # staggered (a strongly cambered blade's exit: the turbine's trailing edge leaves at
             # about 60 deg while its chord from mid-camber is below 45 deg)
             sg = '-' if e == 'le' else ''
-            camber = f'shear_camber > 0.5 && abs({e}_uy_{l}) > abs({e}_cy_{l})'
-            w(f'  {e}_tx_{l}: "{camber} ? {sg}{e}_ux_{l} : {e}_cx_{l}"')
-            w(f'  {e}_ty_{l}: "{camber} ? {sg}{e}_uy_{l} : {e}_cy_{l}"')
+            # (from fixed copies of the edge and its probes, kf below: the optimizer moves the
+            # edge, and a shear that followed it would move every corner with it, which its
+            # trial filter does not expect of an edge point)
+            fx0 = f'{e}f_{l}.axial - (pfa_{e}_{l}.axial + pfb_{e}_{l}.axial)/2'
+            fy0 = f'rm_{l}*({e}f_{l}.theta - (pfa_{e}_{l}.theta + pfb_{e}_{l}.theta)/2)'
+            w(f'  {e}_fux_{l}: "({fx0})/sqrt(({fx0})^2 + ({fy0})^2)"      # camber direction at the edge, from fixed helpers')
+            w(f'  {e}_fuy_{l}: "({fy0})/sqrt(({fx0})^2 + ({fy0})^2)"')
+            camber = f'shear_camber > 0.5 && abs({e}_fuy_{l}) > abs({e}_cy_{l})'
+            w(f'  {e}_tx_{l}: "{camber} ? {sg}{e}_fux_{l} : {e}_cx_{l}"')
+            w(f'  {e}_ty_{l}: "{camber} ? {sg}{e}_fuy_{l} : {e}_cy_{l}"')
             w(f'  {e}_shear_{l}: "abs({e}_ty_{l})*tan(o_shear) > abs({e}_tx_{l})"      # 1: the corners are sheared at this edge')
             w(f'  {e}_lam_{l}: "{e}_shear_{l} ? abs({e}_tx_{l})/(abs({e}_ty_{l})*tan(o_shear)) : 1"')
             w(f'  {e}_dx_{l}: "{e}_tx_{l}*{e}_ty_{l}*({e}_lam_{l} - 1)"      # direction of the sheared lines across the passage')
@@ -345,6 +352,11 @@ def template_text():
         w(f'  pb_le_{l}: {{on_curve: blade_{l}, at: "le_{l}.s - dir_{l}*probe"}}')
         w(f'  pa_te_{l}: {{on_curve: blade_{l}, at: "te_{l}.s - dir_{l}*probe"}}')
         w(f'  pb_te_{l}: {{on_curve: blade_{l}, at: "te_{l}.s + dir_{l}*probe"}}')
+        # fixed copies of the edges and their probes (shear_camber's camber direction)
+        for e, ext, sa, sb in (('le', 'min', '+', '-'), ('te', 'max', '-', '+')):
+            w(f'  {e}f_{l}: {{on_curve: blade_{l}, at: {{{ext}: axial}}, fixed: true}}')
+            w(f'  pfa_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sa} dir_{l}*probe", fixed: true}}')
+            w(f'  pfb_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sb} dir_{l}*probe", fixed: true}}')
         w(f'  ole_{l}: {{project: le_{l}, onto: o_{l}}}')
         w(f'  ote_{l}: {{project: te_{l}, onto: o_{l}}}')
         # each corner is searched on its own side only: from the edge towards side a (b)
