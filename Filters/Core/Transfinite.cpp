@@ -16,10 +16,67 @@ namespace blockforge
 {
 namespace
 {
-/// The blending weight of parameter x (Blending).
-inline double weight(double x, Blending blending)
+/// The blending weight of parameter x for a blend b from linear (0) towards end cells (1):
+/// x + b x (1 - x) (2x - 1), its slope 1 - b at both ends (b = 1: smoothstep x^2 (3 - 2x)).
+inline double weight(double x, double b)
 {
-  return blending == Blending::EndCells ? x * x * (3.0 - 2.0 * x) : x;
+  if (b == 0.0)
+  {
+    return x;
+  }
+  if (b == 1.0)
+  {
+    return x * x * (3.0 - 2.0 * x);
+  }
+  return x + b * x * (1.0 - x) * (2.0 * x - 1.0);
+}
+
+/// The blend b of a fixed Blending (Adaptive is resolved before: resolveAdaptive).
+inline double fixedBlend(Blending blending)
+{
+  return blending == Blending::EndCells ? 1.0 : 0.0;
+}
+
+/// Largest relative difference between the length of an interior line of a grid of
+/// na x nb nodes (a fastest) and the blend of the two boundary lines beside it: lines
+/// along b at each a (alongB) weighted by `across` (the parameters of a, na values), or
+/// lines along a at each b.
+double lineSpread(const double* grid, int na, int nb, bool alongB, const double* across)
+{
+  const int lines = alongB ? na : nb;
+  const int nodes = alongB ? nb : na;
+  const auto length = [&](int line) {
+    double sum = 0.0;
+    for (int n = 1; n < nodes; ++n)
+    {
+      const long a = alongB ? static_cast<long>(line) + static_cast<long>(na) * n
+                            : static_cast<long>(n) + static_cast<long>(na) * line;
+      const long b = alongB ? a - na : a - 1;
+      const double* p = grid + 3 * a;
+      const double* q = grid + 3 * b;
+      sum += std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+        (p[2] - q[2]) * (p[2] - q[2]));
+    }
+    return sum;
+  };
+  const double first = length(0), last = length(lines - 1);
+  double spread = 0.0;
+  for (int line = 1; line < lines - 1; ++line)
+  {
+    const double x = across[line];
+    const double blend = (1.0 - x) * first + x * last;
+    if (blend > 0.0)
+    {
+      spread = std::max(spread, std::abs(length(line) / blend - 1.0));
+    }
+  }
+  return spread;
+}
+
+/// The blend b of an Adaptive direction whose lines spread by `spread` (Blending).
+inline double adaptiveBlend(double spread)
+{
+  return spread > kAdaptiveTolerance ? 1.0 - kAdaptiveTolerance / spread : 0.0;
 }
 
 inline void copyNode(const double* from, double* to)
@@ -99,14 +156,14 @@ void copyBoundary(const BlockFaces& faces, int ni, int nj, int nk, double* out)
  */
 void interiorSeparable(const BlockFaces& F, const std::array<const double*, 12>& params, int ni,
   int nj, int nk, int kBegin, int kEnd, const double* uFaceDifference,
-  const std::array<Blending, 3>& blending, double* out)
+  const std::array<double, 3>& blending, double* out)
 {
   const double* sOfI = params[0];
   const double* tOfJ = params[3];
   const double* uOfK = params[8];
   std::vector<double> sWeights, tWeights, uWeights;
-  const auto weights = [](const double* p, int n, Blending b, std::vector<double>& w) {
-    if (b == Blending::Linear)
+  const auto weights = [](const double* p, int n, double b, std::vector<double>& w) {
+    if (b == 0.0)
     {
       return p;
     }
@@ -208,7 +265,7 @@ void interiorSeparable(const BlockFaces& F, const std::array<const double*, 12>&
  * count is bounded so the result is deterministic.
  */
 void interiorCoupled(const BlockFaces& F, const std::array<const double*, 12>& p, int ni, int nj,
-  int kBegin, int kEnd, const std::array<Blending, 3>& blending, double* out)
+  int kBegin, int kEnd, const std::array<double, 3>& blending, double* out)
 {
   constexpr int maxSweeps = 50;
   constexpr double tolerance = 1e-15;
@@ -313,31 +370,63 @@ void transfiniteFace(const EdgeNodes& bottom, const EdgeNodes& top, const EdgeNo
 
   std::memcpy(out, bottom.xyz, sizeof(double) * 3 * ni);
   std::memcpy(out + 3 * static_cast<long>(ni) * (nj - 1), top.xyz, sizeof(double) * 3 * ni);
-  for (int j = 1; j < nj - 1; ++j)
-  {
-    double* row = out + 3 * static_cast<long>(ni) * j;
-    const double* L = left.xyz + 3 * j;
-    const double* R = right.xyz + 3 * j;
-    copyNode(L, row);
-    copyNode(R, row + 3 * (ni - 1));
-    const double tL = left.params[j];
-    const double tR = right.params[j];
-    const double dt = tR - tL;
-    for (int i = 1; i < ni - 1; ++i)
+  const auto interior = [&](const std::array<double, 2>& blend) {
+    for (int j = 1; j < nj - 1; ++j)
     {
-      const double sB = bottom.params[i];
-      const double ds = top.params[i] - sB;
-      const double denominator = 1.0 - ds * dt;
-      const double s = weight((sB + tL * ds) / denominator, blending[0]);
-      const double t = weight((tL + sB * dt) / denominator, blending[1]);
-      const double* B = bottom.xyz + 3 * i;
-      const double* T = top.xyz + 3 * i;
-      for (int c = 0; c < 3; ++c)
+      double* row = out + 3 * static_cast<long>(ni) * j;
+      const double* L = left.xyz + 3 * j;
+      const double* R = right.xyz + 3 * j;
+      copyNode(L, row);
+      copyNode(R, row + 3 * (ni - 1));
+      const double tL = left.params[j];
+      const double tR = right.params[j];
+      const double dt = tR - tL;
+      for (int i = 1; i < ni - 1; ++i)
       {
-        row[3 * i + c] = (1 - s) * L[c] + s * R[c] + (1 - t) * B[c] + t * T[c] -
-          ((1 - s) * (1 - t) * P00[c] + s * (1 - t) * P10[c] + (1 - s) * t * P01[c] +
-            s * t * P11[c]);
+        const double sB = bottom.params[i];
+        const double ds = top.params[i] - sB;
+        const double denominator = 1.0 - ds * dt;
+        const double s = weight((sB + tL * ds) / denominator, blend[0]);
+        const double t = weight((tL + sB * dt) / denominator, blend[1]);
+        const double* B = bottom.xyz + 3 * i;
+        const double* T = top.xyz + 3 * i;
+        for (int c = 0; c < 3; ++c)
+        {
+          row[3 * i + c] = (1 - s) * L[c] + s * R[c] + (1 - t) * B[c] + t * T[c] -
+            ((1 - s) * (1 - t) * P00[c] + s * (1 - t) * P10[c] + (1 - s) * t * P01[c] +
+              s * t * P11[c]);
+        }
       }
+    }
+  };
+  std::array<double, 2> blend{ fixedBlend(blending[0]), fixedBlend(blending[1]) };
+  interior(blend);
+  if (blending[0] == Blending::Adaptive || blending[1] == Blending::Adaptive)
+  {
+    // the linear grid's lines: their spread in length decides how far to blend
+    std::vector<double> across(std::max(ni, nj));
+    bool again = false;
+    if (blending[0] == Blending::Adaptive) // lines along i at each j
+    {
+      for (int j = 0; j < nj; ++j)
+      {
+        across[j] = 0.5 * (left.params[j] + right.params[j]);
+      }
+      blend[0] = adaptiveBlend(lineSpread(out, ni, nj, false, across.data()));
+      again = again || blend[0] > 0.0;
+    }
+    if (blending[1] == Blending::Adaptive) // lines along j at each i
+    {
+      for (int i = 0; i < ni; ++i)
+      {
+        across[i] = 0.5 * (bottom.params[i] + top.params[i]);
+      }
+      blend[1] = adaptiveBlend(lineSpread(out, ni, nj, true, across.data()));
+      again = again || blend[1] > 0.0;
+    }
+    if (again)
+    {
+      interior(blend);
     }
   }
 }
@@ -379,6 +468,47 @@ void transfiniteBlock(const BlockBoundary& boundary, int ni, int nj, int nk, dou
   }
 
   const auto& p = boundary.edgeParams;
+  std::array<double, 3> blend{ fixedBlend(boundary.blending[0]), fixedBlend(boundary.blending[1]),
+    fixedBlend(boundary.blending[2]) };
+  {
+    // Adaptive: the spread of the lines along that direction on the four faces holding them
+    // (face f's grid na x nb; the lines along b at each a, or along a at each b, weighted by
+    // the mean parameters of the face's two edges across them)
+    struct Lines
+    {
+      int face;
+      bool alongB;
+      int edge0, edge1;
+    };
+    static const std::array<std::array<Lines, 4>, 3> lines{ {
+      { { { 2, false, 8, 9 }, { 3, false, 11, 10 }, { 4, false, 3, 1 }, { 5, false, 7, 5 } } },
+      { { { 0, false, 8, 11 }, { 1, false, 9, 10 }, { 4, true, 0, 2 }, { 5, true, 4, 6 } } },
+      { { { 0, true, 3, 7 }, { 1, true, 1, 5 }, { 2, true, 0, 4 }, { 3, true, 2, 6 } } },
+    } };
+    const std::array<std::array<int, 2>, 6> dims{ { { nj, nk }, { nj, nk }, { ni, nk },
+      { ni, nk }, { ni, nj }, { ni, nj } } };
+    std::vector<double> across;
+    for (int d = 0; d < 3; ++d)
+    {
+      if (boundary.blending[d] != Blending::Adaptive)
+      {
+        continue;
+      }
+      double spread = 0.0;
+      for (const Lines& set : lines[d])
+      {
+        const int na = dims[set.face][0], nb = dims[set.face][1];
+        const int count = set.alongB ? na : nb;
+        across.resize(count);
+        for (int n = 0; n < count; ++n)
+        {
+          across[n] = 0.5 * (p[set.edge0][n] + p[set.edge1][n]);
+        }
+        spread = std::max(spread, lineSpread(boundary.faces[set.face], na, nb, set.alongB, across.data()));
+      }
+      blend[d] = adaptiveBlend(spread);
+    }
+  }
   const bool separable = sameParameters(p[0], p[2], ni) && sameParameters(p[0], p[4], ni) &&
     sameParameters(p[0], p[6], ni) && sameParameters(p[3], p[1], nj) &&
     sameParameters(p[3], p[7], nj) && sameParameters(p[3], p[5], nj) &&
@@ -410,11 +540,11 @@ void transfiniteBlock(const BlockBoundary& boundary, int ni, int nj, int nk, dou
       if (separable)
       {
         interiorSeparable(
-          faces, p, ni, nj, nk, kBegin, kEnd, uFaceDifference.data(), boundary.blending, out);
+          faces, p, ni, nj, nk, kBegin, kEnd, uFaceDifference.data(), blend, out);
       }
       else
       {
-        interiorCoupled(faces, p, ni, nj, kBegin, kEnd, boundary.blending, out);
+        interiorCoupled(faces, p, ni, nj, kBegin, kEnd, blend, out);
       }
     });
 }

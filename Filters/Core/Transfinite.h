@@ -40,8 +40,21 @@ namespace blockforge
 enum class Blending
 {
   Linear,
-  EndCells
+  EndCells,
+  /// Linear where every interior line of that direction on the boundary (a face's own
+  /// lines after a linear pass; a block's on its four faces along it) is within
+  /// kAdaptiveTolerance of the blend of the two edges beside it in length, so that linear
+  /// fractions already keep its end cells within that; else the weights x + b x (1 - x)
+  /// (2x - 1), b = 1 - kAdaptiveTolerance / spread (b = 1: EndCells), just so far towards
+  /// EndCells that the end cells stay within kAdaptiveTolerance of the edges'. An inlet
+  /// block in front of a round nose whose middle lines are half as long as its sides
+  /// (axial_passage_oh's U_M on the turbine) then keeps the O-grid's outer cell there,
+  /// while a block whose lines are alike is the linear grid bit for bit.
+  Adaptive
 };
+
+/// Relative length spread of interior lines up to which Blending::Adaptive stays linear.
+constexpr double kAdaptiveTolerance = 0.2;
 
 /// Nodes of one edge and their relative positions (distribution parameters) in [0, 1].
 struct EdgeNodes

@@ -283,9 +283,15 @@ std::array<Blending, 3> parseBlending(
     {
       return Blending::EndCells;
     }
+    if (value.IsScalar() && value.Scalar() == "adaptive")
+    {
+      return Blending::Adaptive;
+    }
     reporter.fail(at, entityText,
       "'interpolation' must be 'linear' (the default: interior lines take the edges' "
-      "fractions), 'end_cells' (interior lines keep the edges' end cells as lengths) or "
+      "fractions), 'end_cells' (interior lines keep the edges' end cells as lengths), "
+      "'adaptive' (linear while the interior lines' lengths stay within 20 % of their "
+      "edges', else towards end_cells so that their end cells do) or "
       "{i: .., j: .., k: ..} of those");
   };
   if (!node.IsMap())
@@ -308,7 +314,9 @@ std::array<Blending, 3> parseBlending(
 
 void emitBlending(YAML::Emitter& out, const std::array<Blending, 3>& blending)
 {
-  const auto name = [](Blending b) { return b == Blending::EndCells ? "end_cells" : "linear"; };
+  const auto name = [](Blending b) {
+    return b == Blending::EndCells ? "end_cells" : b == Blending::Adaptive ? "adaptive" : "linear";
+  };
   if (blending[0] == blending[1] && blending[1] == blending[2])
   {
     if (blending[0] != Blending::Linear)

@@ -54,7 +54,7 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   lines normal to blade and O-grid), unless the edge block would still be a fan more than
 #   o_fan times wider outside than on the blade (a sharp wedge, whose edge block is left a
 #   fan on the tip: arc-length nodes on a short blade arc under a wide fan fold it).
-# - A trailing edge neither sharp nor sheared (the turbine's capped one): the feet stay o_back
+# - A trailing edge neither sharp nor sheared (a round or capped one, shear_camber 0 on the turbine): the feet stay o_back
 #   along the blade from the edge, the corners their normal offsets on the flanks, so that the
 #   edge block holds the whole fan round the tip or the cap's corners and meets the sides
 #   with cells on the flanks (corners on the fan make the edge block's first cells the feet of
@@ -83,11 +83,12 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   Only at round edges (round_le/te: the O arc between the o_corner points at most o_fan
 #   times the blade arc between their feet): the edge block of a sharp edge is a fan on its
 #   tip, which a corner moved along one side folds. At the default 45deg the distributor's
-#   trailing edge and Rotor 37's edges are sheared; the compressor (sharp) and the turbine
-#   (stagger below 45 deg) are not (o_shear 0: no edge is). With shear_camber 1 the stagger
-#   is the larger of that and the camber's at the edge itself (the turbine's trailing edge,
-#   exit about 60 deg, is then sheared; not the default: at density 0.5 the blade cells of
-#   O_a against O_te's 3.89 times, and without min_down its wake block folded there).
+#   trailing edge and Rotor 37's edges are sheared; the compressor (sharp) is not (o_shear 0:
+#   no edge is). With shear_camber 1 (the default) the stagger is the larger of that and the
+#   camber's at the edge itself: the turbine's capped trailing edge (exit about 60 deg, its
+#   stagger from mid-camber below 45 deg) is sheared too; unsheared, its corners sat on the
+#   flanks (o_back) and the wake block D_M had 7 / 14.5 deg at oa_r / ob_r, its first column
+#   pinched to 0.4 of D_L's beside it (D_L against D_M 2.6-2.8).
 # - Spanwise, the O-grid's outer corner edges follow the blade's corner edges (`follow`),
 #   so a thin O-grid keeps its width along a bowed or leaning blade edge.
 # - O blocks run i around the blade (clockwise in the sketch), j away from the blade, k
@@ -123,8 +124,13 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   2.4 times smaller than the H block's beside them);
 # - U_L, U_R, D_L and D_R keep their edges' end cells along their interior lines
 #   (`interpolation: end_cells`): with the edges' fractions the turbine's D_L against D_M
-#   reached 3.5 (not U_M/D_M, where the O arc leaves its corner nearly along the H line,
-#   nor M_L/M_R, whose shear would gather in their middle cells).
+#   reached 3.5 (not M_L/M_R, whose shear would gather in their middle cells);
+# - U_M and D_M blend their lines from the O-grid to the inlet / outlet `adaptive`: linear
+#   while those lines are within 20 % of their edges' lengths (Rotor 37, the distributor and
+#   the compressor: the same grids), towards end_cells where a round nose or tail makes the
+#   middle lines much shorter than the sides (the turbine's U_M: half as long, its cells at
+#   the O arc 1.8 times smaller than O_le's outer cells; end_cells throughout made the
+#   compressor's U_L|U_M 1.89 -> 2.28, where the O arc leaves its corner along the H line).
 blockforge: 2
 name: axial_passage_oh
 description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.
@@ -139,7 +145,7 @@ parameters:
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
   o_shear: 45deg          # the H lines across the passage beside the blade meet its chord at least at this angle: one side's O corners move along the blade against the other's (0: none; 45deg: the optimized distributor and Rotor 37 reach 47.9 and 47.0 deg at density 1)
   o_lean_shear: 0deg      # at a sheared edge the other corner's normal leans this far from the camber direction (in place of o_corner)
-  shear_camber: 0         # 1: the stagger that decides the shear (o_shear) at an edge is the larger of the blade's near the edge (edge to mid-camber) and the camber's at the edge itself (the turbine's trailing edge is then sheared: optimized 26.4 -> 38.0 deg at density 1, but at density 0.5 O_a's blade cells 3.89 times O_te's; its wake block folded there before min_down); 0: the blade's near the edge
+  shear_camber: 1         # 1 (default): the stagger that decides the shear (o_shear) at an edge is the larger of the blade's near the edge (edge to mid-camber) and the camber's at the edge itself (the turbine's capped trailing edge, exit about 60 deg, is then sheared: its wake block's corners at oa_r/ob_r 7 / 14.5 deg -> open, D_L|D_M 2.62 -> 1.2 at density 1; Rotor 37, the distributor and the compressor are the same grids); 0: the blade's near the edge
   o_reach: 0.3            # a corner so moved stays within this far along its side (fraction of the O curve) from the edge
   bisect_step: 0.005      # at a sheared edge the H lines bisect the blade direction and the O curve's at the unsheared corner, measured over this step along it (fraction of the loop)
   o_back: 0.012           # at a trailing edge neither sharp nor sheared (round or capped) the corners' feet stay at least this far from the edge (fraction of the loop; the turbine's cap spans 0.007), the H lines downstream then leave along the bisector as at a sheared edge
@@ -178,12 +184,12 @@ FOOTER = """blocks:
   O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
   O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, 1], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
   U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
-  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: {j: adaptive}}
   U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
   M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end, period_end], flat: period_flat}, E8: {ends: [period_end, period_end], flat: period_flat}}}}
   M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end, period_end], flat: period_flat}, E6: {ends: [period_end, period_end], flat: period_flat}}}}
   D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
-  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}}
+  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: {j: adaptive}}
   D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
 
 faces:
@@ -272,9 +278,16 @@ def template_text():
             # staggered (a strongly cambered blade's exit: the turbine's trailing edge leaves at
             # about 60 deg while its chord from mid-camber is below 45 deg)
             sg = '-' if e == 'le' else ''
-            camber = f'shear_camber > 0.5 && abs({e}_uy_{l}) > abs({e}_cy_{l})'
-            w(f'  {e}_tx_{l}: "{camber} ? {sg}{e}_ux_{l} : {e}_cx_{l}"')
-            w(f'  {e}_ty_{l}: "{camber} ? {sg}{e}_uy_{l} : {e}_cy_{l}"')
+            # (from fixed copies of the edge and its probes, kf below: the optimizer moves the
+            # edge, and a shear that followed it would move every corner with it, which its
+            # trial filter does not expect of an edge point)
+            fx0 = f'{e}f_{l}.axial - (pfa_{e}_{l}.axial + pfb_{e}_{l}.axial)/2'
+            fy0 = f'rm_{l}*({e}f_{l}.theta - (pfa_{e}_{l}.theta + pfb_{e}_{l}.theta)/2)'
+            w(f'  {e}_fux_{l}: "({fx0})/sqrt(({fx0})^2 + ({fy0})^2)"      # camber direction at the edge, from fixed helpers')
+            w(f'  {e}_fuy_{l}: "({fy0})/sqrt(({fx0})^2 + ({fy0})^2)"')
+            camber = f'shear_camber > 0.5 && abs({e}_fuy_{l}) > abs({e}_cy_{l})'
+            w(f'  {e}_tx_{l}: "{camber} ? {sg}{e}_fux_{l} : {e}_cx_{l}"')
+            w(f'  {e}_ty_{l}: "{camber} ? {sg}{e}_fuy_{l} : {e}_cy_{l}"')
             w(f'  {e}_shear_{l}: "abs({e}_ty_{l})*tan(o_shear) > abs({e}_tx_{l})"      # 1: the corners are sheared at this edge')
             w(f'  {e}_lam_{l}: "{e}_shear_{l} ? abs({e}_tx_{l})/(abs({e}_ty_{l})*tan(o_shear)) : 1"')
             w(f'  {e}_dx_{l}: "{e}_tx_{l}*{e}_ty_{l}*({e}_lam_{l} - 1)"      # direction of the sheared lines across the passage')
@@ -339,6 +352,11 @@ def template_text():
         w(f'  pb_le_{l}: {{on_curve: blade_{l}, at: "le_{l}.s - dir_{l}*probe"}}')
         w(f'  pa_te_{l}: {{on_curve: blade_{l}, at: "te_{l}.s - dir_{l}*probe"}}')
         w(f'  pb_te_{l}: {{on_curve: blade_{l}, at: "te_{l}.s + dir_{l}*probe"}}')
+        # fixed copies of the edges and their probes (shear_camber's camber direction)
+        for e, ext, sa, sb in (('le', 'min', '+', '-'), ('te', 'max', '-', '+')):
+            w(f'  {e}f_{l}: {{on_curve: blade_{l}, at: {{{ext}: axial}}, fixed: true}}')
+            w(f'  pfa_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sa} dir_{l}*probe", fixed: true}}')
+            w(f'  pfb_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sb} dir_{l}*probe", fixed: true}}')
         w(f'  ole_{l}: {{project: le_{l}, onto: o_{l}}}')
         w(f'  ote_{l}: {{project: te_{l}, onto: o_{l}}}')
         # each corner is searched on its own side only: from the edge towards side a (b)

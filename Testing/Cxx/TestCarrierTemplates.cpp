@@ -1984,8 +1984,14 @@ TEST(CarrierTemplates, InterpolationEndCells)
   const std::string wrong = replaced(text, law + "}", law + ", interpolation: smooth}");
   EXPECT_EQ(errorOf([&] { parseFeature(wrong); }), featureLine(wrong, "  box:") +
       "block 'box': 'interpolation' must be 'linear' (the default: interior lines take the edges' "
-      "fractions), 'end_cells' (interior lines keep the edges' end cells as lengths) or {i: .., "
-      "j: .., k: ..} of those");
+      "fractions), 'end_cells' (interior lines keep the edges' end cells as lengths), "
+      "'adaptive' (linear while the interior lines' lengths stay within 20 % of their edges', "
+      "else towards end_cells so that their end cells do) or {i: .., j: .., k: ..} of those");
+  // adaptive reads and writes back
+  const BlockModel adaptive =
+    parseFeature(replaced(text, law + "}", law + ", interpolation: {j: adaptive}}"));
+  EXPECT_EQ(adaptive.blocks[0].blending[1], Blending::Adaptive);
+  EXPECT_EQ(documentRoundTrip(adaptive).blocks[0].blending[1], Blending::Adaptive);
 }
 
 // A min/max objective that is NaN somewhere, or that gives several values, is an error

@@ -47,7 +47,7 @@ using test::Pi;
  * turbine 3.3-3.7, the compressor 5.0-20.5; 28-570 before any grading. Measured now
  * (density 0.5-4, no optimizer, stop 14): Rotor 37 1.30-1.43 and the distributor 1.35-1.47
  * (U_L against M_L, M_L against D_L); the turbine 2.62-2.78 (D_L against D_M, where the O
- * arc leaves its corner oa_r nearly along the interface), the compressor 1.66-1.89 (U_L
+ * arc leaves its corner oa_r nearly along the interface; stop 15 below), the compressor 1.66-1.89 (U_L
  * against U_M, D_M against D_R; its fans against the sides 1.34-1.39: stop 15 grades the
  * sides' feet up from the fan's wall cell, joinFeet's gradeBesideFan, where the feet on the
  * sharp tip widened to a 25th of the next cell gave 2.17-3.48). What brought Rotor 37 from 4.13: the blade faces'
@@ -56,7 +56,15 @@ using test::Pi;
  * turbine's D_L against D_M went 3.14-3.53 -> 2.62-2.78 with `interpolation: end_cells` on
  * U_L, U_R, D_L, D_R (their interior lines keep their edges' end cells); at density 0.5
  * the template's min_cells keep the few cells the match laws need (the distributor's
- * upstream blocks were 2.54, the compressor's 3.73). The bounds, per machine, fail when
+ * upstream blocks were 2.54, the compressor's 3.73). Stop 15: the turbine 2.67 / 2.62 /
+ * 2.73 / 2.78 -> 2.17 / 1.68 / 1.57 / 1.29 at densities 0.5 / 1 / 2 / 4: its capped
+ * trailing edge is sheared (`shear_camber` 1 by default: the camber there is more
+ * staggered than the blade near it), which opens the wake block's corners at oa_r/ob_r
+ * (7 / 14.5 deg: D_L against D_M 2.6-2.8 -> 1.2), and U_M / D_M blend their lines from the
+ * O-grid `adaptive` (in front of the round nose U_M's middle lines are half as long as its
+ * sides: O_le against U_M 1.80-1.90 -> 1.27-1.29, O_te against D_M 1.66-1.80 -> 1.22-1.36);
+ * left: O_a against O_te at the cap's corner (2.17 at density 0.5). Rotor 37 and the
+ * distributor are the same grids. The bounds, per machine, fail when
  * the grading gets worse.
  */
 double maxNeighbourRatio(const std::string& templateName, const std::string& machine)
@@ -64,7 +72,7 @@ double maxNeighbourRatio(const std::string& templateName, const std::string& mac
   if (templateName == "axial_passage_h")
     return 1.5;
   static const std::map<std::string, double> oh = { { "rotor37", 1.5 }, { "distributor", 1.5 },
-    { "turbine", 2.9 }, { "compressor", 2.0 } };
+    { "turbine", 2.2 }, { "compressor", 2.0 } };
   return oh.at(machine);
 }
 

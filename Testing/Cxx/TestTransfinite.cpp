@@ -352,6 +352,143 @@ TEST(TransfiniteBlock, EndCellBlendingKeepsTheEdgesEndCells)
   EXPECT_NEAR(linearMiddle, 0.0137, 2e-4); // linear: the middle fraction of the longer middle
 }
 
+// Blending::Adaptive on the face of EndCellBlendingKeepsTheEdgesEndCells (rows 0.01 at both
+// ends, bottom 1 long, top 2): with its right side bulging by 0.5 the middle row is 2.0
+// against the 1.5 blend of bottom and top (spread 1/3, over the 20 % tolerance), and the
+// adaptive rows start with 0.01 within 25 % (linear: 0.0137, 37 % off; blend b = 0.4);
+// bulging by 0.2 (spread 0.13) the face is the linear face bit for bit. This is
+// axial_passage_oh's U_M in front of the turbine's round nose (its middle lines half as long
+// as its sides: O_le|U_M 1.80-1.90 linear, 1.27-1.29 adaptive) against Rotor 37's, the
+// distributor's and the compressor's (within 17 %: their grids unchanged).
+TEST(TransfiniteFace, AdaptiveBlendingKeepsEndCellsOnlyWhereLinesSpread)
+{
+  const int ni = 21, nj = 9;
+  const auto ends = [&](double length) {
+    std::vector<double> p(ni);
+    const double middle = (length - 0.02) / (ni - 3);
+    for (int i = 0; i < ni; ++i)
+    {
+      p[i] = i == 0 ? 0.0 : (i == ni - 1 ? 1.0 : (0.01 + (i - 1) * middle) / length);
+    }
+    return p;
+  };
+  const std::vector<double> uniform = graded(nj, 1.0);
+  const auto line = [](const Vec3& a, const Vec3& b, const std::vector<double>& params) {
+    Edge e;
+    e.params = params;
+    for (double p : params)
+    {
+      const Vec3 x = a + p * (b - a);
+      e.xyz.insert(e.xyz.end(), { x.x(), x.y(), x.z() });
+    }
+    return e;
+  };
+  const Edge bottom = line({ 0, 0, 0 }, { 1, 0, 0 }, ends(1.0));
+  const Edge top = line({ -0.5, 1, 0 }, { 1.5, 1, 0 }, ends(2.0));
+  const Edge left = line({ 0, 0, 0 }, { -0.5, 1, 0 }, uniform);
+  for (const double bulge : { 0.5, 0.2 })
+  {
+    Edge right = line({ 1, 0, 0 }, { 1.5, 1, 0 }, uniform);
+    for (int j = 0; j < nj; ++j)
+    {
+      right.xyz[3 * j] += 4.0 * bulge * uniform[j] * (1.0 - uniform[j]);
+    }
+    std::vector<double> linear(3 * ni * nj), adaptive(3 * ni * nj);
+    transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), linear.data());
+    transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), adaptive.data(),
+      { Blending::Adaptive, Blending::Linear });
+    if (bulge < 0.3)
+    {
+      EXPECT_EQ(0, std::memcmp(linear.data(), adaptive.data(), linear.size() * sizeof(double)));
+      continue;
+    }
+    double worst = 0.0;
+    for (int j = 1; j + 1 < nj; ++j)
+    {
+      const double first = (node(adaptive, 1 + ni * j) - node(adaptive, ni * j)).norm();
+      const double last = (node(adaptive, ni - 1 + ni * j) - node(adaptive, ni - 2 + ni * j)).norm();
+      worst = std::max({ worst, first / 0.01, 0.01 / first, last / 0.01, 0.01 / last });
+    }
+    EXPECT_LT(worst, 1.25);
+    EXPECT_GT(worst, 1.1); // not end_cells: only as far as the tolerance asks
+    EXPECT_NEAR((node(linear, 1 + ni * 4) - node(linear, ni * 4)).norm(), 0.0137, 2e-4);
+    for (int i = 0; i < ni; ++i)
+    {
+      EXPECT_EQ(0, std::memcmp(&adaptive[3 * i], &bottom.xyz[3 * i], 3 * sizeof(double)));
+      EXPECT_EQ(0, std::memcmp(&adaptive[3 * (i + ni * (nj - 1))], &top.xyz[3 * i], 3 * sizeof(double)));
+    }
+  }
+}
+
+// The block interior with Blending::Adaptive in i, on the block of
+// TransfiniteBlock.EndCellBlendingKeepsTheEdgesEndCells (its faces' i-lines up to 1/3 longer
+// than the blend of their edges): every interior i-line starts with 0.01 within 25 %
+// (linear: 0.0137); with the bulge at 0.2 the interior is the linear one bit for bit.
+TEST(TransfiniteBlock, AdaptiveBlendingKeepsEndCellsOnlyWhereLinesSpread)
+{
+  const int ni = 21, n = 5;
+  std::vector<double> bottom(ni), top(ni);
+  for (int i = 0; i < ni; ++i)
+  {
+    const double middle1 = 0.98 / (ni - 3), middle2 = 1.98 / (ni - 3);
+    bottom[i] = i == 0 ? 0.0 : (i == ni - 1 ? 1.0 : 0.01 + (i - 1) * middle1);
+    top[i] = i == 0 ? 0.0 : (i == ni - 1 ? 1.0 : (0.01 + (i - 1) * middle2) / 2.0);
+  }
+  const std::vector<double> uniform = graded(n, 1.0);
+  std::array<std::vector<double>, 12> params;
+  params[0] = params[2] = bottom;
+  params[4] = params[6] = top;
+  for (int e : { 1, 3, 5, 7, 8, 9, 10, 11 })
+  {
+    params[e] = uniform;
+  }
+  for (const double bulge : { 0.5, 0.2 })
+  {
+    const PointMap map = [bulge](double s, double t, double u) {
+      return Vec3(s * (1 + u) - 0.5 * u + 4.0 * bulge * s * u * (1 - u), t, u);
+    };
+    // faces and interior from the edges, with the blending in i under test
+    const auto mesh = [&](Blending blending) {
+      TestBlock b = buildBlock(map, params);
+      const int faceEdges[6][4] = { { 3, 7, 8, 11 }, { 1, 5, 9, 10 }, { 0, 4, 8, 9 },
+        { 2, 6, 11, 10 }, { 0, 2, 3, 1 }, { 4, 6, 7, 5 } };
+      const int faceFirst[6] = { 1, 1, 0, 0, 0, 0 }; // direction of each face's first index
+      for (int f = 0; f < 6; ++f)
+      {
+        const auto& fe = faceEdges[f];
+        const Blending s = faceFirst[f] == 0 ? blending : Blending::Linear;
+        transfiniteFace(b.edges[fe[0]].nodes(), b.edges[fe[1]].nodes(), b.edges[fe[2]].nodes(),
+          b.edges[fe[3]].nodes(), b.faces[f].data(), { s, Blending::Linear });
+      }
+      BlockBoundary boundary = b.boundary();
+      boundary.blending = { blending, Blending::Linear, Blending::Linear };
+      std::vector<double> nodes(b.nodes.size());
+      transfiniteBlock(boundary, ni, n, n, nodes.data());
+      return nodes;
+    };
+    const std::vector<double> linear = mesh(Blending::Linear), adaptive = mesh(Blending::Adaptive);
+    if (bulge < 0.3)
+    {
+      EXPECT_EQ(0, std::memcmp(linear.data(), adaptive.data(), linear.size() * sizeof(double)));
+      continue;
+    }
+    double worst = 0.0, linearWorst = 0.0;
+    for (int k = 1; k + 1 < n; ++k)
+    {
+      for (int j = 1; j + 1 < n; ++j)
+      {
+        const long row = static_cast<long>(ni) * (j + static_cast<long>(n) * k);
+        const double first = (node(adaptive, row + 1) - node(adaptive, row)).norm();
+        const double plain = (node(linear, row + 1) - node(linear, row)).norm();
+        worst = std::max({ worst, first / 0.01, 0.01 / first });
+        linearWorst = std::max({ linearWorst, plain / 0.01, 0.01 / plain });
+      }
+    }
+    EXPECT_LT(worst, 1.25);
+    EXPECT_GT(linearWorst, 1.3);
+  }
+}
+
 TEST(TransfiniteFace, RejectsMismatchedEdges)
 {
   const PointMap map = affineMap();

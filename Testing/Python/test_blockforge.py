@@ -243,10 +243,11 @@ class AxialPassageOHTest(unittest.TestCase):
         self.check_grid(ROTOR37_INF, 36)
 
     def test_shear_camber_lifts_the_turbines_trailing_edge(self):
-        """`shear_camber` 1 (default 0) decides an edge's shear by the larger stagger of the
-        blade near the edge and its camber at the edge: the turbine's trailing edge (exit
-        about 60 degrees) is sheared, and the wake block's corner cell there, the worst of the
-        placed grid, rises from 0.092 to 0.170 (density 1) and from 0.096 to 0.280 (2)."""
+        """`shear_camber` 1 (the default since stop 15; 0 before) decides an edge's shear by the
+        larger stagger of the blade near the edge and its camber at the edge: the turbine's
+        trailing edge (exit about 60 degrees) is sheared, and the wake block's corner cell
+        there, the worst of the placed grid with 0, rises from 0.092 to 0.304 (density 1) and
+        from 0.096 to 0.376 (2) (0.170 / 0.280 before U_M/D_M's `adaptive` interpolation)."""
         turbine = os.path.join(SOURCE, "Data", "turbine", "Info.txt")
         for density, default_low, sheared_low in ((1.0, 0.1, 0.15), (2.0, 0.1, 0.25)):
             lows = []
