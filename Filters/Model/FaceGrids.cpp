@@ -5,6 +5,7 @@
 #include "MeshInternals.h"
 
 #include "../Core/Carriers.h"
+#include "../Core/Parallel.h"
 #include "../Core/Projection.h"
 #include "../Core/SurfaceFaceGrid.h"
 #include "../Core/Transfinite.h"

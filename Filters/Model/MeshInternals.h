@@ -265,6 +265,13 @@ LocalEdge localEdge(
 /// Throws TemplateError when the first cells at a corner of block `b` are inverted.
 void checkCornerCells(const BlockModel& model, const MeshTopology& topology, int block, double size);
 void checkCornerCells(const BlockModel& model, const MeshTopology& topology, double size);
+/// The blending of the face's two directions (the block's, Transfinite.h).
+inline std::array<Blending, 2> faceBlending(const BlockModel& model, int block, int face)
+{
+  const std::array<int, 2> directions = faceDirections(face);
+  const auto& blending = model.blocks[block].blending;
+  return { blending[directions[0]], blending[directions[1]] };
+}
 void faceFromEdges(const BlockModel& model, const MeshTopology& topology, int block, int face,
   std::vector<double>& out);
 void computeEdgeNodes(const BlockModel& model, const std::vector<NamedCurve>& curves,
@@ -334,6 +341,9 @@ void periodicFace(const BlockModel& model, const MeshTopology& topology, const P
   std::vector<double>& out);
 /// Unique face -> surface carrier of the model's surface face sets.
 std::map<int, int> surfaceFaceCarriers(const BlockModel& model, const MeshTopology& topology);
+/// The grid of unique face `unique` in the orientation of `block`'s local face `local`.
+void localFaceGrid(const MeshTopology& topology, int block, int local, int unique,
+  std::vector<double>& out);
 /// The grid of unique face f (not a periodic image), on its surface carrier if it has one;
 /// a following face (UniqueFace::opposite) after the face it follows.
 void computeFaceGrid(const BlockModel& model, const CarrierGeometry& geometry,
