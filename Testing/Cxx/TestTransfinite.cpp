@@ -222,6 +222,35 @@ TEST(TransfiniteFace, ReproducesAffineMapWithDifferentParametersOnOppositeEdges)
 // Blending::EndCells: a face whose bottom edge (length 1) and top edge (length 2) both
 // start and end with cells of 0.01 (as matched edges do), its right side bulging out by
 // 0.5 in the middle, so the rows there are longer than the blend of the bottom and top.
+namespace
+{
+/// n node parameters of a line `length` long whose first and last cells are 0.01,
+/// uniform between.
+std::vector<double> endCellParameters(int n, double length)
+{
+  std::vector<double> p(n);
+  const double middle = (length - 0.02) / (n - 3);
+  for (int i = 0; i < n; ++i)
+  {
+    p[i] = i == 0 ? 0.0 : (i == n - 1 ? 1.0 : (0.01 + (i - 1) * middle) / length);
+  }
+  return p;
+}
+
+/// The straight edge from a to b with nodes at `params`.
+Edge straightEdge(const Vec3& a, const Vec3& b, const std::vector<double>& params)
+{
+  Edge e;
+  e.params = params;
+  for (double p : params)
+  {
+    const Vec3 x = a + p * (b - a);
+    e.xyz.insert(e.xyz.end(), { x.x(), x.y(), x.z() });
+  }
+  return e;
+}
+} // namespace
+
 // Linear blending gives a row the blended fractions of its own length: the middle row
 // starts with 0.0075 of a row 0.5 longer than the blend, 0.0137; end-cell blending keeps
 // 0.01 within 2e-4 on every row (the first node's weight is h(s) ~ 2e-4, not s). The
@@ -229,27 +258,9 @@ TEST(TransfiniteFace, ReproducesAffineMapWithDifferentParametersOnOppositeEdges)
 TEST(TransfiniteFace, EndCellBlendingKeepsTheEdgesEndCells)
 {
   const int ni = 21, nj = 9;
-  const auto ends = [&](double length) {
-    // first and last cells 0.01, uniform between
-    std::vector<double> p(ni);
-    const double middle = (length - 0.02) / (ni - 3);
-    for (int i = 0; i < ni; ++i)
-    {
-      p[i] = i == 0 ? 0.0 : (i == ni - 1 ? 1.0 : (0.01 + (i - 1) * middle) / length);
-    }
-    return p;
-  };
+  const auto ends = [&](double length) { return endCellParameters(ni, length); };
   const std::vector<double> uniform = graded(nj, 1.0);
-  const auto line = [](const Vec3& a, const Vec3& b, const std::vector<double>& params) {
-    Edge e;
-    e.params = params;
-    for (double p : params)
-    {
-      const Vec3 x = a + p * (b - a);
-      e.xyz.insert(e.xyz.end(), { x.x(), x.y(), x.z() });
-    }
-    return e;
-  };
+  const auto line = straightEdge;
   const Edge bottom = line({ 0, 0, 0 }, { 1, 0, 0 }, ends(1.0));
   const Edge top = line({ -0.5, 1, 0 }, { 1.5, 1, 0 }, ends(2.0));
   const Edge left = line({ 0, 0, 0 }, { -0.5, 1, 0 }, uniform);
@@ -363,26 +374,9 @@ TEST(TransfiniteBlock, EndCellBlendingKeepsTheEdgesEndCells)
 TEST(TransfiniteFace, AdaptiveBlendingKeepsEndCellsOnlyWhereLinesSpread)
 {
   const int ni = 21, nj = 9;
-  const auto ends = [&](double length) {
-    std::vector<double> p(ni);
-    const double middle = (length - 0.02) / (ni - 3);
-    for (int i = 0; i < ni; ++i)
-    {
-      p[i] = i == 0 ? 0.0 : (i == ni - 1 ? 1.0 : (0.01 + (i - 1) * middle) / length);
-    }
-    return p;
-  };
+  const auto ends = [&](double length) { return endCellParameters(ni, length); };
   const std::vector<double> uniform = graded(nj, 1.0);
-  const auto line = [](const Vec3& a, const Vec3& b, const std::vector<double>& params) {
-    Edge e;
-    e.params = params;
-    for (double p : params)
-    {
-      const Vec3 x = a + p * (b - a);
-      e.xyz.insert(e.xyz.end(), { x.x(), x.y(), x.z() });
-    }
-    return e;
-  };
+  const auto line = straightEdge;
   const Edge bottom = line({ 0, 0, 0 }, { 1, 0, 0 }, ends(1.0));
   const Edge top = line({ -0.5, 1, 0 }, { 1.5, 1, 0 }, ends(2.0));
   const Edge left = line({ 0, 0, 0 }, { -0.5, 1, 0 }, uniform);
