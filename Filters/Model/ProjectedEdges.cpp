@@ -175,9 +175,6 @@ constexpr double FanSideRatio = 1.35;
 /// projected feet: inside the block, where checkMesh's interpolation weight (0.05) fails
 /// between cells whose centres lie more than 19 times as far from their face.
 constexpr double FanSideGrowth = 10.0;
-/// Where joinFeet's one cut cannot reach FanSideRatio, the feet graded up from the corner
-/// grow by at most this from cell to cell (rampFeet).
-constexpr double FootRampGrowth = 10.0;
 
 /// The end cell length of `edge` at vertex `v` (one of its ends).
 double cellAtVertex(const UniqueEdge& edge, int v)
@@ -335,7 +332,9 @@ void gradeBesideFan(MeshTopology& topology, const FootJoin& join, int fan)
  * 3.4 times the fan's at density 0.5; round a cap's corner the smoothed O curve's normals
  * spread the feet on one side (turbine 1.6). Only the larger foot moves: the fan's feet
  * cannot spread (they share the tip), and the moved foot's radial line leans by its shift
- * over the O-grid's width.
+ * over the O-grid's width. Where the cut is held (by InBlockRatio against its next cell)
+ * above FanSideRatio times the other side's cell, the feet are graded up from the corner
+ * instead, as beside a fan (rampFeet).
  */
 void joinFeet(const BlockModel& model, MeshTopology& topology, const FootJoin& join)
 {
@@ -398,18 +397,27 @@ void joinFeet(const BlockModel& model, MeshTopology& topology, const FootJoin& j
     ((1.0 - layer) * allowed + share);
   const double wanted = std::max(std::max(foot[small], floor),
     (FootWidthRatio * width[small] - outer[large] * layer) / (1.0 - layer));
-  // Held by that floor far above the other side's cell (the next cell inside being as
-  // large as the foot), the one cut leaves the interface's jump: the turbine's side a at
-  // its cap's corner, where the O corner's foot lies a few hundredths of a millimetre
-  // before the corner and the edge block's first wall cell is that short piece of flank
-  // (O_a|O_te 2.17 / 1.68 / 1.57 at densities 0.5 / 1 / 2). There the feet are graded up
-  // from FootWidthRatio times the other side's cell instead, by at most FootRampGrowth per
-  // cell, until they land on the projected feet (rampFeet).
+  // Held by that floor above FanSideRatio times the other side's cell (the next cell
+  // inside as long as the foot), the one cut leaves the jump at the interface: the
+  // turbine's side a at its cap's corner, where the O corner's foot lies 0.06-0.09 mm
+  // before the corner, whatever the density, and the edge block's first wall cell is that
+  // piece of flank (O_a|O_te 2.17 / 1.68 / 1.57 at densities 0.5 / 1 / 2, the side's
+  // foot cut to half its next cell). There the feet are graded up as beside a fan
+  // (rampFeet: FanSideRatio times the other side's cell, growing by at most FanSideGrowth
+  // until they land on the projected feet; O_a|O_te 1.36 / 1.35 / 1.35). Not to
+  // FootWidthRatio: thinner, the cut wall cell fails checkMesh's determinant (one more
+  // cell at density 1); nor slower than FanSideGrowth: the longer ramp leans more radial
+  // lines (growth 4: the min scaled Jacobian at density 0.5 0.209 -> 0.148). Only where
+  // the ramp's first foot is within FanSideGrowth of the foot it replaces: beside a thin
+  // tip's fan (its feet hundreds of times nearer one another than its outer nodes, a
+  // hexahedral fan on a sharp tip) it would start at a sliver, and the floor stays.
   const double reached = wanted * (1.0 - layer) + outer[large] * layer;
+  const double rampFoot = (FanSideRatio * width[small] - outer[large] * layer) / (1.0 - layer);
   const int outerVertex = radial.a == join.vertex ? radial.b : radial.a;
-  if (reached > FanSideRatio * width[small] && (source.a == outerVertex || source.b == outerVertex) &&
+  if (reached > FanSideRatio * width[small] && FanSideGrowth * rampFoot >= foot[large] &&
+    (source.a == outerVertex || source.b == outerVertex) &&
     rampFeet(edge, source, join.end[large] == 0, source.a == outerVertex, layer,
-      FootWidthRatio * width[small], FootRampGrowth))
+      FanSideRatio * width[small], FanSideGrowth))
   {
     return;
   }

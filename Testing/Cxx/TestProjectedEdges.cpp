@@ -619,6 +619,59 @@ TEST(ProjectedEdges, FeetAtABladeCornerKeepTheWallCellsAlike)
   }
 }
 
+TEST(ProjectedEdges, FeetHeldByTheirNextCellAreGradedUpFromTheCorner)
+{
+  // A blunt corner (bladeCorner(0.1): R's feet 6 times nearer one another than its outer
+  // nodes, as the turbine's edge block by its cap's corner): cut to 1.2 times R's wall
+  // cell, A's first foot would be under a quarter of its next one, so the one cut stops at
+  // half of it (InBlockRatio) and left the wall cells across R|A 2.69 / 3.00 apart at
+  // densities 1 / 2. Held there
+  // above 1.35, A's feet are graded up from the corner instead (rampFeet, as beside a fan):
+  // its first wall cell 1.35 times R's, the next ones growing by at most 10 from cell to
+  // cell (the estimate's outer part a little more) until they land on the normal feet,
+  // which A keeps from there on.
+  const BlockModel model = parseTemplate(bladeCorner(0.1), "corner.yaml");
+  for (const double density : { 1.0, 2.0 })
+  {
+    SCOPED_TRACE(density);
+    const test::Grid grid = test::meshAll(model, density);
+    const int nr = grid.nodes[0][0], na = grid.nodes[1][0], outer = grid.nodes[1][1] - 1;
+    const auto centre = [&](int b, int i) -> Vec3 {
+      return 0.25 * (node(grid, b, i, 0, 0) + node(grid, b, i, 1, 0) + node(grid, b, i, 0, 1) +
+                      node(grid, b, i, 1, 1));
+    };
+    const double ring = (centre(0, nr - 1) - centre(0, nr - 2)).norm();
+    std::vector<double> side;
+    for (int i = 0; i + 1 < na; ++i)
+    {
+      side.push_back((centre(1, i + 1) - centre(1, i)).norm());
+    }
+    std::printf("density %g: wall cells R %.4g, A %.4g (ratio %.3f), A's next %.4g %.4g %.4g\n",
+      density, ring, side[0], side[0] / ring, side[1], side[2], side[3]);
+    EXPECT_NEAR(side[0] / ring, 1.35, 0.03);
+    int landed = -1;
+    for (int i = 1; i < na; ++i)
+    {
+      const double foot = node(grid, 1, i, 0, 0).x(), above = node(grid, 1, i, outer, 0).x();
+      EXPECT_GT(foot, node(grid, 1, i - 1, 0, 0).x()) << i;
+      if (landed < 0 && std::abs(foot - above) < 1e-12)
+      {
+        landed = i;
+      }
+      if (landed >= 0)
+      {
+        EXPECT_NEAR(foot, above, 1e-12) << i; // the normal feet from there on
+      }
+    }
+    EXPECT_GE(landed, 2);
+    EXPECT_LE(landed, na / 2);
+    for (int i = 1; i < landed + 1; ++i)
+    {
+      EXPECT_LT(side[i] / side[i - 1], 11.0) << i;
+    }
+  }
+}
+
 TEST(ProjectedEdges, JoinedFeetFollowMovesAsAFreshMesherDoes)
 {
   // The ring's corner beside the flank (bladeCorner(1)): A's first foot is cut. The flank's
