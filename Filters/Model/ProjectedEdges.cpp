@@ -402,20 +402,17 @@ void joinFeet(const BlockModel& model, MeshTopology& topology, const FootJoin& j
   // turbine's side a at its cap's corner, where the O corner's foot lies 0.06-0.09 mm
   // before the corner, whatever the density, and the edge block's first wall cell is that
   // piece of flank (O_a|O_te 2.17 / 1.68 / 1.57 at densities 0.5 / 1 / 2, the side's
-  // foot cut to half its next cell). There the feet are graded up as beside a fan
-  // (rampFeet: FanSideRatio times the other side's cell, growing by at most FanSideGrowth
-  // until they land on the projected feet; O_a|O_te 1.36 / 1.35 / 1.35). Not to
-  // FootWidthRatio: thinner, the cut wall cell fails checkMesh's determinant (one more
-  // cell at density 1); nor slower than FanSideGrowth: the longer ramp leans more radial
-  // lines (growth 4: the min scaled Jacobian at density 0.5 0.209 -> 0.148). Only where
-  // the ramp's first foot is within FanSideGrowth of the foot it replaces: beside a thin
-  // tip's fan (its feet hundreds of times nearer one another than its outer nodes, a
-  // hexahedral fan on a sharp tip) it would start at a sliver, and the floor stays.
+  // foot cut to half its next cell; 6.3 in the optimized grid, whose corner slides nearer
+  // the cap's corner). There the feet are graded up as beside a fan (rampFeet:
+  // FanSideRatio times the other side's cell, growing by at most FanSideGrowth, within
+  // checkMesh's interpolation weight, until they land on the projected feet; O_a|O_te
+  // 1.36 / 1.35 / 1.35). Not to FootWidthRatio: thinner, the cut wall cell fails
+  // checkMesh's determinant (one more cell at density 1); nor slower than FanSideGrowth:
+  // the longer ramp leans more radial lines (growth 4: the min scaled Jacobian at density
+  // 0.5 0.209 -> 0.148).
   const double reached = wanted * (1.0 - layer) + outer[large] * layer;
-  const double rampFoot = (FanSideRatio * width[small] - outer[large] * layer) / (1.0 - layer);
   const int outerVertex = radial.a == join.vertex ? radial.b : radial.a;
-  if (reached > FanSideRatio * width[small] && FanSideGrowth * rampFoot >= foot[large] &&
-    (source.a == outerVertex || source.b == outerVertex) &&
+  if (reached > FanSideRatio * width[small] && (source.a == outerVertex || source.b == outerVertex) &&
     rampFeet(edge, source, join.end[large] == 0, source.a == outerVertex, layer,
       FanSideRatio * width[small], FanSideGrowth))
   {
