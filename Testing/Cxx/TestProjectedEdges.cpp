@@ -693,31 +693,36 @@ TEST(ProjectedEdges, FeetHeldByTheirNextCellAreGradedUpFromTheCorner)
 
 TEST(ProjectedEdges, JoinedFeetFollowMovesAsAFreshMesherDoes)
 {
-  // The ring's corner beside the flank (bladeCorner(1)): A's first foot is cut. The flank's
-  // far end moves (its outer and inner corners, w00 and w30, along x): the outer line's
-  // matched nodes change, the flank's projection with them, the join is made again from
-  // the new projection, and the grid is a fresh mesher's, bit for bit; moved back, too.
-  const BlockModel model = parseTemplate(bladeCorner(1.0), "corner.yaml");
-  const CarrierGeometry carriers(model);
-  MeshPlan plan(model, carriers);
-  const int inner = plan.model().findVertex("w00"), outer = plan.model().findVertex("w30");
-  for (const double x : { 2.4, 1.7, 2.0 })
+  // The ring's corner beside the flank (bladeCorner(1): A's first foot is cut; 0.1: A's
+  // feet are graded up from the corner, rampFeet). The flank's far end moves (its outer
+  // and inner corners, w00 and w30, along x): the outer line's matched nodes change, the
+  // flank's projection with them, the join is made again from the new projection, and the
+  // grid is a fresh mesher's, bit for bit; moved back, too.
+  for (const double tip : { 1.0, 0.1 })
   {
-    SCOPED_TRACE(x);
-    plan.model().vertices[inner].position.x() = x;
-    plan.model().vertices[outer].position.x() = x;
-    const Feasibility feasibility = plan.update({ inner, outer });
-    ASSERT_TRUE(feasibility.feasible()) << feasibility.message;
-    const test::Grid fresh = test::meshAll(plan.model());
-    for (int b = 0; b < 2; ++b)
+    SCOPED_TRACE(tip);
+    const BlockModel model = parseTemplate(bladeCorner(tip), "corner.yaml");
+    const CarrierGeometry carriers(model);
+    MeshPlan plan(model, carriers);
+    const int inner = plan.model().findVertex("w00"), outer = plan.model().findVertex("w30");
+    for (const double x : { 2.4, 1.7, 2.0 })
     {
-      EXPECT_TRUE(test::sameBits(plan.blockNodes(b), fresh.xyz[b])) << b;
+      SCOPED_TRACE(x);
+      plan.model().vertices[inner].position.x() = x;
+      plan.model().vertices[outer].position.x() = x;
+      const Feasibility feasibility = plan.update({ inner, outer });
+      ASSERT_TRUE(feasibility.feasible()) << feasibility.message;
+      const test::Grid fresh = test::meshAll(plan.model());
+      for (int b = 0; b < 2; ++b)
+      {
+        EXPECT_TRUE(test::sameBits(plan.blockNodes(b), fresh.xyz[b])) << b;
+      }
+      // the join applies: A's first foot short of its outer node
+      EXPECT_LT(node(fresh, 1, 1, 0, 0).x(), 0.9 * node(fresh, 1, 1, fresh.nodes[1][1] - 1, 0).x());
     }
-    // the join applies: A's first foot short of its outer node
-    EXPECT_LT(node(fresh, 1, 1, 0, 0).x(), 0.9 * node(fresh, 1, 1, fresh.nodes[1][1] - 1, 0).x());
+    const test::Grid back = test::meshAll(model);
+    EXPECT_TRUE(test::sameBits(plan.blockNodes(1), back.xyz[1]));
   }
-  const test::Grid back = test::meshAll(model);
-  EXPECT_TRUE(test::sameBits(plan.blockNodes(1), back.xyz[1]));
 }
 
 namespace
