@@ -64,7 +64,14 @@ using test::Pi;
  * O-grid `adaptive` (in front of the round nose U_M's middle lines are half as long as its
  * sides: O_le against U_M 1.80-1.90 -> 1.27-1.29, O_te against D_M 1.66-1.80 -> 1.22-1.36);
  * left: O_a against O_te at the cap's corner (2.17 at density 0.5). Rotor 37 and the
- * distributor are the same grids. The bounds, per machine, fail when
+ * distributor are the same grids. Stop 16: the turbine 2.17 / 1.68 / 1.57 / 1.29 ->
+ * 1.36 / 1.36 / 1.35 / 1.29: at side a's cap corner the O corner oa_r (the sheared edge's
+ * partner) has its foot 0.06-0.09 mm before the corner at every density, so O_te's first
+ * wall cell is that piece of flank; joinFeet's one cut of O_a's foot, held to half its next
+ * cell, left 1.68 at density 1; where that cut stays above FanSideRatio the side's feet
+ * are now graded up from the corner as beside a fan (rampFeet: O_a against O_te 1.36 /
+ * 1.35 / 1.35 / under 1.2; the worst now O_te against D_M at density 1). Rotor 37, the
+ * distributor and the compressor are the same grids. The bounds, per machine, fail when
  * the grading gets worse.
  */
 double maxNeighbourRatio(const std::string& templateName, const std::string& machine)
@@ -72,7 +79,7 @@ double maxNeighbourRatio(const std::string& templateName, const std::string& mac
   if (templateName == "axial_passage_h")
     return 1.5;
   static const std::map<std::string, double> oh = { { "rotor37", 1.5 }, { "distributor", 1.5 },
-    { "turbine", 2.2 }, { "compressor", 2.0 } };
+    { "turbine", 1.4 }, { "compressor", 2.0 } };
   return oh.at(machine);
 }
 
