@@ -334,6 +334,40 @@ def template_text():
             # straight down the camber would leave the O curve there at a small angle)
             bisect = f'shear_{e} || off_{e}_{l}' if e == 'te' else f'shear_{e}'
             w(f'  {base}_x_{l}: "{bisect} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
+        # At a sharp edge (its edge block a fan, corners not sheared) the line across the
+        # passage, from one side's O corner A to the other side's corner B of the blade one
+        # pitch below, meets the blade where a high stagger leaves it: one of the two blocks
+        # squeezed between it and its neighbour line can be a sliver (the compressor's M_R
+        # at ob_f 2 deg at the shroud, M_L at oa_r 9 deg). The mid-passage point then leaves
+        # the middle of AB, across it by half of AB times tan(phi), phi half the difference
+        # of the two squeezed corners (leading edge: U_L's at A, between the H line and AB,
+        # and M_R's at B, between the O curve along side b and BA; trailing edge: M_L's at A,
+        # between the O curve along side a and AB, and D_R's at B, between BA and the H line):
+        # each line turns by about phi, so the two corners come out about equal.
+        #   turned lines: A's line turns from its H line (le) or towards it (te) by phi
+        for e, f, A, B, o_side, h_at in (('le', 'f', 'oa', 'ob', 'xb_f', 'A'), ('te', 'r', 'oa', 'ob', 'xa_r', 'B')):
+            abx = f'({B}_{f}_{l}.axial - {A}_{f}_{l}.axial)'
+            aby = f'(rm_{l}*({B}_{f}_{l}.theta - pitch - {A}_{f}_{l}.theta))'
+            w(f'  {e}_abx_{l}: "{abx}"      # A (side a) to B (side b, one pitch below), unrolled')
+            w(f'  {e}_aby_{l}: "{aby}"')
+            ab = (f'{e}_abx_{l}', f'{e}_aby_{l}')
+            # the H line's direction at its corner: upstream (-1, slope_in_x) at A; downstream (1, slope_out_x) at B
+            hx, hy = ('-1', f'slope_in_x_{l}') if e == 'le' else ('1', f'slope_out_x_{l}')
+            # the O curve's direction from its corner along the side (a step bisect_step along it)
+            corner = f'{B}_{f}_{l}' if e == 'le' else f'{A}_{f}_{l}'
+            ox = f'({o_side}_{l}.axial - {corner}.axial)'
+            oy = f'(rm_{l}*({o_side}_{l}.theta - {corner}.theta))'
+            def angle(ux, uy, vx, vy):
+                return f'abs(atan2(({ux})*({vy}) - ({uy})*({vx}), ({ux})*({vx}) + ({uy})*({vy})))'
+            if e == 'le':
+                first = angle(hx, hy, ab[0], ab[1])                        # U_L at A
+                second = angle(ox, oy, f'-{ab[0]}', f'-{ab[1]}')          # M_R at B
+            else:
+                first = angle(hx, hy, f'-{ab[0]}', f'-{ab[1]}')           # D_R at B
+                second = angle(ox, oy, ab[0], ab[1])                       # M_L at A
+            w(f'  {e}_turn_{l}: "off_{e}_h && off_{e}_s ? 0 : tan(({first} - {second})/2)"      # tan(phi): 0 where the edge is not sharp on either layer')
+            # the normal of AB on the side the H line leaves to
+            w(f'  {e}_nside_{l}: "{hx}*(-{ab[1]}) + ({hy})*{ab[0]} > 0 ? 1 : -1"')
         # parameter gaps (in the dir sense) between consecutive O corners on the blade and the O curve
         def gap(name, a, b):
             x = f'dir_{l}*({b}_{l}.s - {a}_{l}.s)'
@@ -437,6 +471,10 @@ def template_text():
         # a step along the O curve from the unsheared corner of a sheared edge towards the edge
         w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*bisect_step : ob_f_{l}.s + dir_{l}*bisect_step", fixed: true}}')
         w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*bisect_step : ob_r_{l}.s - dir_{l}*bisect_step", fixed: true}}')
+        # a step along the O curve from ob_f along side b (downstream) and from oa_r along side a
+        # (upstream): the sides' directions at the corners of a sharp edge (lo_f, lo_r)
+        w(f'  xb_f_{l}: {{on_curve: o_{l}, at: "ob_f_{l}.s - dir_{l}*bisect_step", fixed: true}}')
+        w(f'  xa_r_{l}: {{on_curve: o_{l}, at: "oa_r_{l}.s - dir_{l}*bisect_step", fixed: true}}')
         # the sides' mid-points (where the periodic line's middle point lo_m looks across): half-way
         # along each side, between the corners' feet where the corners are sheared
         ga = f'dir_{l}*(fa_r_{l}.s - fa_f_{l}.s)'
@@ -446,8 +484,14 @@ def template_text():
         w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')
         w(f'  ob_m_{l}: {{project: b_m_{l}, onto: o_{l}}}')
         w(f'  # mid-passage points between side a and the side b of the blade one pitch below')
+        # (at a sharp edge lo_f / lo_r leave the middle across it: {e}_turn above)
         for f in ('f', 'm', 'r'):
-            w(f'  lo_{f}_{l}: {{on_surface: {S}, axial: "(oa_{f}_{l}.axial + ob_{f}_{l}.axial)/2", theta: "(oa_{f}_{l}.theta + ob_{f}_{l}.theta - pitch)/2"}}')
+            if f == 'm':
+                w(f'  lo_{f}_{l}: {{on_surface: {S}, axial: "(oa_{f}_{l}.axial + ob_{f}_{l}.axial)/2", theta: "(oa_{f}_{l}.theta + ob_{f}_{l}.theta - pitch)/2"}}')
+                continue
+            e = 'le' if f == 'f' else 'te'
+            t = f'{e}_nside_{l}*{e}_turn_{l}/2'
+            w(f'  lo_{f}_{l}: {{on_surface: {S}, axial: "(oa_{f}_{l}.axial + ob_{f}_{l}.axial)/2 - {t}*{e}_aby_{l}", theta: "(oa_{f}_{l}.theta + ob_{f}_{l}.theta - pitch)/2 + {t}*{e}_abx_{l}/rm_{l}"}}')
         w(f'  hi_f_{l}: {{periodic: lo_f_{l}}}')
         w(f'  hi_r_{l}: {{periodic: lo_r_{l}}}')
         w(f'  # inlet and outlet: on the axial planes, H lines leaving the O-grid along slope_in/out')
