@@ -65,6 +65,15 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   downstream the H lines leave the O-grid along the camber direction at the edges
 #   (follow_le, follow_te: 1 = the blade angle, 0 = axial) to the inlet and outlet planes;
 #   on staggered blades much below 0.5 folds cells where they meet the O-grid.
+#   At a sharp edge (a fan on the tip: its corners cannot be sheared, below) the line across
+#   the passage from one side's O corner A to the other side's B, one pitch below, leaves
+#   one block a sliver on a staggered blade (the compressor's M_R at ob_f 2.1 deg at the
+#   shroud, M_L at oa_r 9.4 deg, U_L and D_R beside them 43 / 48 deg): lo_f / lo_r leave
+#   the middle of AB across it by |AB|/2 tan(phi), phi half the difference of the two
+#   squeezed corners (U_L at A against M_R at B; M_L at A against D_R at B), so that both
+#   lines turn by about phi and those corners come out about equal (16.7 / 28.0 and
+#   23.9 / 33.5 deg; the compressor's min scaled Jacobian 0.034 -> 0.156 at density 2, no
+#   interpolation-weight face left at M_R's corner); round and sheared edges keep the middle.
 # - Shear (o_shear): a line across the passage beside the blade runs from side a's node j to
 #   side b's node j of the blade one pitch below; with both sides' corners at one chordwise
 #   station it runs along the pitch, at 90 deg - stagger to the blade (28 deg at Rotor 37's
