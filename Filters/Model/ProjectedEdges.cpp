@@ -183,6 +183,103 @@ double cellAtVertex(const UniqueEdge& edge, int v)
 }
 
 /**
+ * The feet of a projected edge graded up from its end at a blade corner: its first wall
+ * cell (measured as joinFeet measures it, foot (1 - layer) + outer cell layer) is
+ * `firstWidth`, the next ones grow by a common factor of at most `growth` (never
+ * shrinking) until they land on a projected foot M, which is kept from there on with the
+ * feet after it: the smallest M within half the edge for which such a factor exists and
+ * the projected cell after M is within `growth` of cell M. `fromA`: the corner is the
+ * edge's vertex a; `sourceFromA`: it is the source's vertex a (the O corner's side).
+ * Returns false, leaving the edge as it was, where no such M exists.
+ */
+bool rampFeet(UniqueEdge& edge, const UniqueEdge& source, bool fromA, bool sourceFromA,
+  double layer, double firstWidth, double growth)
+{
+  const int cells = static_cast<int>(edge.params.size()) - 1;
+  if (cells < 3 || source.params.size() != edge.params.size() || !(layer > 0.0 && layer < 0.5))
+  {
+    return false;
+  }
+  // lengths from the corner: the edge's feet as projected (P) and its outer cells
+  std::vector<double> P(cells + 1), outer(cells + 1, 0.0);
+  for (int m = 0; m <= cells; ++m)
+  {
+    P[m] = edge.length * (fromA ? edge.params[m] : 1.0 - edge.params[cells - m]);
+    if (m > 0)
+    {
+      const std::vector<double>& q = source.params;
+      outer[m] = source.length *
+        (sourceFromA ? q[m] - q[m - 1] : q[cells - m + 1] - q[cells - m]);
+    }
+  }
+  const double first = (firstWidth - outer[1] * layer) / (1.0 - layer);
+  if (!(first > 0.0))
+  {
+    return false; // the outer cells differ more than that
+  }
+  const auto widthOf = [&](double foot, int k) { return foot * (1.0 - layer) + outer[k] * layer; };
+  const double startWidth = widthOf(first, 1);
+  std::vector<double> Q(cells + 1, 0.0);
+  const auto fill = [&](double g, int last) { // Q[1..last] for factor g; returns Q[last]
+    double foot = first, width = startWidth;
+    Q[1] = first;
+    for (int k = 2; k <= last; ++k)
+    {
+      width *= g;
+      foot = std::max((width - outer[k] * layer) / (1.0 - layer), foot);
+      Q[k] = Q[k - 1] + foot;
+    }
+    return Q[last];
+  };
+  // smooth[k]: the projected wall cells from k to the middle of the edge grow by at most
+  // `growth` from cell to cell (feet still on a tip are not)
+  const int half = cells / 2;
+  std::vector<char> smooth(cells + 2, 1);
+  for (int k = half; k >= 1; --k)
+  {
+    smooth[k] = smooth[k + 1] &&
+      widthOf(P[k + 1] - P[k], k + 1) <= growth * widthOf(P[k] - P[k - 1], k);
+  }
+  int m = 2;
+  for (; m <= half; ++m)
+  {
+    if (!smooth[m] || !(fill(1.0, m) <= P[m]) || !(fill(growth, m) >= P[m]))
+    {
+      continue;
+    }
+    double low = 1.0, high = growth;
+    for (int round = 0; round < 60; ++round)
+    {
+      const double g = 0.5 * (low + high);
+      (fill(g, m) < P[m] ? low : high) = g;
+    }
+    fill(high, m);
+    if (P[m] > Q[m - 1] &&
+      widthOf(P[m + 1] - P[m], m + 1) <= growth * widthOf(P[m] - Q[m - 1], m))
+    {
+      break;
+    }
+  }
+  if (m > half)
+  {
+    return false; // not reached within half the edge: left as projected
+  }
+  std::vector<double>& p = edge.params;
+  for (int k = 1; k < m; ++k)
+  {
+    if (fromA)
+    {
+      p[k] = Q[k] / edge.length;
+    }
+    else
+    {
+      p[cells - k] = 1.0 - Q[k] / edge.length;
+    }
+  }
+  return true;
+}
+
+/**
  * The feet of a side beside a fan whose feet are one point (FootJoin with one edge
  * collapsed: axial_passage_oh's prisms on a sharp tip). The wall cells are measured as
  * joinFeet measures them: the fan's is e + (o - e) h / W with e = 0, a sliver of its outer
@@ -192,9 +289,10 @@ double cellAtVertex(const UniqueEdge& edge, int v)
  * 2.5-3.5 times the fan's (the compressor's O_le|O_b at densities 0.5-4), and the next
  * 16-25 times that. Here the side's first foot is cut to FanSideRatio times the fan's wall
  * cell, the next ones grow from it by at most FanSideGrowth per cell (their outer cells
- * counted as above) until they reach the projected feet, which are kept from there on. The
- * radial lines of the cells in between lean towards the tip (round a sharp tip the normal
- * of a point on the O curve's arc has its foot on the tip, so those have no orthogonal foot).
+ * counted as above) until they reach the projected feet, which are kept from there on
+ * (rampFeet). The radial lines of the cells in between lean towards the tip (round a sharp
+ * tip the normal of a point on the O curve's arc has its foot on the tip, so those have no
+ * orthogonal foot).
  */
 void gradeBesideFan(MeshTopology& topology, const FootJoin& join, int fan)
 {
@@ -216,87 +314,8 @@ void gradeBesideFan(MeshTopology& topology, const FootJoin& join, int fan)
     return;
   }
   const double fanWidth = cellAtVertex(fanSource, outerVertex) * layer;
-  // lengths from the join's vertex: the side's feet as projected (P) and its outer cells
-  const bool fromA = join.end[side] == 0;
-  const bool sourceFromA = source.a == outerVertex;
-  std::vector<double> P(cells + 1), outer(cells + 1, 0.0);
-  for (int m = 0; m <= cells; ++m)
-  {
-    P[m] = edge.length * (fromA ? edge.params[m] : 1.0 - edge.params[cells - m]);
-    if (m > 0)
-    {
-      const std::vector<double>& q = source.params;
-      outer[m] = source.length *
-        (sourceFromA ? q[m] - q[m - 1] : q[cells - m + 1] - q[cells - m]);
-    }
-  }
-  const double first = (FanSideRatio * fanWidth - outer[1] * layer) / (1.0 - layer);
-  if (!(first > 0.0))
-  {
-    return; // the outer cells differ more than that
-  }
-  // Cells 1..M: the feet whose wall cells grow by a common factor g <= FanSideGrowth
-  // from the first, landing on the projected foot M (never shrinking); the smallest M for
-  // which such a g exists and the projected cell after M is within FanSideGrowth of cell M.
-  const auto widthOf = [&](double foot, int k) { return foot * (1.0 - layer) + outer[k] * layer; };
-  const double firstWidth = widthOf(first, 1);
-  std::vector<double> Q(cells + 1, 0.0);
-  const auto fill = [&](double g, int last) { // Q[1..last] for factor g; returns Q[last]
-    double foot = first, width = firstWidth;
-    Q[1] = first;
-    for (int k = 2; k <= last; ++k)
-    {
-      width *= g;
-      foot = std::max((width - outer[k] * layer) / (1.0 - layer), foot);
-      Q[k] = Q[k - 1] + foot;
-    }
-    return Q[last];
-  };
-  // smooth[k]: the projected wall cells from k to the middle of the side grow by at most
-  // FanSideGrowth from cell to cell (the feet still on the tip are not)
-  const int half = cells / 2;
-  std::vector<char> smooth(cells + 2, 1);
-  for (int k = half; k >= 1; --k)
-  {
-    smooth[k] = smooth[k + 1] &&
-      widthOf(P[k + 1] - P[k], k + 1) <= FanSideGrowth * widthOf(P[k] - P[k - 1], k);
-  }
-  int m = 2;
-  for (; m <= half; ++m)
-  {
-    if (!smooth[m] || !(fill(1.0, m) <= P[m]) || !(fill(FanSideGrowth, m) >= P[m]))
-    {
-      continue;
-    }
-    double low = 1.0, high = FanSideGrowth;
-    for (int round = 0; round < 60; ++round)
-    {
-      const double g = 0.5 * (low + high);
-      (fill(g, m) < P[m] ? low : high) = g;
-    }
-    fill(high, m);
-    if (P[m] > Q[m - 1] &&
-      widthOf(P[m + 1] - P[m], m + 1) <= FanSideGrowth * widthOf(P[m] - Q[m - 1], m))
-    {
-      break;
-    }
-  }
-  if (m > half)
-  {
-    return; // not reached within half the side: left as projected
-  }
-  std::vector<double>& p = edge.params;
-  for (int k = 1; k < m; ++k)
-  {
-    if (fromA)
-    {
-      p[k] = Q[k] / edge.length;
-    }
-    else
-    {
-      p[cells - k] = 1.0 - Q[k] / edge.length;
-    }
-  }
+  rampFeet(edge, source, join.end[side] == 0, source.a == outerVertex, layer,
+    FanSideRatio * fanWidth, FanSideGrowth);
 }
 
 /**
@@ -313,7 +332,9 @@ void gradeBesideFan(MeshTopology& topology, const FootJoin& join, int fan)
  * 3.4 times the fan's at density 0.5; round a cap's corner the smoothed O curve's normals
  * spread the feet on one side (turbine 1.6). Only the larger foot moves: the fan's feet
  * cannot spread (they share the tip), and the moved foot's radial line leans by its shift
- * over the O-grid's width.
+ * over the O-grid's width. Where the cut is held (by InBlockRatio against its next cell)
+ * above FanSideRatio times the other side's cell, the feet are graded up from the corner
+ * instead, as beside a fan (rampFeet).
  */
 void joinFeet(const BlockModel& model, MeshTopology& topology, const FootJoin& join)
 {
@@ -376,6 +397,27 @@ void joinFeet(const BlockModel& model, MeshTopology& topology, const FootJoin& j
     ((1.0 - layer) * allowed + share);
   const double wanted = std::max(std::max(foot[small], floor),
     (FootWidthRatio * width[small] - outer[large] * layer) / (1.0 - layer));
+  // Held by that floor above FanSideRatio times the other side's cell (the next cell
+  // inside as long as the foot), the one cut leaves the jump at the interface: the
+  // turbine's side a at its cap's corner, where the O corner's foot lies 0.06-0.09 mm
+  // before the corner, whatever the density, and the edge block's first wall cell is that
+  // piece of flank (O_a|O_te 2.17 / 1.68 / 1.57 at densities 0.5 / 1 / 2, the side's
+  // foot cut to half its next cell; 6.3 in the optimized grid, whose corner slides nearer
+  // the cap's corner). There the feet are graded up as beside a fan (rampFeet:
+  // FanSideRatio times the other side's cell, growing by at most FanSideGrowth, within
+  // checkMesh's interpolation weight, until they land on the projected feet; O_a|O_te
+  // 1.36 / 1.35 / 1.35). Not to FootWidthRatio: thinner, the cut wall cell fails
+  // checkMesh's determinant (one more cell at density 1); nor slower than FanSideGrowth:
+  // the longer ramp leans more radial lines (growth 4: the min scaled Jacobian at density
+  // 0.5 0.209 -> 0.148).
+  const double reached = wanted * (1.0 - layer) + outer[large] * layer;
+  const int outerVertex = radial.a == join.vertex ? radial.b : radial.a;
+  if (reached > FanSideRatio * width[small] && (source.a == outerVertex || source.b == outerVertex) &&
+    rampFeet(edge, source, join.end[large] == 0, source.a == outerVertex, layer,
+      FanSideRatio * width[small], FanSideGrowth))
+  {
+    return;
+  }
   if (!(wanted < foot[large]))
   {
     return;

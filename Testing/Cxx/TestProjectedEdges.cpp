@@ -573,7 +573,10 @@ TEST(ProjectedEdges, FeetAtABladeCornerKeepTheWallCellsAlike)
   // layer), the next four cells taking the length it gives up; A's other feet stay the
   // normal feet of its outer nodes. At a thin tip (radius 0.001: R a fan, its feet 500
   // times nearer one another than its outer nodes) A's first foot would be cut to a few
-  // hundredths of its next one: it is cut only to half of it (InBlockRatio).
+  // hundredths of its next one; cut only to half of it (InBlockRatio) the wall cells
+  // differed by 10.8 / 20.6 at densities 1 / 2, so A's feet are graded up from the corner
+  // instead (rampFeet, as beside a fan): 1.35 times R's wall cell, the next growing by at
+  // most 10 until they land on the normal feet.
   for (const double tip : { 1.0, 0.001 })
   {
     const BlockModel model = parseTemplate(bladeCorner(tip), "corner.yaml");
@@ -599,53 +602,127 @@ TEST(ProjectedEdges, FeetAtABladeCornerKeepTheWallCellsAlike)
       }
       else
       {
-        EXPECT_NEAR(next / side, 2.0, 0.05);
-        EXPECT_GT(side / ring, 5.0);
+        EXPECT_NEAR(side / ring, 1.35, 0.03);
+        EXPECT_LT(next / side, 10.0);
+        EXPECT_GT(next / side, 2.0);
       }
+      int landed = -1;
       for (int i = 1; i < na; ++i)
       {
         const double foot = node(grid, 1, i, 0, 0).x(), above = node(grid, 1, i, outer, 0).x();
-        if (i >= 5)
+        EXPECT_GT(foot, node(grid, 1, i - 1, 0, 0).x()) << i;
+        if (landed < 0 && std::abs(foot - above) < 1e-12)
+        {
+          landed = i;
+        }
+        if (landed >= 0)
         {
           EXPECT_NEAR(foot, above, 1e-12) << i; // the normal feet
         }
         else
         {
-          EXPECT_LT(foot, above) << i; // the cut foot's length taken up by the next four
-          EXPECT_GT(foot, node(grid, 1, i - 1, 0, 0).x()) << i;
+          EXPECT_LT(foot, above) << i; // the cut foot's length taken up by the next ones
         }
       }
+      // the one cut: the next four cells share it; the ramp lands within half the side
+      if (tip == 1.0)
+      {
+        EXPECT_EQ(landed, 5);
+      }
+      else
+      {
+        EXPECT_GE(landed, 2);
+        EXPECT_LE(landed, na / 2);
+      }
+    }
+  }
+}
+
+TEST(ProjectedEdges, FeetHeldByTheirNextCellAreGradedUpFromTheCorner)
+{
+  // A blunt corner (bladeCorner(0.1): R's feet 6 times nearer one another than its outer
+  // nodes, as the turbine's edge block by its cap's corner): cut to 1.2 times R's wall
+  // cell, A's first foot would be under a quarter of its next one, so the one cut stops at
+  // half of it (InBlockRatio) and left the wall cells across R|A 2.69 / 3.00 apart at
+  // densities 1 / 2. Held there
+  // above 1.35, A's feet are graded up from the corner instead (rampFeet, as beside a fan):
+  // its first wall cell 1.35 times R's, the next ones growing by at most 10 from cell to
+  // cell (the estimate's outer part a little more) until they land on the normal feet,
+  // which A keeps from there on.
+  const BlockModel model = parseTemplate(bladeCorner(0.1), "corner.yaml");
+  for (const double density : { 1.0, 2.0 })
+  {
+    SCOPED_TRACE(density);
+    const test::Grid grid = test::meshAll(model, density);
+    const int nr = grid.nodes[0][0], na = grid.nodes[1][0], outer = grid.nodes[1][1] - 1;
+    const auto centre = [&](int b, int i) -> Vec3 {
+      return 0.25 * (node(grid, b, i, 0, 0) + node(grid, b, i, 1, 0) + node(grid, b, i, 0, 1) +
+                      node(grid, b, i, 1, 1));
+    };
+    const double ring = (centre(0, nr - 1) - centre(0, nr - 2)).norm();
+    std::vector<double> side;
+    for (int i = 0; i + 1 < na; ++i)
+    {
+      side.push_back((centre(1, i + 1) - centre(1, i)).norm());
+    }
+    std::printf("density %g: wall cells R %.4g, A %.4g (ratio %.3f), A's next %.4g %.4g %.4g\n",
+      density, ring, side[0], side[0] / ring, side[1], side[2], side[3]);
+    EXPECT_NEAR(side[0] / ring, 1.35, 0.03);
+    int landed = -1;
+    for (int i = 1; i < na; ++i)
+    {
+      const double foot = node(grid, 1, i, 0, 0).x(), above = node(grid, 1, i, outer, 0).x();
+      EXPECT_GT(foot, node(grid, 1, i - 1, 0, 0).x()) << i;
+      if (landed < 0 && std::abs(foot - above) < 1e-12)
+      {
+        landed = i;
+      }
+      if (landed >= 0)
+      {
+        EXPECT_NEAR(foot, above, 1e-12) << i; // the normal feet from there on
+      }
+    }
+    EXPECT_GE(landed, 2);
+    EXPECT_LE(landed, na / 2);
+    for (int i = 1; i < landed + 1; ++i)
+    {
+      EXPECT_LT(side[i] / side[i - 1], 11.0) << i;
     }
   }
 }
 
 TEST(ProjectedEdges, JoinedFeetFollowMovesAsAFreshMesherDoes)
 {
-  // The ring's corner beside the flank (bladeCorner(1)): A's first foot is cut. The flank's
-  // far end moves (its outer and inner corners, w00 and w30, along x): the outer line's
-  // matched nodes change, the flank's projection with them, the join is made again from
-  // the new projection, and the grid is a fresh mesher's, bit for bit; moved back, too.
-  const BlockModel model = parseTemplate(bladeCorner(1.0), "corner.yaml");
-  const CarrierGeometry carriers(model);
-  MeshPlan plan(model, carriers);
-  const int inner = plan.model().findVertex("w00"), outer = plan.model().findVertex("w30");
-  for (const double x : { 2.4, 1.7, 2.0 })
+  // The ring's corner beside the flank (bladeCorner(1): A's first foot is cut; 0.1: A's
+  // feet are graded up from the corner, rampFeet). The flank's far end moves (its outer
+  // and inner corners, w00 and w30, along x): the outer line's matched nodes change, the
+  // flank's projection with them, the join is made again from the new projection, and the
+  // grid is a fresh mesher's, bit for bit; moved back, too.
+  for (const double tip : { 1.0, 0.1 })
   {
-    SCOPED_TRACE(x);
-    plan.model().vertices[inner].position.x() = x;
-    plan.model().vertices[outer].position.x() = x;
-    const Feasibility feasibility = plan.update({ inner, outer });
-    ASSERT_TRUE(feasibility.feasible()) << feasibility.message;
-    const test::Grid fresh = test::meshAll(plan.model());
-    for (int b = 0; b < 2; ++b)
+    SCOPED_TRACE(tip);
+    const BlockModel model = parseTemplate(bladeCorner(tip), "corner.yaml");
+    const CarrierGeometry carriers(model);
+    MeshPlan plan(model, carriers);
+    const int inner = plan.model().findVertex("w00"), outer = plan.model().findVertex("w30");
+    for (const double x : { 2.4, 1.7, 2.0 })
     {
-      EXPECT_TRUE(test::sameBits(plan.blockNodes(b), fresh.xyz[b])) << b;
+      SCOPED_TRACE(x);
+      plan.model().vertices[inner].position.x() = x;
+      plan.model().vertices[outer].position.x() = x;
+      const Feasibility feasibility = plan.update({ inner, outer });
+      ASSERT_TRUE(feasibility.feasible()) << feasibility.message;
+      const test::Grid fresh = test::meshAll(plan.model());
+      for (int b = 0; b < 2; ++b)
+      {
+        EXPECT_TRUE(test::sameBits(plan.blockNodes(b), fresh.xyz[b])) << b;
+      }
+      // the join applies: A's first foot short of its outer node
+      EXPECT_LT(node(fresh, 1, 1, 0, 0).x(), 0.9 * node(fresh, 1, 1, fresh.nodes[1][1] - 1, 0).x());
     }
-    // the join applies: A's first foot short of its outer node
-    EXPECT_LT(node(fresh, 1, 1, 0, 0).x(), 0.9 * node(fresh, 1, 1, fresh.nodes[1][1] - 1, 0).x());
+    const test::Grid back = test::meshAll(model);
+    EXPECT_TRUE(test::sameBits(plan.blockNodes(1), back.xyz[1]));
   }
-  const test::Grid back = test::meshAll(model);
-  EXPECT_TRUE(test::sameBits(plan.blockNodes(1), back.xyz[1]));
 }
 
 namespace
