@@ -78,6 +78,14 @@ struct DistributionLaw
   /// periodic line graded `ends`: grown by 2 the sides' middle cells were 2.7 times the
   /// mean at density 0.5, chords far off the turbine's curved O-grid side).
   double matchFlatness = 0.0;
+  /// Match only: 0 (the default), no limit; k > 0, the matched end cells of this edge at
+  /// most k times its mean cell (length over cells), the edges continuing it taking the
+  /// lowered cell too: a narrow edge whose group holds only matched edges, some of them
+  /// much wider, would otherwise start from cells above its mean and shrink to a fraction
+  /// of it in its middle (axial_passage_oh's wake block at a sharp trailing edge: outlet
+  /// cells of 0.08 mm between end cells of 1 mm, mean 0.39 mm, that fail checkMesh's face
+  /// tets).
+  double matchAtMost = 0.0;
 
   bool operator==(const DistributionLaw& o) const
   {
@@ -85,7 +93,7 @@ struct DistributionLaw
       firstCellSize == o.firstCellSize && lastCellSize == o.lastCellSize &&
       sourceEdge == o.sourceEdge && leanLimit == o.leanLimit && fadeStart == o.fadeStart &&
       fadeEnd == o.fadeEnd && endsFlatness == o.endsFlatness &&
-      matchFlatness == o.matchFlatness;
+      matchFlatness == o.matchFlatness && matchAtMost == o.matchAtMost;
   }
   bool operator!=(const DistributionLaw& o) const { return !(*this == o); }
 };

@@ -144,6 +144,7 @@ void buildMatchGroups(const BlockModel& model, MeshTopology& topology)
         edge.matched = true;
         edge.matchRatio = law.expansionRatio;
         edge.matchFlatness = law.matchFlatness;
+        edge.matchAtMost = law.matchAtMost;
         edge.matchLean = std::max(edge.matchLean, law.leanLimit);
       }
     }
@@ -283,6 +284,15 @@ std::vector<int> matchEdgeEnds(const BlockModel& model, MeshTopology& topology)
       }
     }
     double target = graded > 0 ? std::exp(gradedLogs / graded) : std::exp(meanLogs / matched);
+    for (const int key : group)
+    {
+      // a member whose end cells may be at most k times its mean cell lowers the group's
+      const UniqueEdge& edge = topology.edges[key / 2];
+      if (edge.matched && edge.matchAtMost > 0.0 && !edge.projectedAfterMatch)
+      {
+        target = std::min(target, edge.matchAtMost * edge.length / (edge.nodeCount - 1));
+      }
+    }
     for (const int key : group)
     {
       // a member leaving its end across its course asks for a longer cell: all follow

@@ -131,13 +131,13 @@ void computeEdgeParameters(const BlockModel& model, MeshTopology& topology, int 
       const Block& block = model.blocks[use.block];
       const DistributionLaw& law = block.laws[use.localEdge];
       if (law.kind != DistributionLaw::Kind::Match || law.expansionRatio != edge.matchRatio ||
-        law.matchFlatness != edge.matchFlatness)
+        law.matchFlatness != edge.matchFlatness || law.matchAtMost != edge.matchAtMost)
       {
         const std::array<int, 2> ends = edgeVertices(use.localEdge);
         fail(block.where, blockEntity(model, use.block),
           "edge " + edgeText(model, block.vertices[ends[0]], block.vertices[ends[1]]) + " (" +
             syntax::edgeLabel(use.localEdge) + ") is matched to its neighbours in another "
-            "block that uses it: give it the same law 'match' (with the same ratio and flat) here");
+            "block that uses it: give it the same law 'match' (with the same ratio, flat and at_most) here");
       }
     }
     try

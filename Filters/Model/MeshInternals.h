@@ -113,6 +113,7 @@ struct UniqueEdge : TopologyEdge
   bool matched = false;
   double matchRatio = DefaultMatchRatio;
   double matchFlatness = 0.0; ///< DistributionLaw::matchFlatness of its blocks' law
+  double matchAtMost = 0.0;   ///< DistributionLaw::matchAtMost of its blocks' law (0: none)
   double matchFirst = 0.0, matchLast = 0.0;
   /// Law `project_from` in its blocks: the unique edge whose nodes are projected onto this
   /// one (-1: none), and whether that edge's nodes come after the matched edges' (a chain

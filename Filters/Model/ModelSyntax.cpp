@@ -265,7 +265,7 @@ namespace
 {
 const char* const LawSyntax =
   "uniform, {geometric: k}, {two_sided: k}, {first_cell: h, ratio: r}, "
-  "{ends: [a, b]}, {ends: [a, b], flat: k}, match, {match: r}, {match: r, lean: angle}, {match: r, flat: k}, "
+  "{ends: [a, b]}, {ends: [a, b], flat: k}, match, {match: r}, {match: r, lean: angle}, {match: r, flat: k}, {match: r, at_most: k}, "
   "{project_from: edge} or "
   "{project_from: edge, fade: k} (or fade: [k_first, k_last])";
 }
@@ -361,7 +361,7 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
   const std::vector<MapEntry> entries = mapEntries(node, here, entityText, what, reporter);
   checkKeys(entries,
     { "geometric", "two_sided", "first_cell", "ratio", "ends", "match", "lean", "project_from",
-      "fade", "flat" },
+      "fade", "flat", "at_most" },
     entityText, reporter);
   const MapEntry* fade = findEntry(entries, "fade");
   if (const MapEntry* project = findEntry(entries, "project_from"))
@@ -419,12 +419,23 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
     }
     return k;
   };
+  const MapEntry* atMost = findEntry(entries, "at_most");
   if (const MapEntry* match = findEntry(entries, "match"))
   {
-    if (entries.size() != 1u + (lean ? 1u : 0u) + (flat ? 1u : 0u))
+    if (entries.size() != 1u + (lean ? 1u : 0u) + (flat ? 1u : 0u) + (atMost ? 1u : 0u))
     {
       reporter.fail(match->line, entityText,
-        what + ": expected {match: r} with lean: angle, flat: k or both, alone");
+        what + ": expected {match: r} with any of lean: angle, flat: k, at_most: k, alone");
+    }
+    if (atMost)
+    {
+      law.matchAtMost = number(atMost->value, atMost->line, what + " at_most");
+      if (!(law.matchAtMost >= 0.0) || !std::isfinite(law.matchAtMost))
+      {
+        reporter.fail(atMost->line, entityText,
+          what + ": a matched edge's end cells at most k times its mean cell needs k > 0 (0: "
+                 "no limit), got " + formatNumber(law.matchAtMost));
+      }
     }
     if (flat)
     {
@@ -453,6 +464,10 @@ DistributionLaw parseLaw(const YAML::Node& node, int line, const std::string& en
   if (lean)
   {
     reporter.fail(lean->line, entityText, what + ": 'lean' belongs to the law match");
+  }
+  if (atMost)
+  {
+    reporter.fail(atMost->line, entityText, what + ": 'at_most' belongs to the law match");
   }
   if (const MapEntry* ends = findEntry(entries, "ends"))
   {
@@ -569,6 +584,10 @@ void emitLaw(YAML::Emitter& out, const DistributionLaw& law, const BlockModel& m
       if (law.matchFlatness != 0.0)
       {
         out << YAML::Key << "flat" << YAML::Value << formatNumber(law.matchFlatness);
+      }
+      if (law.matchAtMost != 0.0)
+      {
+        out << YAML::Key << "at_most" << YAML::Value << formatNumber(law.matchAtMost);
       }
       out << YAML::EndMap;
       return;

@@ -65,6 +65,15 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   downstream the H lines leave the O-grid along the camber direction at the edges
 #   (follow_le, follow_te: 1 = the blade angle, 0 = axial) to the inlet and outlet planes;
 #   on staggered blades much below 0.5 folds cells where they meet the O-grid.
+#   At a sharp edge (a fan on the tip: its corners cannot be sheared, below) the line across
+#   the passage from one side's O corner A to the other side's B, one pitch below, leaves
+#   one block a sliver on a staggered blade (the compressor's M_R at ob_f 2.1 deg at the
+#   shroud, M_L at oa_r 9.4 deg, U_L and D_R beside them 43 / 48 deg): lo_f / lo_r leave
+#   the middle of AB across it by |AB|/2 tan(phi), phi half the difference of the two
+#   squeezed corners (U_L at A against M_R at B; M_L at A against D_R at B), so that both
+#   lines turn by about phi and those corners come out about equal (16.7 / 28.0 and
+#   23.9 / 33.5 deg; the compressor's min scaled Jacobian 0.034 -> 0.156 at density 2, no
+#   interpolation-weight face left at M_R's corner); round and sheared edges keep the middle.
 # - Shear (o_shear): a line across the passage beside the blade runs from side a's node j to
 #   side b's node j of the blade one pitch below; with both sides' corners at one chordwise
 #   station it runs along the pitch, at 90 deg - stagger to the blade (28 deg at Rotor 37's
@@ -131,6 +140,17 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   middle lines much shorter than the sides (the turbine's U_M: half as long, its cells at
 #   the O arc 1.8 times smaller than O_le's outer cells; end_cells throughout made the
 #   compressor's U_L|U_M 1.89 -> 2.28, where the O arc leaves its corner along the H line).
+# - at a sharp trailing edge (a fan on the tip) the wake block D_M's outlet edge starts from
+#   cells no larger than its mean cell (`at_most: wake_cap`, parameter wake_at_most), and
+#   D_L's and D_R's outlet edges grow from those by o_match: the outlet's three edges are
+#   matched to one another alone, and the geometric mean of their mean cells (D_M's ten
+#   cells across a few millimetres, D_L's and D_R's six across a pitch) started D_M's from
+#   2.6 times its mean and shrank it to a quarter of it in its middle: the compressor's
+#   outlet cells 0.08 mm wide, 6.7 mm long, twisted along the span failed checkMesh's face
+#   tets (20 faces at density 1). Round and capped trailing edges keep the geometric mean
+#   (Rotor 37's and the distributor's wake and inlet edges shrink the same way, by up to 2.8
+#   and 4.8 from mean to smallest cell, and pass checkMesh; lowered too, the optimizer ended
+#   at 46.06 deg on Rotor 37, below its 47.0).
 blockforge: 2
 name: axial_passage_oh
 description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.
@@ -176,6 +196,7 @@ parameters:
   period_end: 0.1         # ... and the periodic lines beside them (law `ends`): end cells this fraction of their mean cell ...
   period_flat: 3.0        # ... and that flat in between, so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
+  wake_at_most: 1         # at a sharp trailing edge (its edge block a fan, o_fan) the wake block's outlet edge starts from cells at most this many times its mean cell (law `match`, at_most), and D_L's and D_R's outlet edges grow from those: matched as the other edges (the geometric mean of the three edges' mean cells) the compressor's outlet cells were 1.0 mm at D_M's ends and 0.084 mm in its middle (mean 0.39 mm), 80 times longer than wide, twisted along the span: checkMesh's face tets (0: no limit)
 """
 
 FOOTER = """blocks:
@@ -189,7 +210,7 @@ FOOTER = """blocks:
   M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end, period_end], flat: period_flat}, E8: {ends: [period_end, period_end], flat: period_flat}}}}
   M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end, period_end], flat: period_flat}, E6: {ends: [period_end, period_end], flat: period_flat}}}}
   D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
-  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: {j: adaptive}}
+  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E3: {match: o_match, at_most: wake_cap}, E7: {match: o_match, at_most: wake_cap}}}, interpolation: {j: adaptive}}
   D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
 
 faces:
@@ -322,6 +343,40 @@ def template_text():
             # straight down the camber would leave the O curve there at a small angle)
             bisect = f'shear_{e} || off_{e}_{l}' if e == 'te' else f'shear_{e}'
             w(f'  {base}_x_{l}: "{bisect} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
+        # At a sharp edge (its edge block a fan, corners not sheared) the line across the
+        # passage, from one side's O corner A to the other side's corner B of the blade one
+        # pitch below, meets the blade where a high stagger leaves it: one of the two blocks
+        # squeezed between it and its neighbour line can be a sliver (the compressor's M_R
+        # at ob_f 2 deg at the shroud, M_L at oa_r 9 deg). The mid-passage point then leaves
+        # the middle of AB, across it by half of AB times tan(phi), phi half the difference
+        # of the two squeezed corners (leading edge: U_L's at A, between the H line and AB,
+        # and M_R's at B, between the O curve along side b and BA; trailing edge: M_L's at A,
+        # between the O curve along side a and AB, and D_R's at B, between BA and the H line):
+        # each line turns by about phi, so the two corners come out about equal.
+        #   turned lines: A's line turns from its H line (le) or towards it (te) by phi
+        for e, f, A, B, o_side, h_at in (('le', 'f', 'oa', 'ob', 'xb_f', 'A'), ('te', 'r', 'oa', 'ob', 'xa_r', 'B')):
+            abx = f'({B}_{f}_{l}.axial - {A}_{f}_{l}.axial)'
+            aby = f'(rm_{l}*({B}_{f}_{l}.theta - pitch - {A}_{f}_{l}.theta))'
+            w(f'  {e}_abx_{l}: "{abx}"      # A (side a) to B (side b, one pitch below), unrolled')
+            w(f'  {e}_aby_{l}: "{aby}"')
+            ab = (f'{e}_abx_{l}', f'{e}_aby_{l}')
+            # the H line's direction at its corner: upstream (-1, slope_in_x) at A; downstream (1, slope_out_x) at B
+            hx, hy = ('-1', f'slope_in_x_{l}') if e == 'le' else ('1', f'slope_out_x_{l}')
+            # the O curve's direction from its corner along the side (a step bisect_step along it)
+            corner = f'{B}_{f}_{l}' if e == 'le' else f'{A}_{f}_{l}'
+            ox = f'({o_side}_{l}.axial - {corner}.axial)'
+            oy = f'(rm_{l}*({o_side}_{l}.theta - {corner}.theta))'
+            def angle(ux, uy, vx, vy):
+                return f'abs(atan2(({ux})*({vy}) - ({uy})*({vx}), ({ux})*({vx}) + ({uy})*({vy})))'
+            if e == 'le':
+                first = angle(hx, hy, ab[0], ab[1])                        # U_L at A
+                second = angle(ox, oy, f'-{ab[0]}', f'-{ab[1]}')          # M_R at B
+            else:
+                first = angle(hx, hy, f'-{ab[0]}', f'-{ab[1]}')           # D_R at B
+                second = angle(ox, oy, ab[0], ab[1])                       # M_L at A
+            w(f'  {e}_turn_{l}: "off_{e}_h && off_{e}_s ? 0 : tan(({first} - {second})/2)"      # tan(phi): 0 where the edge is not sharp on either layer')
+            # the normal of AB on the side the H line leaves to
+            w(f'  {e}_nside_{l}: "{hx}*(-{ab[1]}) + ({hy})*{ab[0]} > 0 ? 1 : -1"')
         # parameter gaps (in the dir sense) between consecutive O corners on the blade and the O curve
         def gap(name, a, b):
             x = f'dir_{l}*({b}_{l}.s - {a}_{l}.s)'
@@ -330,6 +385,7 @@ def template_text():
         gap('ogap_le', 'ob_f', 'oa_f'); gap('ogap_a', 'oa_f', 'oa_r'); gap('ogap_te', 'oa_r', 'ob_r'); gap('ogap_b', 'ob_r', 'ob_f')
     for e in ('le', 'te'):
         w(f'  shear_{e}: "({e}_shear_h || {e}_shear_s) && round_{e}_h && round_{e}_s && {e}_ty_h*{e}_ty_s > 0"      # 1: the corners at this edge are sheared (both layers)')
+    w('  wake_cap: "off_te_h && off_te_s ? 0 : wake_at_most"      # the wake block\'s outlet edge: its end cells at most this many times its mean cell (0: no limit) where the trailing edge is sharp on hub or shroud (a fan on the tip)')
     w('')
     w('carriers:')
     w('  hub: {revolve: hub, axis: machine, extend: extend}')
@@ -424,6 +480,10 @@ def template_text():
         # a step along the O curve from the unsheared corner of a sheared edge towards the edge
         w(f'  wle_{l}: {{on_curve: o_{l}, at: "sb_f_{l} ? oa_f_{l}.s - dir_{l}*bisect_step : ob_f_{l}.s + dir_{l}*bisect_step", fixed: true}}')
         w(f'  wte_{l}: {{on_curve: o_{l}, at: "sb_r_{l} ? oa_r_{l}.s + dir_{l}*bisect_step : ob_r_{l}.s - dir_{l}*bisect_step", fixed: true}}')
+        # a step along the O curve from ob_f along side b (downstream) and from oa_r along side a
+        # (upstream): the sides' directions at the corners of a sharp edge (lo_f, lo_r)
+        w(f'  xb_f_{l}: {{on_curve: o_{l}, at: "ob_f_{l}.s - dir_{l}*bisect_step", fixed: true}}')
+        w(f'  xa_r_{l}: {{on_curve: o_{l}, at: "oa_r_{l}.s - dir_{l}*bisect_step", fixed: true}}')
         # the sides' mid-points (where the periodic line's middle point lo_m looks across): half-way
         # along each side, between the corners' feet where the corners are sheared
         ga = f'dir_{l}*(fa_r_{l}.s - fa_f_{l}.s)'
@@ -433,8 +493,14 @@ def template_text():
         w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')
         w(f'  ob_m_{l}: {{project: b_m_{l}, onto: o_{l}}}')
         w(f'  # mid-passage points between side a and the side b of the blade one pitch below')
+        # (at a sharp edge lo_f / lo_r leave the middle across it: {e}_turn above)
         for f in ('f', 'm', 'r'):
-            w(f'  lo_{f}_{l}: {{on_surface: {S}, axial: "(oa_{f}_{l}.axial + ob_{f}_{l}.axial)/2", theta: "(oa_{f}_{l}.theta + ob_{f}_{l}.theta - pitch)/2"}}')
+            if f == 'm':
+                w(f'  lo_{f}_{l}: {{on_surface: {S}, axial: "(oa_{f}_{l}.axial + ob_{f}_{l}.axial)/2", theta: "(oa_{f}_{l}.theta + ob_{f}_{l}.theta - pitch)/2"}}')
+                continue
+            e = 'le' if f == 'f' else 'te'
+            t = f'{e}_nside_{l}*{e}_turn_{l}/2'
+            w(f'  lo_{f}_{l}: {{on_surface: {S}, axial: "(oa_{f}_{l}.axial + ob_{f}_{l}.axial)/2 - {t}*{e}_aby_{l}", theta: "(oa_{f}_{l}.theta + ob_{f}_{l}.theta - pitch)/2 + {t}*{e}_abx_{l}/rm_{l}"}}')
         w(f'  hi_f_{l}: {{periodic: lo_f_{l}}}')
         w(f'  hi_r_{l}: {{periodic: lo_r_{l}}}')
         w(f'  # inlet and outlet: on the axial planes, H lines leaving the O-grid along slope_in/out')

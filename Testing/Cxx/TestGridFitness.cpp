@@ -64,14 +64,24 @@ using test::Pi;
  * O-grid `adaptive` (in front of the round nose U_M's middle lines are half as long as its
  * sides: O_le against U_M 1.80-1.90 -> 1.27-1.29, O_te against D_M 1.66-1.80 -> 1.22-1.36);
  * left: O_a against O_te at the cap's corner (2.17 at density 0.5). Rotor 37 and the
- * distributor are the same grids. Stop 16: the turbine 2.17 / 1.68 / 1.57 / 1.29 ->
+ * distributor are the same grids. Stop 16, the turbine: 2.17 / 1.68 / 1.57 / 1.29 ->
  * 1.36 / 1.36 / 1.35 / 1.29: at side a's cap corner the O corner oa_r (the sheared edge's
  * partner) has its foot 0.06-0.09 mm before the corner at every density, so O_te's first
  * wall cell is that piece of flank; joinFeet's one cut of O_a's foot, held to half its next
  * cell, left 1.68 at density 1; where that cut stays above FanSideRatio the side's feet
  * are now graded up from the corner as beside a fan (rampFeet: O_a against O_te 1.36 /
  * 1.35 / 1.35 / under 1.2; the worst now O_te against D_M at density 1). Rotor 37, the
- * distributor and the compressor are the same grids. The bounds, per machine, fail when
+ * distributor and the compressor are the same grids. Stop 16, the compressor: at its sharp
+ * trailing edge the wake block's outlet edge starts from cells at most its mean cell
+ * (`at_most`: checkMesh's face tets by the outlet gone), and at both sharp edges the
+ * mid-passage points leave the
+ * middle of the line across the passage so that its squeezed corners come out about equal
+ * (M_R at ob_f 2.1 -> 16.7 deg at the shroud; min scaled Jacobian 0.034 -> 0.156 at
+ * density 2): 1.85 / 1.66 / 1.79 / 1.89 -> 1.85 / 1.69 / 1.84 / 1.93 (U_L against U_M,
+ * D_M against D_R: U_M's and D_M's corners at the fans' O corners, 10-15 deg, whose O arc
+ * leaves nearly along the H line, pinch their first column mid-way to the inlet / outlet,
+ * where the linear blend of the inlet's and the O arc's first cells, pointing nearly
+ * opposite ways along the interface, is shortest). The bounds, per machine, fail when
  * the grading gets worse.
  */
 double maxNeighbourRatio(const std::string& templateName, const std::string& machine)

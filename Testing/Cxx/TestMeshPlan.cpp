@@ -268,11 +268,18 @@ TEST(Placement, ExpressionAndCurveChainsFollowMovesAsTheTemplateWould)
   const int oa = vertexIndex(model, "oa_f_h"), ob = vertexIndex(model, "ob_f_h");
   const int lo = vertexIndex(model, "lo_f_h"), aIn = vertexIndex(model, "a_in_h");
   const int loIn = vertexIndex(model, "lo_in_h"), hi = vertexIndex(model, "hi_f_h");
-  // What follows what: expressions (lo_f_h is mid-way between the O corners), and the
-  // periodic line lo_h drawn through lo_f_h, lo_m_h, lo_r_h.
+  // What follows what: expressions (lo_f_h is mid-way between the O corners, moved across
+  // the line between them at a sharp edge, le_turn_h: it follows the corners and what the
+  // turn reads, the H lines' slope among them), and the periodic line lo_h drawn through
+  // lo_f_h, lo_m_h, lo_r_h.
   const PlacementExpressions& mid = model.vertices[lo].rule.expressions;
   EXPECT_EQ(mid.form, PlacementExpressions::Form::AxialTheta);
-  EXPECT_EQ(mid.follows, (std::vector<int>{ std::min(oa, ob), std::max(oa, ob) }));
+  EXPECT_TRUE(std::is_sorted(mid.follows.begin(), mid.follows.end()));
+  for (const int corner : { oa, ob })
+  {
+    EXPECT_TRUE(std::binary_search(mid.follows.begin(), mid.follows.end(), corner));
+  }
+  EXPECT_FALSE(std::binary_search(mid.follows.begin(), mid.follows.end(), lo));
   EXPECT_EQ(model.vertices[oa].rule.expressions.form, PlacementExpressions::Form::None);
   const int line = model.findCarrier("lo_h");
   ASSERT_GE(line, 0);

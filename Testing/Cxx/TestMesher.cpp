@@ -630,6 +630,86 @@ TEST(Mesher, MatchedEdgesTakeTheirEndCellsFromTheirNeighbours)
   }
 }
 
+TEST(Mesher, MatchedEdgesStartAtMostTheirLimitTimesTheirMeanCell)
+{
+  // The two cubes of MatchedEdgesTakeTheirEndCellsFromTheirNeighbours (4 cells across the
+  // left one, 16 across the right one, `match` along x): the geometric mean 0.125 of the
+  // mean cells is twice the right block's mean cell. With `at_most: 1` on the right block's
+  // x edges its cells are its mean cell, uniform, and the left block's cells at the shared
+  // face take that cell too; at_most 3 (above 2) changes nothing; 0 is no limit.
+  BlockModel model = loadTemplate(test::sourcePath("Testing/Data/two_blocks.yaml"));
+  model.blocks[1].cells[0] = 16;
+  DistributionLaw match;
+  match.kind = DistributionLaw::Kind::Match;
+  match.expansionRatio = 1.2;
+  for (const double atMost : { 0.0, 1.0, 3.0 })
+  {
+    SCOPED_TRACE(atMost);
+    for (int b = 0; b < 2; ++b)
+    {
+      for (int e = 0; e < 12; ++e)
+      {
+        if (edgeDirection(e) == 0)
+        {
+          model.blocks[b].laws[e] = match;
+          model.blocks[b].laws[e].matchAtMost = b == 1 ? atMost : 0.0;
+        }
+      }
+    }
+    for (const double density : { 1.0, 2.0 })
+    {
+      SCOPED_TRACE(density);
+      const auto grids = meshBlocks(model, density);
+      const BlockGrid& left = grids[0];
+      const BlockGrid& right = grids[1];
+      const double expected = (atMost == 1.0 ? 0.0625 : std::sqrt(0.25 * 0.0625)) / density;
+      for (int k = 0; k < left.nk; ++k)
+      {
+        for (int j = 0; j < left.nj; ++j)
+        {
+          const double last = (left.node(left.ni - 1, j, k) - left.node(left.ni - 2, j, k)).norm();
+          EXPECT_NEAR(last, expected, 1e-12);
+          for (int i = 0; i + 1 < right.ni; ++i)
+          {
+            const double cell = (right.node(i + 1, j, k) - right.node(i, j, k)).norm();
+            if (atMost == 1.0)
+            {
+              EXPECT_NEAR(cell, 0.0625 / density, 1e-12) << i; // its mean cell throughout
+            }
+            else if (i == 0)
+            {
+              EXPECT_NEAR(cell, expected, 1e-12);
+            }
+          }
+        }
+      }
+    }
+    // the limit travels in the model document
+    const BlockModel reread = readModelDocument(writeModelDocument(model));
+    EXPECT_EQ(reread.blocks[1].laws, model.blocks[1].laws);
+    EXPECT_EQ(meshBlocks(reread)[1].xyz, meshBlocks(model)[1].xyz);
+  }
+  // a limit belongs to the law match only, and is not negative
+  const std::string path = test::sourcePath("Testing/Data/match_lean.yaml");
+  const std::string law = "grading: {i: {match: 1.2, lean: lean}}";
+  for (const auto& [text, message] : std::vector<std::pair<std::string, std::string>>{
+         { "grading: {i: {geometric: 1.2, at_most: 1}}", "'at_most' belongs to the law match" },
+         { "grading: {i: {match: 1.2, at_most: -1}}", "needs k > 0" } })
+  {
+    std::string document = test::readText(path);
+    document.replace(document.find(law), law.size(), text);
+    try
+    {
+      parseTemplate(document, "match_lean.yaml");
+      ADD_FAILURE() << "no error for " << text;
+    }
+    catch (const TemplateError& error)
+    {
+      EXPECT_NE(std::string(error.what()).find(message), std::string::npos) << error.what();
+    }
+  }
+}
+
 TEST(Mesher, MatchedEdgesLeanNoMoreThanTheirLimit)
 {
   // The right block's bottom edge is a half circle of radius 0.5 leaving the shared face
