@@ -740,7 +740,7 @@ TEST(FaceChecks, MeasuresTheNeighbourRatioAcrossInterfaces)
  * faces, 26.06 degrees at the command line); now 22.35 and 23.08 degrees here (19.81 and
  * 25.32 at the command line, whose search runs on the model the reader's inputs give).
  * Stop 16 (issue 8): the optimized grid's interface ratio stays at most max(the placed
- * grid's, maximumInterfaceRatio): compressor 1.66 -> 1.66 (unguarded 1.76), turbine 1.36
+ * grid.s, maximumInterfaceRatio): compressor 1.69 -> 1.59 (unguarded 1.70), turbine 1.36
  * -> 1.52 (unguarded 6.70, periodic M_L|M_R).
  */
 TEST(OptimizerPassage, OptimizedGridsFailNoFaceWeight)
