@@ -32,7 +32,12 @@
  * A configuration is infeasible when its grid folds, or when it fails more of checkMesh's
  * interpolation-weight and volume-ratio faces than the start's grid (FaceChecks.h; e.g. a
  * fan's corner moved off the tip's arc while its feet stay on the tip): the smallest angle
- * does not see a wall cell beside one 20 times its width.
+ * does not see a wall cell beside one 20 times its width. It is infeasible too when two
+ * cells across a block interface differ more than ObjectiveSettings::maximumInterfaceRatio
+ * times (or than the start's grid's, where that is more; FaceChecks.h InterfaceRatio):
+ * the inlet points sliding along the inlet (lo_in, b_in) and the O-grid's corner ob_f left
+ * Rotor 37's U_M cell at the inlet 3.6 times its U_R neighbour, none of it in the angles
+ * the search improves (issue 8).
  *
  * Everything that follows a moved vertex follows it: vertices placed from it (rules),
  * the parameters of carrier edges ending at it, and surface curves drawn through it.
@@ -117,8 +122,9 @@ public:
 
   /**
    * Whether a configuration whose grid fails more of checkMesh's interpolation-weight and
-   * volume-ratio faces (FaceChecks.h) than the start's is infeasible (the default), or only
-   * measured (GridMeasures::weakFaces).
+   * volume-ratio faces (FaceChecks.h) than the start's, or jumps more across a block
+   * interface than ObjectiveSettings::maximumInterfaceRatio allows, is infeasible (the
+   * default), or only measured (GridMeasures::weakFaces).
    */
   void refuseWeakFaces(bool refuse);
 

@@ -79,6 +79,9 @@ struct ControlProblem::Impl
   std::unique_ptr<InterfaceFaces> Interfaces;
   long long StartWeakFaces = 0;
   bool RefuseWeakFaces = true;
+  /// The start grid's largest neighbour size ratio across block interfaces; a
+  /// configuration may have max(this, Objective.maximumInterfaceRatio).
+  double StartInterfaceRatio = 1.0;
 
   /// Forgets the measured angles of the blocks the last plan update recomputed.
   void forgetUpdated()
@@ -136,6 +139,9 @@ struct ControlProblem::Impl
 
   /// A feasible measure with more weak faces than the start becomes infeasible: the
   /// optimizer refuses configurations that fail more of checkMesh's face checks.
+  /// A feasible measure whose neighbour size ratio across block interfaces exceeds
+  /// max(the start's, Objective.maximumInterfaceRatio) becomes infeasible too: the
+  /// trials' inlet and outlet points left U_M's last cell 3.6 times U_R's first (Rotor 37).
   GridMeasures refuseWeakFaces(GridMeasures measures)
   {
     if (!measures.feasible)
@@ -150,6 +156,21 @@ struct ControlProblem::Impl
       measures.failure = std::to_string(measures.weakFaces) +
         " faces fail checkMesh's interpolation weight or volume ratio (" +
         std::to_string(StartWeakFaces) + " at the start)";
+      return measures;
+    }
+    if (RefuseWeakFaces && Objective.maximumInterfaceRatio > 0.0)
+    {
+      measures.interfaceRatio = Interfaces->largestRatio(planGrids()).ratio;
+      const double bound = std::max(StartInterfaceRatio, Objective.maximumInterfaceRatio);
+      if (measures.interfaceRatio > bound)
+      {
+        measures.feasible = false;
+        // (grows with the excess, in hundredths, so the search sees the way back)
+        measures.objective =
+          infeasibleObjective(1 + static_cast<long long>(100.0 * (measures.interfaceRatio - bound)));
+        measures.failure = "neighbour size ratio " + std::to_string(measures.interfaceRatio) +
+          " across a block interface (at most " + std::to_string(bound) + ")";
+      }
     }
     return measures;
   }
@@ -287,6 +308,7 @@ struct ControlProblem::Impl
       Interfaces.reset(new InterfaceFaces(grids, Plan->topology().periodicSideLinks()));
       Cells.clear();
       StartWeakFaces = weakFaces();
+      StartInterfaceRatio = Interfaces->largestRatio(grids).ratio;
       Current.clear();
       for (const ControlVariable& variable : Variables)
       {

@@ -264,6 +264,55 @@ long long InterfaceFaces::weakFaces(
   return weak;
 }
 
+namespace
+{
+/// Width of cell (i, j, k) of a block along its direction d: the distance between the
+/// centres (corner means) of its two faces across d.
+double cellWidth(const quality::BlockView& view, const int (&cell)[3], int d)
+{
+  Vec3 low = Vec3::Zero(), high = Vec3::Zero();
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    int ijk[3] = { cell[0] + (corner & 1), cell[1] + ((corner >> 1) & 1), cell[2] + ((corner >> 2) & 1) };
+    const Vec3 p = Eigen::Map<const Vec3>(view.node(ijk[0], ijk[1], ijk[2]));
+    (ijk[d] == cell[d] ? low : high) += p;
+  }
+  return 0.25 * (high - low).norm();
+}
+} // namespace
+
+InterfaceRatio InterfaceFaces::largestRatio(const std::vector<BlockGrid>& blocks) const
+{
+  double totalCells = 0.0;
+  const std::vector<quality::BlockView> views = quality::blockViews(blocks, totalCells);
+  InterfaceRatio worst;
+  for (const Pairs::Pair& pair : P->pairs)
+  {
+    int owner[3], neighbour[3];
+    P3 q[4];
+    views[pair.owner.block].sideFace(pair.owner.side, pair.owner.a, pair.owner.b, q, owner);
+    views[pair.neighbour.block].sideFace(
+      pair.neighbour.side, pair.neighbour.a, pair.neighbour.b, q, neighbour);
+    const double a = cellWidth(views[pair.owner.block], owner, pair.owner.side / 2);
+    const double b = cellWidth(views[pair.neighbour.block], neighbour, pair.neighbour.side / 2);
+    const double smaller = std::min(a, b);
+    if (!(smaller > 0.0))
+    {
+      continue; // a collapsed cell (a fan's apex): no width to compare
+    }
+    const double ratio = std::max(a, b) / smaller;
+    if (ratio > worst.ratio)
+    {
+      worst.ratio = ratio;
+      worst.ownerBlock = pair.owner.block;
+      worst.neighbourBlock = pair.neighbour.block;
+      worst.ownerCell = { { owner[0], owner[1], owner[2] } };
+      worst.neighbourCell = { { neighbour[0], neighbour[1], neighbour[2] } };
+    }
+  }
+  return worst;
+}
+
 long long weakFaceCount(const std::vector<BlockGrid>& blocks, const std::vector<PeriodicSideLink>& periodic)
 {
   std::vector<BlockCells> cells;

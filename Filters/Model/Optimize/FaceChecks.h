@@ -14,12 +14,17 @@
  * failed below 0.05; the volume ratio min(vO, vN) / max(vO, vN), failed below 0.01. Faces
  * between blocks are paired by coincident corners, periodic sides through their rotation
  * (as GridQuality pairs them).
+ *
+ * The same pairs give the neighbour size ratio across block interfaces (issue 8's
+ * measure, InterfaceRatio), which the optimizer holds to a bound: the checks above fail
+ * only at a jump of 19, while a jump of 3 to 5 already spoils a solver's gradients.
  */
 #pragma once
 
 #include "GridObjective.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -62,6 +67,19 @@ private:
 };
 
 /**
+ * The neighbour size ratio across one face between blocks: the larger over the smaller
+ * of the two cells' widths across it (the distance between the centres of a cell's face
+ * on the interface and of its opposite face; TestGridFitness's and
+ * Benchmark/interface_ratios.py's measure), and the two cells (block, cell i, j, k).
+ */
+struct InterfaceRatio
+{
+  double ratio = 1.0;
+  int ownerBlock = -1, neighbourBlock = -1;
+  std::array<int, 3> ownerCell{ { -1, -1, -1 } }, neighbourCell{ { -1, -1, -1 } };
+};
+
+/**
  * The faces between blocks (coincident corners, found on the grid given to the
  * constructor, which fixes the pairing: the optimizer moves nodes, not the topology) and
  * between periodic sides. weakFaces() counts those that fail on a grid with the same
@@ -74,6 +92,9 @@ public:
   ~InterfaceFaces();
   long long weakFaces(
     const std::vector<BlockGrid>& blocks, const std::vector<const BlockCells*>& cells) const;
+  /// The worst neighbour size ratio across the faces between blocks (periodic sides
+  /// included) on a grid with the same block sizes: where it is and how large.
+  InterfaceRatio largestRatio(const std::vector<BlockGrid>& blocks) const;
 
 private:
   struct Pairs;

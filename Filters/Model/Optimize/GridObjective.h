@@ -51,6 +51,15 @@ struct ObjectiveSettings
   /// templates' own grading sets (1.15-1.7 on the passage templates): 29.4 against 30.4
   /// degrees on the distributor's OH grid (Benchmark/OPTIMIZER.md).
   double sizeRatioLimit = 1.5;
+  /// A configuration whose neighbour size ratio across the faces between blocks
+  /// (FaceChecks.h InterfaceRatio) exceeds the larger of this and the start's is
+  /// infeasible (ControlProblem); 0 or less: not held. Issue 8: unguarded, the optimized
+  /// axial_passage_oh grids at density 1 jumped 3.58 (Rotor 37, U_M|U_R at the inlet),
+  /// 2.50 (distributor), 4.70 (turbine). Smallest angle at density 1 (Rotor 37 /
+  /// distributor) against this bound: 1.5: 43.86 / 45.22; 1.55: 47.42 / 47.10 (628
+  /// trials on the distributor instead of 427); 1.6: 47.40 / 47.12 (the same trial counts);
+  /// 1.7 and 2.0: 47.29 / 47.22 (unguarded 47.29 / 47.22).
+  double maximumInterfaceRatio = 1.6;
 };
 
 /// One block grid: ni x nj x nk nodes, 3 doubles per node, i fastest.
@@ -121,6 +130,9 @@ struct GridMeasures
   /// Faces failing checkMesh's interpolation weight or volume ratio (FaceChecks.h); a
   /// configuration with more than its start is infeasible. 0 when not measured.
   long long weakFaces = 0;
+  /// Largest neighbour size ratio across the faces between blocks (FaceChecks.h); 0 when
+  /// not measured.
+  double interfaceRatio = 0.0;
   double objective = 0.0;         ///< the value minimised (lower is better)
   std::string failure;            ///< why it is not feasible
 };
