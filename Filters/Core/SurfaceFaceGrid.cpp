@@ -370,7 +370,13 @@ void surfaceFaceGrid(const ParametricSurface& surface, const std::vector<Eigen::
   {
     even[k] = Eigen::Vector2d(sigma.forward(loopST[k][0]), tau.forward(loopST[k][1]));
   }
-  const std::vector<double> evenGrid = parameterTfi(even, loop, bottom, top, left, right, { Blending::Linear, Blending::Linear }); // linear: the grid that does not fold
+  // linear: the grid that does not fold; with the widths EndWidths keeps beside its sides,
+  // so that the guard does not take them back to the linear grid's narrow cells
+  const auto safeBlending = [](Blending b) {
+    return b == Blending::EndWidths ? Blending::EndWidths : Blending::Linear;
+  };
+  const std::vector<double> evenGrid = parameterTfi(even, loop, bottom, top, left, right,
+    { safeBlending(blending[0]), safeBlending(blending[1]) });
   std::vector<Eigen::Vector2d> safe(st);
   for (int b = 1; b + 1 < nb; ++b)
   {

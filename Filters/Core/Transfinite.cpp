@@ -79,6 +79,120 @@ inline double adaptiveBlend(double spread)
   return spread > kAdaptiveTolerance ? 1.0 - kAdaptiveTolerance / spread : 0.0;
 }
 
+/// Blending::EndWidths on a face grid of na x nb nodes (a fastest), for the lines along a
+/// (alongA) or along b: `sideParams` the parameters of the two side edges the lines run
+/// between (one per line), `acrossA` / `acrossB` those of the two edges along the lines
+/// (one per node of a line), whose mean places a node across the face.
+void keepEndWidths(double* grid, int na, int nb, bool alongA, const double* sideParams[2],
+  const double* acrossA, const double* acrossB)
+{
+  const int nodes = alongA ? na : nb; // along a line
+  const int lines = alongA ? nb : na;
+  if (nodes < 3 || lines < 3)
+  {
+    return;
+  }
+  const auto at = [&](int node, int line) -> double* {
+    const long index = alongA ? node + static_cast<long>(na) * line
+                              : line + static_cast<long>(na) * node;
+    return grid + 3 * index;
+  };
+  const auto distance = [](const double* p, const double* q) {
+    return std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+      (p[2] - q[2]) * (p[2] - q[2]));
+  };
+  // the displacement of each line's node next to each side, from the linear grid
+  std::vector<double> shift[2];
+  for (int side = 0; side < 2; ++side)
+  {
+    const int edgeNode = side == 0 ? 0 : nodes - 1;
+    const int nextNode = side == 0 ? 1 : nodes - 2;
+    const double firstWidth = distance(at(nextNode, 0), at(edgeNode, 0));
+    const double lastWidth = distance(at(nextNode, lines - 1), at(edgeNode, lines - 1));
+    bool narrowed = false;
+    for (int line = 1; line < lines - 1 && !narrowed; ++line)
+    {
+      const double t = sideParams[side][line];
+      const double target = (1.0 - t) * firstWidth + t * lastWidth;
+      narrowed = distance(at(nextNode, line), at(edgeNode, line)) < (1.0 - kAdaptiveTolerance) * target;
+    }
+    if (!narrowed)
+    {
+      continue;
+    }
+    shift[side].assign(3 * static_cast<std::size_t>(lines), 0.0);
+    for (int line = 1; line < lines - 1; ++line)
+    {
+      const double t = sideParams[side][line];
+      const double target = (1.0 - t) * firstWidth + t * lastWidth;
+      const double* p = at(edgeNode, line);
+      const double* q = at(nextNode, line);
+      const double* before = at(edgeNode, line - 1);
+      const double* after = at(edgeNode, line + 1);
+      double tangent[3], offset[3];
+      double tangentLength = 0.0;
+      for (int c = 0; c < 3; ++c)
+      {
+        tangent[c] = after[c] - before[c];
+        offset[c] = q[c] - p[c];
+        tangentLength += tangent[c] * tangent[c];
+      }
+      tangentLength = std::sqrt(tangentLength);
+      if (!(tangentLength > 0.0))
+      {
+        continue;
+      }
+      double along = 0.0;
+      for (int c = 0; c < 3; ++c)
+      {
+        tangent[c] /= tangentLength;
+        along += offset[c] * tangent[c];
+      }
+      double normal[3], across = 0.0;
+      for (int c = 0; c < 3; ++c)
+      {
+        normal[c] = offset[c] - along * tangent[c];
+        across += normal[c] * normal[c];
+      }
+      across = std::sqrt(across);
+      const double width = distance(q, p);
+      if (!(across > 0.0) || !(target > width))
+      {
+        continue;
+      }
+      // across the side (its normal in the face), so that the cell is `target` wide
+      const double move = std::sqrt(target * target - along * along) - across;
+      for (int c = 0; c < 3; ++c)
+      {
+        shift[side][3 * line + c] = move * normal[c] / across;
+      }
+    }
+  }
+  for (int side = 0; side < 2; ++side)
+  {
+    if (shift[side].empty())
+    {
+      continue;
+    }
+    const auto sigma = [&](int node) { return 0.5 * (acrossA[node] + acrossB[node]); };
+    const int nextNode = side == 0 ? 1 : nodes - 2;
+    const double nextShare = side == 0 ? 1.0 - sigma(nextNode) : sigma(nextNode);
+    for (int line = 1; line < lines - 1; ++line)
+    {
+      const double* move = shift[side].data() + 3 * line;
+      for (int node = 1; node < nodes - 1; ++node)
+      {
+        const double share = (side == 0 ? 1.0 - sigma(node) : sigma(node)) / nextShare;
+        double* p = at(node, line);
+        for (int c = 0; c < 3; ++c)
+        {
+          p[c] += share * move[c];
+        }
+      }
+    }
+  }
+}
+
 inline void copyNode(const double* from, double* to)
 {
   to[0] = from[0];
@@ -428,6 +542,16 @@ void transfiniteFace(const EdgeNodes& bottom, const EdgeNodes& top, const EdgeNo
     {
       interior(blend);
     }
+  }
+  if (blending[0] == Blending::EndWidths) // lines along i, between the left and right edges
+  {
+    const double* sides[2] = { left.params, right.params };
+    keepEndWidths(out, ni, nj, true, sides, bottom.params, top.params);
+  }
+  if (blending[1] == Blending::EndWidths) // lines along j, between the bottom and top edges
+  {
+    const double* sides[2] = { bottom.params, top.params };
+    keepEndWidths(out, ni, nj, false, sides, left.params, right.params);
   }
 }
 
