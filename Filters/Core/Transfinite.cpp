@@ -160,11 +160,11 @@ void keepEndWidths(double* grid, int na, int nb, bool alongA, const double* side
       {
         continue;
       }
-      // across the side (its normal in the face), so that the cell is `target` wide
-      const double move = std::sqrt(target * target - along * along) - across;
+      // along the cell's own direction, so that the cell is `target` wide
+      const double move = target / width - 1.0;
       for (int c = 0; c < 3; ++c)
       {
-        shift[side][3 * line + c] = move * normal[c] / across;
+        shift[side][3 * line + c] = move * offset[c];
       }
     }
   }
