@@ -174,15 +174,17 @@ void keepEndWidths(double* grid, int na, int nb, bool alongA, const double* side
     {
       continue;
     }
+    // the share falls linearly (in the nodes' parameters) from the node next to this side
+    // to the node next to the far side, so that the far side's cells keep their width
     const auto sigma = [&](int node) { return 0.5 * (acrossA[node] + acrossB[node]); };
-    const int nextNode = side == 0 ? 1 : nodes - 2;
-    const double nextShare = side == 0 ? 1.0 - sigma(nextNode) : sigma(nextNode);
+    const double near = sigma(side == 0 ? 1 : nodes - 2);
+    const double far = sigma(side == 0 ? nodes - 2 : 1);
     for (int line = 1; line < lines - 1; ++line)
     {
       const double* move = shift[side].data() + 3 * line;
       for (int node = 1; node < nodes - 1; ++node)
       {
-        const double share = (side == 0 ? 1.0 - sigma(node) : sigma(node)) / nextShare;
+        const double share = far == near ? 1.0 : (far - sigma(node)) / (far - near);
         double* p = at(node, line);
         for (int c = 0; c < 3; ++c)
         {
