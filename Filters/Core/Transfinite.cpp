@@ -123,8 +123,9 @@ void keepEndWidths(double* grid, int na, int nb, bool alongA, const double* side
     shift[side].assign(3 * static_cast<std::size_t>(lines), 0.0);
     for (int line = 1; line < lines - 1; ++line)
     {
+      // up to (1 - kAdaptiveTolerance) of the blend: lines within that stay (bit for bit)
       const double t = sideParams[side][line];
-      const double target = (1.0 - t) * firstWidth + t * lastWidth;
+      const double target = (1.0 - kAdaptiveTolerance) * ((1.0 - t) * firstWidth + t * lastWidth);
       const double* p = at(edgeNode, line);
       const double* q = at(nextNode, line);
       const double* before = at(edgeNode, line - 1);
