@@ -79,6 +79,14 @@ inline double adaptiveBlend(double spread)
   return spread > kAdaptiveTolerance ? 1.0 - kAdaptiveTolerance / spread : 0.0;
 }
 
+/// Blending::EndWidths corrects a side's cells only where one of them is narrower than this
+/// fraction of the blend of the side's end cells (then all up to 1 - kAdaptiveTolerance).
+/// Why not 1 - kAdaptiveTolerance itself: axial_passage_oh's U_M / D_M come out at least
+/// 0.75 of that blend on Rotor 37 and the distributor (their grids stay the same) and 0.69
+/// on the turbine (some of its faces lifted a little), 0.46-0.69 beside the compressor's
+/// fans (its D_M hub face, 0.74-0.93, is left).
+constexpr double kEndWidthsTrigger = 0.7;
+
 /// Blending::EndWidths on a face grid of na x nb nodes (a fastest), for the lines along a
 /// (alongA) or along b: `sideParams` the parameters of the two side edges the lines run
 /// between (one per line), `acrossA` / `acrossB` those of the two edges along the lines
@@ -109,14 +117,14 @@ void keepEndWidths(double* grid, int na, int nb, bool alongA, const double* side
     const int nextNode = side == 0 ? 1 : nodes - 2;
     const double firstWidth = distance(at(nextNode, 0), at(edgeNode, 0));
     const double lastWidth = distance(at(nextNode, lines - 1), at(edgeNode, lines - 1));
-    bool narrowed = false;
-    for (int line = 1; line < lines - 1 && !narrowed; ++line)
+    double least = 1.0;
+    for (int line = 1; line < lines - 1; ++line)
     {
       const double t = sideParams[side][line];
       const double target = (1.0 - t) * firstWidth + t * lastWidth;
-      narrowed = distance(at(nextNode, line), at(edgeNode, line)) < (1.0 - kAdaptiveTolerance) * target;
+      least = std::min(least, distance(at(nextNode, line), at(edgeNode, line)) / target);
     }
-    if (!narrowed)
+    if (!(least < kEndWidthsTrigger))
     {
       continue;
     }
