@@ -136,44 +136,18 @@ void keepEndWidths(double* grid, int na, int nb, bool alongA, const double* side
       const double target = (1.0 - kAdaptiveTolerance) * ((1.0 - t) * firstWidth + t * lastWidth);
       const double* p = at(edgeNode, line);
       const double* q = at(nextNode, line);
-      const double* before = at(edgeNode, line - 1);
-      const double* after = at(edgeNode, line + 1);
-      double tangent[3], offset[3];
-      double tangentLength = 0.0;
-      for (int c = 0; c < 3; ++c)
-      {
-        tangent[c] = after[c] - before[c];
-        offset[c] = q[c] - p[c];
-        tangentLength += tangent[c] * tangent[c];
-      }
-      tangentLength = std::sqrt(tangentLength);
-      if (!(tangentLength > 0.0))
-      {
-        continue;
-      }
-      double along = 0.0;
-      for (int c = 0; c < 3; ++c)
-      {
-        tangent[c] /= tangentLength;
-        along += offset[c] * tangent[c];
-      }
-      double normal[3], across = 0.0;
-      for (int c = 0; c < 3; ++c)
-      {
-        normal[c] = offset[c] - along * tangent[c];
-        across += normal[c] * normal[c];
-      }
-      across = std::sqrt(across);
       const double width = distance(q, p);
-      if (!(across > 0.0) || !(target > width))
+      if (!(width > 0.0) || !(target > width))
       {
         continue;
       }
-      // along the cell's own direction, so that the cell is `target` wide
+      // along the cell's own direction, so that the cell is `target` wide (across the side
+      // instead, the cells by a corner whose far end leaves nearly along the side were
+      // sheared: the compressor's U_M corner cell at oa_f, scaled Jacobian 0.132 -> 0.089)
       const double move = target / width - 1.0;
       for (int c = 0; c < 3; ++c)
       {
-        shift[side][3 * line + c] = move * offset[c];
+        shift[side][3 * line + c] = move * (q[c] - p[c]);
       }
     }
   }
