@@ -274,7 +274,13 @@ void surfaceFaceGrid(const ParametricSurface& surface, const std::vector<Eigen::
       std::to_string(loop.size()));
   }
   const std::size_t count = static_cast<std::size_t>(na) * nb;
-  std::vector<double> parameters = parameterTfi(loopST, loop, bottom, top, left, right, blending);
+  // EndWidths measures widths: not in (s, t), whose scales differ (the guard's even grid
+  // below, and the 3-D targets, keep them); the targets' search starts from the linear grid
+  const auto parameterBlending = [](Blending b) {
+    return b == Blending::EndWidths ? Blending::Linear : b;
+  };
+  std::vector<double> parameters = parameterTfi(loopST, loop, bottom, top, left, right,
+    { parameterBlending(blending[0]), parameterBlending(blending[1]) });
   std::vector<double> targets(3 * count);
   transfiniteFace(bottom, top, left, right, targets.data(), blending);
   // Every node's (s, t): boundary nodes from the loop, interior nodes placed below.
@@ -370,7 +376,13 @@ void surfaceFaceGrid(const ParametricSurface& surface, const std::vector<Eigen::
   {
     even[k] = Eigen::Vector2d(sigma.forward(loopST[k][0]), tau.forward(loopST[k][1]));
   }
-  const std::vector<double> evenGrid = parameterTfi(even, loop, bottom, top, left, right, { Blending::Linear, Blending::Linear }); // linear: the grid that does not fold
+  // linear: the grid that does not fold; with the widths EndWidths keeps beside its sides,
+  // so that the guard does not take them back to the linear grid's narrow cells
+  const auto safeBlending = [](Blending b) {
+    return b == Blending::EndWidths ? Blending::EndWidths : Blending::Linear;
+  };
+  const std::vector<double> evenGrid = parameterTfi(even, loop, bottom, top, left, right,
+    { safeBlending(blending[0]), safeBlending(blending[1]) });
   std::vector<Eigen::Vector2d> safe(st);
   for (int b = 1; b + 1 < nb; ++b)
   {

@@ -79,6 +79,105 @@ inline double adaptiveBlend(double spread)
   return spread > kAdaptiveTolerance ? 1.0 - kAdaptiveTolerance / spread : 0.0;
 }
 
+/// Blending::EndWidths corrects a side's cells only where one of them is narrower than this
+/// fraction of the blend of the side's end cells (then all up to 1 - kAdaptiveTolerance).
+/// Why not 1 - kAdaptiveTolerance itself: axial_passage_oh's U_M / D_M come out at least
+/// 0.75 of that blend on Rotor 37 and the distributor (their grids stay the same) and 0.69
+/// on the turbine (some of its faces lifted a little), 0.46-0.69 beside the compressor's
+/// fans (its D_M hub face, 0.74-0.93, is left).
+constexpr double kEndWidthsTrigger = 0.7;
+
+/// Blending::EndWidths on a face grid of na x nb nodes (a fastest), for the lines along a
+/// (alongA) or along b: `sideParams` the parameters of the two side edges the lines run
+/// between (one per line), `acrossA` / `acrossB` those of the two edges along the lines
+/// (one per node of a line), whose mean places a node across the face.
+void keepEndWidths(double* grid, int na, int nb, bool alongA, const double* sideParams[2],
+  const double* acrossA, const double* acrossB)
+{
+  const int nodes = alongA ? na : nb; // along a line
+  const int lines = alongA ? nb : na;
+  if (nodes < 3 || lines < 3)
+  {
+    return;
+  }
+  const auto at = [&](int node, int line) -> double* {
+    const long index = alongA ? node + static_cast<long>(na) * line
+                              : line + static_cast<long>(na) * node;
+    return grid + 3 * index;
+  };
+  const auto distance = [](const double* p, const double* q) {
+    return std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+      (p[2] - q[2]) * (p[2] - q[2]));
+  };
+  // the displacement of each line's node next to each side, from the linear grid
+  std::vector<double> shift[2];
+  for (int side = 0; side < 2; ++side)
+  {
+    const int edgeNode = side == 0 ? 0 : nodes - 1;
+    const int nextNode = side == 0 ? 1 : nodes - 2;
+    const double firstWidth = distance(at(nextNode, 0), at(edgeNode, 0));
+    const double lastWidth = distance(at(nextNode, lines - 1), at(edgeNode, lines - 1));
+    double least = 1.0;
+    for (int line = 1; line < lines - 1; ++line)
+    {
+      const double t = sideParams[side][line];
+      const double target = (1.0 - t) * firstWidth + t * lastWidth;
+      least = std::min(least, distance(at(nextNode, line), at(edgeNode, line)) / target);
+    }
+    if (!(least < kEndWidthsTrigger))
+    {
+      continue;
+    }
+    shift[side].assign(3 * static_cast<std::size_t>(lines), 0.0);
+    for (int line = 1; line < lines - 1; ++line)
+    {
+      // up to (1 - kAdaptiveTolerance) of the blend: lines within that stay (bit for bit)
+      const double t = sideParams[side][line];
+      const double target = (1.0 - kAdaptiveTolerance) * ((1.0 - t) * firstWidth + t * lastWidth);
+      const double* p = at(edgeNode, line);
+      const double* q = at(nextNode, line);
+      const double width = distance(q, p);
+      if (!(width > 0.0) || !(target > width))
+      {
+        continue;
+      }
+      // along the cell's own direction, so that the cell is `target` wide (across the side
+      // instead, the cells by a corner whose far end leaves nearly along the side were
+      // sheared: the compressor's U_M corner cell at oa_f, scaled Jacobian 0.132 -> 0.089)
+      const double move = target / width - 1.0;
+      for (int c = 0; c < 3; ++c)
+      {
+        shift[side][3 * line + c] = move * (q[c] - p[c]);
+      }
+    }
+  }
+  for (int side = 0; side < 2; ++side)
+  {
+    if (shift[side].empty())
+    {
+      continue;
+    }
+    // the share falls linearly (in the nodes' parameters) from the node next to this side
+    // to the node next to the far side, so that the far side's cells keep their width
+    const auto sigma = [&](int node) { return 0.5 * (acrossA[node] + acrossB[node]); };
+    const double near = sigma(side == 0 ? 1 : nodes - 2);
+    const double far = sigma(side == 0 ? nodes - 2 : 1);
+    for (int line = 1; line < lines - 1; ++line)
+    {
+      const double* move = shift[side].data() + 3 * line;
+      for (int node = 1; node < nodes - 1; ++node)
+      {
+        const double share = far == near ? 1.0 : (far - sigma(node)) / (far - near);
+        double* p = at(node, line);
+        for (int c = 0; c < 3; ++c)
+        {
+          p[c] += share * move[c];
+        }
+      }
+    }
+  }
+}
+
 inline void copyNode(const double* from, double* to)
 {
   to[0] = from[0];
@@ -428,6 +527,16 @@ void transfiniteFace(const EdgeNodes& bottom, const EdgeNodes& top, const EdgeNo
     {
       interior(blend);
     }
+  }
+  if (blending[0] == Blending::EndWidths) // lines along i, between the left and right edges
+  {
+    const double* sides[2] = { left.params, right.params };
+    keepEndWidths(out, ni, nj, true, sides, bottom.params, top.params);
+  }
+  if (blending[1] == Blending::EndWidths) // lines along j, between the bottom and top edges
+  {
+    const double* sides[2] = { bottom.params, top.params };
+    keepEndWidths(out, ni, nj, false, sides, left.params, right.params);
   }
 }
 

@@ -50,7 +50,18 @@ enum class Blending
   /// block in front of a round nose whose middle lines are half as long as its sides
   /// (axial_passage_oh's U_M on the turbine) then keeps the O-grid's outer cell there,
   /// while a block whose lines are alike is the linear grid bit for bit.
-  Adaptive
+  Adaptive,
+  /// Linear, and on a face (transfiniteFace) the first and last cells of the lines of that
+  /// direction keep the width of their ends' cells: where a line's cell at a side edge comes
+  /// out narrower than (1 - kAdaptiveTolerance) times the blend (along that side) of the side's
+  /// two end cells, the nodes next to the side move away from it, across it, until the cell is
+  /// that blend long, and the line's other interior nodes follow by a share falling linearly
+  /// to the far side. Why: the linear blend of a first cell pointing across the side (an
+  /// inlet's) and one leaving nearly along it (an O arc leaving a fan corner) is shortest
+  /// mid-way (axial_passage_oh's U_M on the compressor: 0.47 of its ends against U_L's cells).
+  /// A face whose cells keep their width is the linear grid bit for bit; a block's interior
+  /// (transfiniteBlock) is linear, so it carries its faces' correction.
+  EndWidths
 };
 
 /// Relative length spread of interior lines up to which Blending::Adaptive stays linear.

@@ -287,11 +287,17 @@ std::array<Blending, 3> parseBlending(
     {
       return Blending::Adaptive;
     }
+    if (value.IsScalar() && value.Scalar() == "end_widths")
+    {
+      return Blending::EndWidths;
+    }
     reporter.fail(at, entityText,
       "'interpolation' must be 'linear' (the default: interior lines take the edges' "
       "fractions), 'end_cells' (interior lines keep the edges' end cells as lengths), "
       "'adaptive' (linear while the interior lines' lengths stay within 20 % of their "
-      "edges', else towards end_cells so that their end cells do) or "
+      "edges', else towards end_cells so that their end cells do), 'end_widths' (linear, and "
+      "on a face the cells next to a side keep the width of that side's end cells where "
+      "they come out 20 % narrower) or "
       "{i: .., j: .., k: ..} of those");
   };
   if (!node.IsMap())
@@ -315,7 +321,10 @@ std::array<Blending, 3> parseBlending(
 void emitBlending(YAML::Emitter& out, const std::array<Blending, 3>& blending)
 {
   const auto name = [](Blending b) {
-    return b == Blending::EndCells ? "end_cells" : b == Blending::Adaptive ? "adaptive" : "linear";
+    return b == Blending::EndCells ? "end_cells"
+      : b == Blending::Adaptive    ? "adaptive"
+      : b == Blending::EndWidths   ? "end_widths"
+                                   : "linear";
   };
   if (blending[0] == blending[1] && blending[1] == blending[2])
   {

@@ -81,7 +81,11 @@ using test::Pi;
  * D_M against D_R: U_M's and D_M's corners at the fans' O corners, 10-15 deg, whose O arc
  * leaves nearly along the H line, pinch their first column mid-way to the inlet / outlet,
  * where the linear blend of the inlet's and the O arc's first cells, pointing nearly
- * opposite ways along the interface, is shortest). The bounds, per machine, fail when
+ * opposite ways along the interface, is shortest). Stop 16, issue 8: U_M and D_M
+ * interpolate across `end_widths` (their first and last columns lifted to 0.8 of the blend
+ * of their ends' widths where one comes out under 0.7 of it): 1.85 / 1.69 / 1.84 / 1.93 ->
+ * 1.54 / 1.39 / 1.40 / 1.42 (bound 2.0 -> 1.6); a few of the turbine's U_M / D_M faces are
+ * lifted a little (ratio the same); Rotor 37 and the distributor are the same grids. The bounds, per machine, fail when
  * the grading gets worse.
  */
 double maxNeighbourRatio(const std::string& templateName, const std::string& machine)
@@ -89,7 +93,7 @@ double maxNeighbourRatio(const std::string& templateName, const std::string& mac
   if (templateName == "axial_passage_h")
     return 1.5;
   static const std::map<std::string, double> oh = { { "rotor37", 1.5 }, { "distributor", 1.5 },
-    { "turbine", 1.4 }, { "compressor", 2.0 } };
+    { "turbine", 1.4 }, { "compressor", 1.6 } };
   return oh.at(machine);
 }
 

@@ -414,6 +414,64 @@ TEST(TransfiniteFace, AdaptiveBlendingKeepsEndCellsOnlyWhereLinesSpread)
   }
 }
 
+// Blending::EndWidths in i on a face whose left side leans (0.3 across over 1 up): the
+// bottom's first cell (0.05) points across it, the top's first cell leaves the top-left
+// corner 10 deg off the side, back down along it (axial_passage_oh's U_M at the compressor's
+// fan corner oa_f). Linear, the first column's width falls to 0.66 of the blend of its ends
+// mid-way; end_widths lifts every interior row's first cell to 0.8 of that blend, leaves
+// the boundary and the right column as they are, and a face whose top leaves straight
+// (no cell under 0.7 of the blend) is the linear face bit for bit.
+TEST(TransfiniteFace, EndWidthsLiftsANarrowedFirstColumn)
+{
+  const int ni = 21, nj = 9;
+  const std::vector<double> uniformI = graded(ni, 1.0), uniformJ = graded(nj, 1.0);
+  const auto line = straightEdge;
+  const Edge bottom = line({ 0, 0, 0 }, { 1, 0, 0 }, uniformI);
+  const Edge left = line({ 0, 0, 0 }, { 0.3, 1, 0 }, uniformJ);
+  const Edge right = line({ 1, 0, 0 }, { 1.3, 1, 0 }, uniformJ);
+  for (const bool bent : { true, false })
+  {
+    Edge top = line({ 0.3, 1, 0 }, { 1.3, 1, 0 }, uniformI);
+    if (bent)
+    {
+      top.xyz[3] = 0.29417;
+      top.xyz[4] = 0.95034;
+    }
+    std::vector<double> linear(3 * ni * nj), widths(3 * ni * nj);
+    transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), linear.data());
+    transfiniteFace(bottom.nodes(), top.nodes(), left.nodes(), right.nodes(), widths.data(),
+      { Blending::EndWidths, Blending::Linear });
+    if (!bent)
+    {
+      EXPECT_EQ(0, std::memcmp(linear.data(), widths.data(), linear.size() * sizeof(double)));
+      continue;
+    }
+    const auto first = [&](const std::vector<double>& grid, int j) {
+      return (node(grid, 1 + ni * j) - node(grid, ni * j)).norm();
+    };
+    const double firstBottom = first(linear, 0), firstTop = first(linear, nj - 1);
+    double narrowest = 1.0, narrowestLifted = 1.0;
+    for (int j = 1; j + 1 < nj; ++j)
+    {
+      const double t = uniformJ[j];
+      const double blend = (1.0 - t) * firstBottom + t * firstTop;
+      narrowest = std::min(narrowest, first(linear, j) / blend);
+      const double lifted = first(widths, j) / blend;
+      EXPECT_GE(lifted, 0.8 - 1e-12) << j;
+      narrowestLifted = std::min(narrowestLifted, lifted);
+      EXPECT_EQ(0, std::memcmp(&widths[3 * (ni - 2 + ni * j)], &linear[3 * (ni - 2 + ni * j)],
+        3 * sizeof(double))) << j;
+    }
+    EXPECT_NEAR(narrowest, 0.66, 0.01);
+    EXPECT_NEAR(narrowestLifted, 0.8, 1e-9); // lifted to 0.8, not to the blend
+    for (int i = 0; i < ni; ++i)
+    {
+      EXPECT_EQ(0, std::memcmp(&widths[3 * i], &bottom.xyz[3 * i], 3 * sizeof(double)));
+      EXPECT_EQ(0, std::memcmp(&widths[3 * (i + ni * (nj - 1))], &top.xyz[3 * i], 3 * sizeof(double)));
+    }
+  }
+}
+
 // The block interior with Blending::Adaptive in i, on the block of
 // TransfiniteBlock.EndCellBlendingKeepsTheEdgesEndCells (its faces' i-lines up to 1/3 longer
 // than the blend of their edges): every interior i-line starts with 0.01 within 25 %
