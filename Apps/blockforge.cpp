@@ -6,6 +6,7 @@
  *
  *   blockforge TEMPLATE [-i POINTS] [-p NAME=EXPR ...] [-d DENSITY] [-m GB] -o OUTPUT [--ascii]
  *              [--no-optimize] [--objective NAME] [--max-evaluations N]
+ *              [--max-interface-ratio R]
  *
  * OUTPUT's extension picks the writer: DIR/NAME.foam (OpenFOAM case: DIR/constant/polyMesh
  * and an empty NAME.foam), NAME.xyz (Plot3D multiblock), NAME.cgns (CGNS), NAME.vtm (VTK
@@ -44,6 +45,7 @@ namespace
 const char* const Usage =
   "usage: blockforge TEMPLATE [-i POINTS] [-p NAME=EXPR ...] [-d DENSITY] [-m GB] -o OUTPUT\n"
   "                  [--ascii] [--no-optimize] [--objective NAME] [--max-evaluations N]\n"
+  "                  [--max-interface-ratio R]\n"
   "\n"
   "Applies a BlockForge template (to the point data of -i: a BladeGen .inf, an Info.txt or a\n"
   "point file), optimizes its control points (the BlockOptimizer with its defaults, as\n"
@@ -69,6 +71,10 @@ const char* const Usage =
   "                          smallest element angle), non-orthogonality (OpenFOAM's\n"
   "                          largest) or min-angle-and-size-ratio\n"
   "  --max-evaluations N     the optimizer's trial budget (default 700, 1 to 1000000)\n"
+  "  --max-interface-ratio R the optimizer refuses trials whose neighbour cells across a\n"
+  "                          block interface differ more than R times (or than the\n"
+  "                          placed grid's largest ratio, if more; default 1.6, 0: not\n"
+  "                          held)\n"
   "The grid is written under a temporary name and moved into place: a failure leaves no\n"
   "partial grid and keeps an older one. Exit status 1 with a message on any error.\n";
 
@@ -82,6 +88,7 @@ struct Arguments
   bool optimize = true;
   optimize::ObjectiveKind objective = optimize::ObjectiveKind::MinAngle;
   int maximumEvaluations = optimize::SearchSettings{}.maxEvaluations;
+  double maximumInterfaceRatio = optimize::ObjectiveSettings{}.maximumInterfaceRatio;
 };
 
 bool endsWith(const std::string& text, const std::string& suffix)
@@ -172,6 +179,18 @@ Arguments parse(int argc, char** argv)
           "--max-evaluations needs a whole number from 1 to 1000000, got '" + text + "'");
       }
       args.maximumEvaluations = static_cast<int>(count);
+    }
+    else if (arg == "--max-interface-ratio")
+    {
+      const std::string text = value();
+      char* end = nullptr;
+      args.maximumInterfaceRatio = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || !std::isfinite(args.maximumInterfaceRatio) ||
+        !(args.maximumInterfaceRatio == 0.0 || args.maximumInterfaceRatio >= 1.0))
+      {
+        throw std::invalid_argument(
+          "--max-interface-ratio needs 0 (not held) or a number >= 1, got '" + text + "'");
+      }
     }
     else if (arg == "--compress")
       throw std::invalid_argument("--compress (zlib .vtm pieces) is only in python3 -m "
@@ -298,6 +317,7 @@ int main(int argc, char** argv)
       settings.maximumMemory = args.maximumMemory;
       settings.objective.kind = args.objective;
       settings.search.maxEvaluations = args.maximumEvaluations;
+      settings.objective.maximumInterfaceRatio = args.maximumInterfaceRatio;
       const optimize::OptimizerResult result = optimize::optimizeModel(model, carriers, settings);
       model = result.model;
       char line[256];

@@ -187,6 +187,7 @@ int vtkBlockOptimizer::RequestData(
     }
     settings.search.maxEvaluations = this->MaximumEvaluations;
     settings.search.tolerance = this->Tolerance;
+    settings.objective.maximumInterfaceRatio = this->MaximumInterfaceRatio;
     settings.densityMultiplier = this->DensityMultiplier;
     settings.maximumMemory = this->MaximumMemory;
     settings.automatic = this->Automatic;
@@ -325,6 +326,7 @@ void vtkBlockOptimizer::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Algorithm: " << this->Algorithm << "\n";
   os << indent << "MaximumEvaluations: " << this->MaximumEvaluations << "\n";
   os << indent << "Tolerance: " << this->Tolerance << "\n";
+  os << indent << "MaximumInterfaceRatio: " << this->MaximumInterfaceRatio << "\n";
   os << indent << "DensityMultiplier: " << this->DensityMultiplier << "\n";
   os << indent << "MaximumMemory: " << this->MaximumMemory << "\n";
   os << indent << "Automatic: " << this->Automatic << "\n";

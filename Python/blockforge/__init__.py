@@ -96,7 +96,7 @@ OBJECTIVES = {"min-angle": 0, "non-orthogonality": 1, "min-angle-and-size-ratio"
 def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_file=None,
                   timings=None, allow_inverted_cells=False, warnings=None,
                   maximum_memory=0.0, optimize=True, objective="min-angle",
-                  maximum_evaluations=None):
+                  maximum_evaluations=None, maximum_interface_ratio=None):
     """:func:`mesh_template`; with a dict *timings*, also records the seconds of each
     stage under "read" (only with an input file), "template", "optimize" (unless
     *optimize* is false) and "mesh + quality"; with a list *warnings*, collects the stages'
@@ -132,6 +132,12 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
         optimizer.SetObjective(OBJECTIVES[objective])
         if maximum_evaluations is not None:
             optimizer.SetMaximumEvaluations(int(maximum_evaluations))
+        if maximum_interface_ratio is not None:
+            ratio = float(maximum_interface_ratio)
+            if not (ratio == 0.0 or 1.0 <= ratio < float("inf")):
+                raise RuntimeError("maximum_interface_ratio needs 0 (not held) or a number "
+                                   f">= 1, got {maximum_interface_ratio!r}")
+            optimizer.SetMaximumInterfaceRatio(ratio)
         optimizer.SetInputConnection(template.GetOutputPort())
         stages.append(("optimize", optimizer))
         model = optimizer
@@ -178,7 +184,8 @@ def _run_pipeline(template_file, parameters=None, density_multiplier=1.0, input_
 
 def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_file=None,
                   allow_inverted_cells=False, maximum_memory=0.0, optimize=True,
-                  objective="min-angle", maximum_evaluations=None):
+                  objective="min-angle", maximum_evaluations=None,
+                  maximum_interface_ratio=None):
     """Applies a template, optimizes its control points, meshes it and measures the grid.
 
     Without *input_file* the pipeline is vtkBlockTemplateSource -> vtkBlockOptimizer ->
@@ -208,6 +215,10 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
         largest non-orthogonality) or "min-angle-and-size-ratio"
     :param maximum_evaluations: the optimizer's trial budget (vtkBlockOptimizer's
         MaximumEvaluations, 1 to 1000000; default None: the optimizer's own, 700)
+    :param maximum_interface_ratio: the optimizer refuses trials whose neighbour cells
+        across a block interface differ more than this (or than the placed grid's largest
+        ratio, if more); vtkBlockOptimizer's MaximumInterfaceRatio, 0: not held, else at
+        least 1; default None: the optimizer's own, 1.6
     :returns: the vtkGridQuality algorithm after its update (port 0: the grid with the
         quality arrays; port 1: MinAngle class table; port 2: statistics table)
     :raises RuntimeError: when a stage (reader, template, mesher or quality) reports an
@@ -218,4 +229,5 @@ def mesh_template(template_file, parameters=None, density_multiplier=1.0, input_
     return _run_pipeline(template_file, parameters, density_multiplier, input_file,
                          allow_inverted_cells=allow_inverted_cells,
                          maximum_memory=maximum_memory, optimize=optimize,
-                         objective=objective, maximum_evaluations=maximum_evaluations)
+                         objective=objective, maximum_evaluations=maximum_evaluations,
+                         maximum_interface_ratio=maximum_interface_ratio)

@@ -41,6 +41,17 @@ def _parse_evaluations(text):
     return count
 
 
+def _parse_interface_ratio(text):
+    try:
+        ratio = float(text)
+    except ValueError:
+        ratio = -1.0
+    if not (ratio == 0.0 or 1.0 <= ratio < float("inf")):
+        raise argparse.ArgumentTypeError(
+            f"needs 0 (not held) or a number >= 1, got '{printable(text)}'")
+    return ratio
+
+
 def optimizer_lines(quality):
     """What the BlockOptimizer upstream of *quality* did, if there is one."""
     algorithm = quality
@@ -130,6 +141,12 @@ def main(argv=None):
     parser.add_argument("--max-evaluations", type=_parse_evaluations, default=None, metavar="N",
                         help="the optimizer's trial budget (vtkBlockOptimizer's "
                              "MaximumEvaluations; default 700, 1 to 1000000)")
+    parser.add_argument("--max-interface-ratio", type=_parse_interface_ratio, default=None,
+                        metavar="R",
+                        help="the optimizer refuses trials whose neighbour cells across a "
+                             "block interface differ more than R times, or than the placed "
+                             "grid's largest ratio if more (vtkBlockOptimizer's "
+                             "MaximumInterfaceRatio; default 1.6, 0: not held)")
     parser.add_argument("--no-optimize", action="store_true",
                         help="mesh the template's vertices as placed (default: the "
                              "BlockOptimizer moves the control points first)")
@@ -149,7 +166,8 @@ def main(argv=None):
                                            warnings, args.max_memory,
                                            optimize=not args.no_optimize,
                                            objective=args.objective,
-                                           maximum_evaluations=args.max_evaluations)
+                                           maximum_evaluations=args.max_evaluations,
+                                           maximum_interface_ratio=args.max_interface_ratio)
     except (RuntimeError, MemoryError) as error:
         print(f"error: {printable(error) if str(error) else 'out of memory'}", file=sys.stderr)
         return 1

@@ -67,6 +67,7 @@ class OptimizerProxyTest(unittest.TestCase):
         optimizer = BlockOptimizer(Input=source, Tolerance=1e-12)
         self.assertEqual(optimizer.Objective, "MinAngle")
         self.assertEqual(optimizer.MaximumEvaluations, 700)
+        self.assertAlmostEqual(optimizer.MaximumInterfaceRatio, 1.6)
         self.assertEqual(optimizer.Algorithm, "Compass")
         optimizer.UpdatePipeline()
         model = servermanager.Fetch(optimizer)
