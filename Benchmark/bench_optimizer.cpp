@@ -69,7 +69,13 @@ std::string classes(const GridMeasures& m)
 std::string angleText(const GridMeasures& m)
 {
   char text[64];
-  if (!m.feasible)
+  if (!m.feasible && m.invertedCells == 0 && !m.failure.empty())
+  {
+    // the baseline moved a point so that the template cannot place a vertex that
+    // depends on it (e.g. a mid-passage point beyond the hub or shroud contour)
+    std::snprintf(text, sizeof text, "no placement");
+  }
+  else if (!m.feasible)
   {
     std::snprintf(text, sizeof text, "inverted cells");
   }
@@ -153,8 +159,20 @@ std::vector<double> laplacian(ControlProblem& problem, const model::BlockModel& 
 GridMeasures blockScore(ControlProblem& problem, const model::BlockModel& model,
   const std::vector<double>& x, double sharpness)
 {
-  const std::vector<Vec3> positions = problem.verticesAt(x);
   GridMeasures measures;
+  std::vector<Vec3> positions;
+  try
+  {
+    positions = problem.verticesAt(x);
+  }
+  catch (const std::exception& error)
+  {
+    // a point the template cannot place there: infeasible, as the optimizer counts it
+    measures.invertedCells = 1;
+    measures.objective = infeasibleObjective(1);
+    measures.failure = error.what();
+    return measures;
+  }
   std::vector<double> corners;
   double lowest = 180.0;
   for (const model::Block& block : model.blocks)
@@ -573,8 +591,16 @@ int main(int argc, char** argv)
     {
       const auto begin = std::chrono::steady_clock::now();
       ControlProblem problem(model, geometry, 1.0, settings.objective, {});
-      const std::vector<double> x = laplacian(problem, model, geometry);
-      row.laplace = problem.evaluate(x);
+      try
+      {
+        const std::vector<double> x = laplacian(problem, model, geometry);
+        row.laplace = problem.evaluate(x);
+      }
+      catch (const std::exception& error)
+      {
+        row.laplace = GridMeasures();
+        row.laplace.failure = error.what();
+      }
       row.laplaceSeconds = seconds(begin);
     }
     if (baselines)
