@@ -296,8 +296,8 @@ std::array<Blending, 3> parseBlending(
       "fractions), 'end_cells' (interior lines keep the edges' end cells as lengths), "
       "'adaptive' (linear while the interior lines' lengths stay within 20 % of their "
       "edges', else towards end_cells so that their end cells do), 'end_widths' (linear, and "
-      "on a face the cells next to a side keep the width of that side's end cells where "
-      "they come out 20 % narrower) or "
+      "on a face a cell next to a side that comes out under 0.7 of the width of that side's "
+      "end cells is widened to 0.8 of it) or "
       "{i: .., j: .., k: ..} of those");
   };
   if (!node.IsMap())

@@ -1986,7 +1986,9 @@ TEST(CarrierTemplates, InterpolationEndCells)
       "block 'box': 'interpolation' must be 'linear' (the default: interior lines take the edges' "
       "fractions), 'end_cells' (interior lines keep the edges' end cells as lengths), "
       "'adaptive' (linear while the interior lines' lengths stay within 20 % of their edges', "
-      "else towards end_cells so that their end cells do) or {i: .., j: .., k: ..} of those");
+      "else towards end_cells so that their end cells do), 'end_widths' (linear, and on a "
+      "face a cell next to a side that comes out under 0.7 of the width of that side's end "
+      "cells is widened to 0.8 of it) or {i: .., j: .., k: ..} of those");
   // adaptive reads and writes back
   const BlockModel adaptive =
     parseFeature(replaced(text, law + "}", law + ", interpolation: {j: adaptive}}"));

@@ -607,6 +607,8 @@ class OptimizerTest(unittest.TestCase):
         # template's lean limit is lifted (179deg): its blade-side cells then leave the
         # round leading edge across the pitch as before issue 8's limit, which is what
         # folds the coarse preview (with the limit, no preview of the four machines folds).
+        # The interface-ratio bound is lifted too (0): held, the optimizer ends where the
+        # preview no longer folds (stop 16).
         template = os.path.join(SOURCE, "Templates", "axial_passage_h.yaml")
         lifted = {"lean": "179deg"}
         for density in (0.5, 4.0):
@@ -616,7 +618,7 @@ class OptimizerTest(unittest.TestCase):
                 optimize=False))
             optimized = self.min_angle(blockforge._run_pipeline(
                 template, lifted, density_multiplier=density, input_file=ROTOR37_INF,
-                warnings=warnings))
+                warnings=warnings, maximum_interface_ratio=0))
             self.assertGreaterEqual(optimized, placed, density)
             if density == 0.5:
                 self.assertTrue(any("preview" in w for w in warnings), warnings)
