@@ -73,6 +73,65 @@ Vec3 node(const test::Grid& grid, int b, int i, int j, int k)
   return grid.at(b, i, j, k);
 }
 
+/// The blade wall cells of the corner tests (block 0 beside the corner, block 1 the side
+/// along the blade): block 0's last wall cell and block 1's wall cells, as the distances
+/// between the centres of their cells' blade faces' spanwise edges (j, k = 0..1).
+struct WallCells
+{
+  double corner = 0.0;       ///< block 0's last wall cell, next to block 1
+  std::vector<double> side;  ///< block 1's wall cells from the corner on
+};
+
+WallCells wallCells(const test::Grid& grid)
+{
+  const int nr = grid.nodes[0][0], na = grid.nodes[1][0];
+  const auto centre = [&](int b, int i) -> Vec3 {
+    return 0.25 * (node(grid, b, i, 0, 0) + node(grid, b, i, 1, 0) + node(grid, b, i, 0, 1) +
+                    node(grid, b, i, 1, 1));
+  };
+  WallCells cells;
+  cells.corner = (centre(0, nr - 1) - centre(0, nr - 2)).norm();
+  for (int i = 0; i + 1 < na; ++i)
+  {
+    cells.side.push_back((centre(1, i + 1) - centre(1, i)).norm());
+  }
+  return cells;
+}
+
+/// Block 1's feet graded up from the corner (rampFeet): they advance along the blade
+/// (in x, on the plane y = 0 where `onAxis`), land on the normal feet of their outer nodes
+/// after 2 to half of the side's nodes and keep them from there on, and the ramp's cells
+/// grow by less than 11 from one to the next.
+void expectFeetRampToTheNormalFeet(const test::Grid& grid, const std::vector<double>& side,
+  bool onAxis)
+{
+  const int na = grid.nodes[1][0], outer = grid.nodes[1][1] - 1;
+  int landed = -1;
+  for (int i = 1; i < na; ++i)
+  {
+    const double foot = node(grid, 1, i, 0, 0).x(), above = node(grid, 1, i, outer, 0).x();
+    EXPECT_GT(foot, node(grid, 1, i - 1, 0, 0).x()) << i;
+    if (onAxis)
+    {
+      EXPECT_NEAR(node(grid, 1, i, 0, 0).y(), 0.0, 1e-12) << i;
+    }
+    if (landed < 0 && std::abs(foot - above) < 1e-12)
+    {
+      landed = i;
+    }
+    if (landed >= 0)
+    {
+      EXPECT_NEAR(foot, above, 1e-12) << i; // the normal feet from there on
+    }
+  }
+  EXPECT_GE(landed, 2);
+  EXPECT_LE(landed, na / 2);
+  for (int i = 1; i < landed + 1; ++i)
+  {
+    EXPECT_LT(side[i] / side[i - 1], 11.0) << i;
+  }
+}
+
 /// The largest difference in angle between an inner arc node of block b and the outer
 /// arc node of the same i (interior nodes only unless `withEnds`); the outer ones must lie
 /// on the radius 1.5.
@@ -654,40 +713,13 @@ TEST(ProjectedEdges, FeetHeldByTheirNextCellAreGradedUpFromTheCorner)
   {
     SCOPED_TRACE(density);
     const test::Grid grid = test::meshAll(model, density);
-    const int nr = grid.nodes[0][0], na = grid.nodes[1][0], outer = grid.nodes[1][1] - 1;
-    const auto centre = [&](int b, int i) -> Vec3 {
-      return 0.25 * (node(grid, b, i, 0, 0) + node(grid, b, i, 1, 0) + node(grid, b, i, 0, 1) +
-                      node(grid, b, i, 1, 1));
-    };
-    const double ring = (centre(0, nr - 1) - centre(0, nr - 2)).norm();
-    std::vector<double> side;
-    for (int i = 0; i + 1 < na; ++i)
-    {
-      side.push_back((centre(1, i + 1) - centre(1, i)).norm());
-    }
+    const WallCells cells = wallCells(grid);
+    const double ring = cells.corner;
+    const std::vector<double>& side = cells.side;
     std::printf("density %g: wall cells R %.4g, A %.4g (ratio %.3f), A's next %.4g %.4g %.4g\n",
       density, ring, side[0], side[0] / ring, side[1], side[2], side[3]);
     EXPECT_NEAR(side[0] / ring, 1.35, 0.03);
-    int landed = -1;
-    for (int i = 1; i < na; ++i)
-    {
-      const double foot = node(grid, 1, i, 0, 0).x(), above = node(grid, 1, i, outer, 0).x();
-      EXPECT_GT(foot, node(grid, 1, i - 1, 0, 0).x()) << i;
-      if (landed < 0 && std::abs(foot - above) < 1e-12)
-      {
-        landed = i;
-      }
-      if (landed >= 0)
-      {
-        EXPECT_NEAR(foot, above, 1e-12) << i; // the normal feet from there on
-      }
-    }
-    EXPECT_GE(landed, 2);
-    EXPECT_LE(landed, na / 2);
-    for (int i = 1; i < landed + 1; ++i)
-    {
-      EXPECT_LT(side[i] / side[i - 1], 11.0) << i;
-    }
+    expectFeetRampToTheNormalFeet(grid, side, false);
   }
 }
 
@@ -778,43 +810,16 @@ TEST(ProjectedEdges, FeetBesideAFanGrowFromItsWallCell)
   {
     SCOPED_TRACE(density);
     const test::Grid grid = test::meshAll(model, density);
-    const int nr = grid.nodes[0][0], na = grid.nodes[1][0], outer = grid.nodes[1][1] - 1;
+    const int nr = grid.nodes[0][0];
     // R's feet are the tip
     EXPECT_EQ(node(grid, 0, nr - 1, 0, 0), node(grid, 0, 0, 0, 0));
-    const auto centre = [&](int b, int i) -> Vec3 {
-      return 0.25 * (node(grid, b, i, 0, 0) + node(grid, b, i, 1, 0) + node(grid, b, i, 0, 1) +
-                      node(grid, b, i, 1, 1));
-    };
-    const double fan = (centre(0, nr - 1) - centre(0, nr - 2)).norm();
-    std::vector<double> side;
-    for (int i = 0; i + 1 < na; ++i)
-    {
-      side.push_back((centre(1, i + 1) - centre(1, i)).norm());
-    }
+    const WallCells cells = wallCells(grid);
+    const double fan = cells.corner;
+    const std::vector<double>& side = cells.side;
     std::printf("density %g: wall cells R %.4g, A %.4g (ratio %.3f), A's next %.4g %.4g %.4g\n",
       density, fan, side[0], side[0] / fan, side[1], side[2], side[3]);
     EXPECT_LT(side[0] / fan, 1.5);
     EXPECT_GT(side[0] / fan, 1.2);
-    int landed = -1;
-    for (int i = 1; i < na; ++i)
-    {
-      const double foot = node(grid, 1, i, 0, 0).x(), above = node(grid, 1, i, outer, 0).x();
-      EXPECT_GT(foot, node(grid, 1, i - 1, 0, 0).x()) << i;
-      EXPECT_NEAR(node(grid, 1, i, 0, 0).y(), 0.0, 1e-12) << i;
-      if (landed < 0 && std::abs(foot - above) < 1e-12)
-      {
-        landed = i;
-      }
-      if (landed >= 0)
-      {
-        EXPECT_NEAR(foot, above, 1e-12) << i; // the normal feet from there on
-      }
-    }
-    EXPECT_GE(landed, 2);
-    EXPECT_LE(landed, na / 2);
-    for (int i = 1; i < landed + 1; ++i)
-    {
-      EXPECT_LT(side[i] / side[i - 1], 11.0) << i;
-    }
+    expectFeetRampToTheNormalFeet(grid, side, true);
   }
 }

@@ -402,6 +402,18 @@ class NativeCommandLineTest(unittest.TestCase):
         self.assertEqual(run.returncode, 1)
         self.assertIn("a_file", run.stderr)
 
+    def assert_refused(self, command, option, values, message, folder):
+        """Each of *values* given to *option* is refused with exit status 2, naming the
+        option and *message*, and writes no grid."""
+        for bad in values:
+            path = os.path.join(folder, "bad.xyz")
+            run = subprocess.run(command + [CYLINDER, option, bad, "-o", path],
+                                 capture_output=True, text=True)
+            self.assertEqual(run.returncode, 2, (command[0], option, bad))
+            self.assertIn(option, run.stderr)
+            self.assertIn(message, run.stderr)
+            self.assertFalse(os.path.exists(path), (option, bad))
+
     def test_max_evaluations(self):
         """--max-evaluations N: both command lines take the optimizer's trial budget and
         write the same bytes; a budget that is not a positive whole number is refused."""
@@ -416,13 +428,8 @@ class NativeCommandLineTest(unittest.TestCase):
             self.assertEqual(run.returncode, 0, run.stderr)
             self.assertIn("optimizer: smallest element angle", run.stdout)
             self.assertLessEqual(int(re.search(r"(\d+) evaluations", run.stdout).group(1)), 12)
-            for bad in ("0", "-3", "2.5", "many"):
-                run = subprocess.run(command + [CYLINDER, "--max-evaluations", bad, "-o",
-                                     os.path.join(folder, "bad.xyz")],
-                                     capture_output=True, text=True)
-                self.assertEqual(run.returncode, 2, (label, bad))
-                self.assertIn("--max-evaluations", run.stderr)
-                self.assertIn("whole number from 1 to 1000000", run.stderr)
+            self.assert_refused(command, "--max-evaluations", ("0", "-3", "2.5", "many"),
+                                "whole number from 1 to 1000000", folder)
         self.assertTrue(filecmp.cmp(os.path.join(folder, "python", "grid.xyz"),
                                     os.path.join(folder, "native", "grid.xyz"), shallow=False))
 
@@ -461,16 +468,10 @@ class NativeCommandLineTest(unittest.TestCase):
         self.assertTrue(filecmp.cmp(os.path.join(folder, "free", "grid.xyz"),
                                     os.path.join(folder, "free_python", "grid.xyz"),
                                     shallow=False))
-        for label, command in (("python", [sys.executable, "-m", "blockforge"]),
-                               ("native", [CLI])):
-            for bad in ("0.5", "-1", "nan", "inf", "many"):
-                run = subprocess.run(command + [CYLINDER, "--max-interface-ratio", bad, "-o",
-                                     os.path.join(folder, "bad.xyz")],
-                                     capture_output=True, text=True)
-                self.assertEqual(run.returncode, 2, (label, bad))
-                self.assertIn("--max-interface-ratio", run.stderr)
-                self.assertIn("0 (not held) or a number >= 1", run.stderr)
-        self.assertFalse(os.path.exists(os.path.join(folder, "bad.xyz")))
+        for command in ([sys.executable, "-m", "blockforge"], [CLI]):
+            self.assert_refused(command, "--max-interface-ratio",
+                                ("0.5", "-1", "nan", "inf", "many"),
+                                "0 (not held) or a number >= 1", folder)
 
     def test_errors_name_the_problem(self):
         run = subprocess.run([CLI, os.path.join(SOURCE, "Testing", "Data", "bad_syntax.yaml"),
