@@ -37,6 +37,13 @@ inline double fixedBlend(Blending blending)
   return blending == Blending::EndCells ? 1.0 : 0.0;
 }
 
+/// Distance between two grid nodes (3 doubles each).
+inline double nodeDistance(const double* p, const double* q)
+{
+  return std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+    (p[2] - q[2]) * (p[2] - q[2]));
+}
+
 /// Largest relative difference between the length of an interior line of a grid of
 /// na x nb nodes (a fastest) and the blend of the two boundary lines beside it: lines
 /// along b at each a (alongB) weighted by `across` (the parameters of a, na values), or
@@ -52,10 +59,7 @@ double lineSpread(const double* grid, int na, int nb, bool alongB, const double*
       const long a = alongB ? static_cast<long>(line) + static_cast<long>(na) * n
                             : static_cast<long>(n) + static_cast<long>(na) * line;
       const long b = alongB ? a - na : a - 1;
-      const double* p = grid + 3 * a;
-      const double* q = grid + 3 * b;
-      sum += std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-        (p[2] - q[2]) * (p[2] - q[2]));
+      sum += nodeDistance(grid + 3 * a, grid + 3 * b);
     }
     return sum;
   };
@@ -105,24 +109,20 @@ void keepEndWidths(double* grid, int na, int nb, bool alongA, const double* side
                               : line + static_cast<long>(na) * node;
     return grid + 3 * index;
   };
-  const auto distance = [](const double* p, const double* q) {
-    return std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-      (p[2] - q[2]) * (p[2] - q[2]));
-  };
   // the displacement of each line's node next to each side, from the linear grid
   std::vector<double> shift[2];
   for (int side = 0; side < 2; ++side)
   {
     const int edgeNode = side == 0 ? 0 : nodes - 1;
     const int nextNode = side == 0 ? 1 : nodes - 2;
-    const double firstWidth = distance(at(nextNode, 0), at(edgeNode, 0));
-    const double lastWidth = distance(at(nextNode, lines - 1), at(edgeNode, lines - 1));
+    const double firstWidth = nodeDistance(at(nextNode, 0), at(edgeNode, 0));
+    const double lastWidth = nodeDistance(at(nextNode, lines - 1), at(edgeNode, lines - 1));
     double least = 1.0;
     for (int line = 1; line < lines - 1; ++line)
     {
       const double t = sideParams[side][line];
       const double target = (1.0 - t) * firstWidth + t * lastWidth;
-      least = std::min(least, distance(at(nextNode, line), at(edgeNode, line)) / target);
+      least = std::min(least, nodeDistance(at(nextNode, line), at(edgeNode, line)) / target);
     }
     if (!(least < kEndWidthsTrigger))
     {
@@ -136,7 +136,7 @@ void keepEndWidths(double* grid, int na, int nb, bool alongA, const double* side
       const double target = (1.0 - kAdaptiveTolerance) * ((1.0 - t) * firstWidth + t * lastWidth);
       const double* p = at(edgeNode, line);
       const double* q = at(nextNode, line);
-      const double width = distance(q, p);
+      const double width = nodeDistance(q, p);
       if (!(width > 0.0) || !(target > width))
       {
         continue;

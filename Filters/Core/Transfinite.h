@@ -52,11 +52,11 @@ enum class Blending
   /// while a block whose lines are alike is the linear grid bit for bit.
   Adaptive,
   /// Linear, and on a face (transfiniteFace) the first and last cells of the lines of that
-  /// direction keep the width of their ends' cells: where a line's cell at a side edge comes
-  /// out narrower than (1 - kAdaptiveTolerance) times the blend (along that side) of the side's
-  /// two end cells, the nodes next to the side move away from it, across it, until the cell is
-  /// that blend long, and the line's other interior nodes follow by a share falling linearly
-  /// to the far side. Why: the linear blend of a first cell pointing across the side (an
+  /// direction keep most of the width of their ends' cells: where a line's cell at a side
+  /// edge comes out narrower than 0.7 times the blend (along that side) of the side's two end
+  /// cells, every line's node next to that side whose cell is under (1 - kAdaptiveTolerance)
+  /// of the blend moves along its cell until the cell is that wide, and the line's other
+  /// interior nodes follow by a share falling linearly to the node next to the far side. Why: the linear blend of a first cell pointing across the side (an
   /// inlet's) and one leaving nearly along it (an O arc leaving a fan corner) is shortest
   /// mid-way (axial_passage_oh's U_M on the compressor: 0.47 of its ends against U_L's cells).
   /// A face whose cells keep their width is the linear grid bit for bit; a block's interior

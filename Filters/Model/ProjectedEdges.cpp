@@ -302,17 +302,13 @@ void gradeBesideFan(MeshTopology& topology, const FootJoin& join, int fan)
   const int outerVertex = radial.a == join.vertex ? radial.b : radial.a;
   const UniqueEdge& fanSource = topology.edges[topology.edges[join.edge[fan]].projectedFrom];
   const UniqueEdge& source = topology.edges[edge.projectedFrom];
-  const int cells = static_cast<int>(edge.params.size()) - 1;
-  if (cells < 3 || (fanSource.a != outerVertex && fanSource.b != outerVertex) ||
-    (source.a != outerVertex && source.b != outerVertex) || source.params.size() != edge.params.size())
+  if ((fanSource.a != outerVertex && fanSource.b != outerVertex) ||
+    (source.a != outerVertex && source.b != outerVertex))
   {
     return;
   }
+  // (rampFeet leaves the edge as it is for too few cells or a layer outside (0, 0.5))
   const double layer = cellAtVertex(radial, join.vertex) / radial.length / 2;
-  if (!(layer > 0.0 && layer < 0.5))
-  {
-    return;
-  }
   const double fanWidth = cellAtVertex(fanSource, outerVertex) * layer;
   rampFeet(edge, source, join.end[side] == 0, source.a == outerVertex, layer,
     FanSideRatio * fanWidth, FanSideGrowth);

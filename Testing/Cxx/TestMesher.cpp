@@ -198,6 +198,36 @@ bool identical(const std::vector<BlockGrid>& a, const std::vector<BlockGrid>& b)
   }
   return true;
 }
+
+/// Law `match` with ratio 1.2 (the matched-edge tests).
+DistributionLaw matchLaw()
+{
+  DistributionLaw match;
+  match.kind = DistributionLaw::Kind::Match;
+  match.expansionRatio = 1.2;
+  return match;
+}
+
+/// Testing/Data/two_blocks.yaml (two unit cubes along x) with 4 cells across the left cube
+/// and 16 across the right one, every edge along x graded matchLaw(), the right block's
+/// with at_most `rightAtMost` (0: no limit).
+BlockModel twoCubesMatchedAlongX(double rightAtMost)
+{
+  BlockModel model = loadTemplate(test::sourcePath("Testing/Data/two_blocks.yaml"));
+  model.blocks[1].cells[0] = 16;
+  for (std::size_t b = 0; b < model.blocks.size(); ++b)
+  {
+    for (int e = 0; e < 12; ++e)
+    {
+      if (edgeDirection(e) == 0)
+      {
+        model.blocks[b].laws[e] = matchLaw();
+        model.blocks[b].laws[e].matchAtMost = b == 1 ? rightAtMost : 0.0;
+      }
+    }
+  }
+  return model;
+}
 } // namespace
 
 TEST(Mesher, CylinderWallNodesAtRadius)
@@ -576,21 +606,7 @@ TEST(Mesher, MatchedEdgesTakeTheirEndCellsFromTheirNeighbours)
   // Two unit cubes along x, 4 cells across the left one and 16 across the right one, law
   // `match` along x in both: at the shared face both cells are the geometric mean of the
   // two blocks' mean cells (0.25 and 0.0625), 0.125, at every density.
-  BlockModel model = loadTemplate(test::sourcePath("Testing/Data/two_blocks.yaml"));
-  model.blocks[1].cells[0] = 16;
-  DistributionLaw match;
-  match.kind = DistributionLaw::Kind::Match;
-  match.expansionRatio = 1.2;
-  for (Block& block : model.blocks)
-  {
-    for (int e = 0; e < 12; ++e)
-    {
-      if (edgeDirection(e) == 0)
-      {
-        block.laws[e] = match;
-      }
-    }
-  }
+  const BlockModel model = twoCubesMatchedAlongX(0.0);
   for (const double density : { 1.0, 2.0 })
   {
     SCOPED_TRACE(density);
@@ -617,7 +633,7 @@ TEST(Mesher, MatchedEdgesTakeTheirEndCellsFromTheirNeighbours)
   }
   // A block that shares a matched edge must match it too.
   BlockModel mixed = loadTemplate(test::sourcePath("Testing/Data/two_blocks.yaml"));
-  mixed.blocks[0].laws[1] = match; // left E2 (a1-a2, along j) is on the shared face
+  mixed.blocks[0].laws[1] = matchLaw(); // left E2 (a1-a2, along j) is on the shared face
   try
   {
     meshBlocks(mixed);
@@ -637,25 +653,10 @@ TEST(Mesher, MatchedEdgesStartAtMostTheirLimitTimesTheirMeanCell)
   // mean cells is twice the right block's mean cell. With `at_most: 1` on the right block's
   // x edges its cells are its mean cell, uniform, and the left block's cells at the shared
   // face take that cell too; at_most 3 (above 2) changes nothing; 0 is no limit.
-  BlockModel model = loadTemplate(test::sourcePath("Testing/Data/two_blocks.yaml"));
-  model.blocks[1].cells[0] = 16;
-  DistributionLaw match;
-  match.kind = DistributionLaw::Kind::Match;
-  match.expansionRatio = 1.2;
   for (const double atMost : { 0.0, 1.0, 3.0 })
   {
     SCOPED_TRACE(atMost);
-    for (int b = 0; b < 2; ++b)
-    {
-      for (int e = 0; e < 12; ++e)
-      {
-        if (edgeDirection(e) == 0)
-        {
-          model.blocks[b].laws[e] = match;
-          model.blocks[b].laws[e].matchAtMost = b == 1 ? atMost : 0.0;
-        }
-      }
-    }
+    const BlockModel model = twoCubesMatchedAlongX(atMost);
     for (const double density : { 1.0, 2.0 })
     {
       SCOPED_TRACE(density);
