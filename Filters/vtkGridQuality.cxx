@@ -41,8 +41,9 @@ vtkStandardNewMacro(vtkGridQuality);
 
 namespace
 {
-const char* const MeasureNames[6] = { "MinAngle", "MaxAngle", "NonOrthogonality", "Skewness",
-  "AspectRatio", "ScaledJacobian" };
+constexpr int MeasureCount = 7;
+const char* const MeasureNames[MeasureCount] = { "MinAngle", "MaxAngle", "NonOrthogonality",
+  "Skewness", "AspectRatio", "ScaledJacobian", "CellDeterminant" };
 const char* const ClassLabels[5] = { "0-20", "20-40", "40-60", "60-80", "80-90" };
 const double ClassCentres[5] = { 10.0, 30.0, 50.0, 70.0, 85.0 };
 
@@ -172,7 +173,7 @@ int vtkGridQuality::RequestData(
   // The measures are written straight into the output arrays: no copy, and the fresh
   // memory is prepared in one go rather than faulted page by page.
   std::vector<vtkSmartPointer<vtkStructuredGrid>> measuredGrids;
-  std::vector<std::array<vtkSmartPointer<vtkDoubleArray>, 6>> measureArrays(grids.size());
+  std::vector<std::array<vtkSmartPointer<vtkDoubleArray>, MeasureCount>> measureArrays(grids.size());
   std::vector<blockforge::CellQualityPointers> outputs(grids.size());
   std::vector<std::pair<void*, std::size_t>> freshMemory;
   for (size_t b = 0; b < grids.size(); ++b)
@@ -180,7 +181,7 @@ int vtkGridQuality::RequestData(
     auto measured = vtkSmartPointer<vtkStructuredGrid>::New();
     measured->ShallowCopy(grids[b]);
     const vtkIdType cells = measured->GetNumberOfCells();
-    for (int m = 0; m < 6; ++m)
+    for (int m = 0; m < MeasureCount; ++m)
     {
       auto array = vtkSmartPointer<vtkDoubleArray>::New();
       array->SetName(MeasureNames[m]);
@@ -191,7 +192,8 @@ int vtkGridQuality::RequestData(
     }
     outputs[b] = { measureArrays[b][0]->GetPointer(0), measureArrays[b][1]->GetPointer(0),
       measureArrays[b][2]->GetPointer(0), measureArrays[b][3]->GetPointer(0),
-      measureArrays[b][4]->GetPointer(0), measureArrays[b][5]->GetPointer(0) };
+      measureArrays[b][4]->GetPointer(0), measureArrays[b][5]->GetPointer(0),
+      measureArrays[b][6]->GetPointer(0) };
     // The mesher already labels its blocks; other inputs get the leaf ordinal.
     if (!measured->GetCellData()->GetArray("BlockId"))
     {
@@ -238,7 +240,7 @@ int vtkGridQuality::RequestData(
 
   // Local statistics, reduced across MPI ranks below.
   std::array<double, 5> classCounts{};
-  std::array<double, 6> minimum, maximum, sum{};
+  std::array<double, MeasureCount> minimum, maximum, sum{};
   minimum.fill(std::numeric_limits<double>::max());
   maximum.fill(std::numeric_limits<double>::lowest());
   double cellCount = 0.0;
@@ -250,10 +252,10 @@ int vtkGridQuality::RequestData(
     double maximum = std::numeric_limits<double>::lowest();
     double sum = 0.0;
   };
-  std::vector<ArraySummary> summaries(6 * grids.size());
+  std::vector<ArraySummary> summaries(MeasureCount * grids.size());
   blockforge::forEachChunk(static_cast<long>(summaries.size()), [&](long n) {
-    const double* values = measureArrays[n / 6][n % 6]->GetPointer(0);
-    const vtkIdType cells = measureArrays[n / 6][n % 6]->GetNumberOfTuples();
+    const double* values = measureArrays[n / MeasureCount][n % MeasureCount]->GetPointer(0);
+    const vtkIdType cells = measureArrays[n / MeasureCount][n % MeasureCount]->GetNumberOfTuples();
     ArraySummary& summary = summaries[n];
     for (vtkIdType c = 0; c < cells; ++c)
     {
@@ -265,9 +267,9 @@ int vtkGridQuality::RequestData(
   for (size_t b = 0; b < grids.size(); ++b)
   {
     const vtkIdType cells = measureArrays[b][0]->GetNumberOfTuples();
-    for (int m = 0; m < 6; ++m)
+    for (int m = 0; m < MeasureCount; ++m)
     {
-      const ArraySummary& summary = summaries[6 * b + m];
+      const ArraySummary& summary = summaries[MeasureCount * b + m];
       minimum[m] = std::min(minimum[m], summary.minimum);
       maximum[m] = std::max(maximum[m], summary.maximum);
       sum[m] += summary.sum;
@@ -298,12 +300,12 @@ int vtkGridQuality::RequestData(
   {
     {
       std::array<double, 5> classTotal{};
-      std::array<double, 6> minTotal{}, maxTotal{}, sumTotal{};
+      std::array<double, MeasureCount> minTotal{}, maxTotal{}, sumTotal{};
       double countTotal = 0.0;
       controller->AllReduce(classCounts.data(), classTotal.data(), 5, vtkCommunicator::SUM_OP);
-      controller->AllReduce(minimum.data(), minTotal.data(), 6, vtkCommunicator::MIN_OP);
-      controller->AllReduce(maximum.data(), maxTotal.data(), 6, vtkCommunicator::MAX_OP);
-      controller->AllReduce(sum.data(), sumTotal.data(), 6, vtkCommunicator::SUM_OP);
+      controller->AllReduce(minimum.data(), minTotal.data(), MeasureCount, vtkCommunicator::MIN_OP);
+      controller->AllReduce(maximum.data(), maxTotal.data(), MeasureCount, vtkCommunicator::MAX_OP);
+      controller->AllReduce(sum.data(), sumTotal.data(), MeasureCount, vtkCommunicator::SUM_OP);
       controller->AllReduce(&cellCount, &countTotal, 1, vtkCommunicator::SUM_OP);
       classCounts = classTotal;
       minimum = minTotal;
@@ -354,7 +356,7 @@ int vtkGridQuality::RequestData(
   minColumn->SetName("Min");
   meanColumn->SetName("Mean");
   maxColumn->SetName("Max");
-  for (int m = 0; m < 6; ++m)
+  for (int m = 0; m < MeasureCount; ++m)
   {
     const bool empty = cellCount == 0.0;
     const double mean = empty ? 0.0 : sum[m] / cellCount;

@@ -15,6 +15,14 @@
  * - Skewness: OpenFOAM's face skewness (checkMesh's), maximum over the cell's faces [-];
  * - AspectRatio: longest over shortest mean cell width [-];
  * - ScaledJacobian: Verdict's hex scaled Jacobian (1 = cube, negative = inverted) [-];
+ * - CellDeterminant: OpenFOAM checkMesh's cell determinant (-allGeometry;
+ *   primitiveMeshTools::cellDeterminant): |det(sum (S_f/a)(S_f/a)^T)| / 8 over the
+ *   cell's internal faces, block interfaces and periodic faces included, true boundary
+ *   faces (walls, inlet, outlet) and faces without area left out, a their mean |S_f|;
+ *   1 for a cube, V^4/a^6 for a parallelepiped inside the grid. checkMesh fails cells
+ *   under 0.001: thin cells (a box thinner than about 1/29 of both other sides), and
+ *   much sooner cells that lost a face to the boundary (a unit cube with one boundary
+ *   face has 0.5, with two opposite ones 0) [-];
  * - BlockId: index of the block.
  *
  * Output port 0 is the input with these arrays; its field data holds

@@ -10,7 +10,9 @@
  * on x86-64). Each internal face is evaluated once, by the cell above it, and updates
  * both cells; non-orthogonality is accumulated as a signed squared cosine, so one root
  * and one acos per cell remain. Rare special cases (collapsed edges or faces, Verdict's
- * degenerate cells) take the literal formulas, for that lane only.
+ * degenerate cells) take the literal formulas, for that lane only. The cell determinant
+ * takes the six face area vectors the pass has anyway, every face counted; the cells with
+ * a true boundary face are measured again without it after the pass (boundaryFaces).
  *
  * The faces on block sides are paired in QualityInterfaces.cpp; the measures of a single
  * cell or face and the MinAngle classes are in QualityMeasures.cpp.
@@ -124,7 +126,7 @@ void reserveResultArrays(
   {
     CellQualityArrays& q = quality[n];
     for (std::vector<double>* values : { &q.minAngle, &q.maxAngle, &q.nonOrthogonality, &q.skewness,
-           &q.aspectRatio, &q.scaledJacobian })
+           &q.aspectRatio, &q.scaledJacobian, &q.cellDeterminant })
     {
       values->reserve(views[n].cellCount);
       const auto begin = reinterpret_cast<std::uintptr_t>(values->data());
@@ -151,7 +153,7 @@ void reserveResultArrays(
   {
     CellQualityArrays& q = quality[n];
     for (std::vector<double>* values : { &q.minAngle, &q.maxAngle, &q.nonOrthogonality, &q.skewness,
-           &q.aspectRatio, &q.scaledJacobian })
+           &q.aspectRatio, &q.scaledJacobian, &q.cellDeterminant })
     {
       values->resize(views[n].cellCount);
     }
@@ -410,7 +412,12 @@ private:
     {
       faces[2 * d] = reversed(below[d]);
     }
-    const V3<T> centre = cellCentroidFromFaces(c, faces);
+    int regular = 0;
+    const V3<T> centre = cellCentroidFromFaces(c, faces, &regular);
+    if (quality_.cellDeterminant)
+    {
+      cellDeterminants(faces, regular, cell);
+    }
     const CoordinateArrays& centres = centres_[k_ % 2];
     storeLanes(centres.x + inLayer, centre.x);
     storeLanes(centres.y + inLayer, centre.y);
@@ -431,6 +438,38 @@ private:
     {
       const V3<T> q[4] = { c[0], c[1], c[2], c[3] };
       lowerFace<T>(q, below[2], centres_[1 - k_ % 2], inLayer, cell - layerCells_, centre, cell);
+    }
+  }
+
+  /// The cell determinant of lanes whose six faces all count (faces inside the block, or
+  /// on its sides: boundaryFaces measures the cells with a true boundary face again).
+  /// Lanes with a collapsed face or no volume (not `regular`) leave the collapsed faces out.
+  template <typename T>
+  void cellDeterminants(const FaceGeometry<T> (&faces)[6], int regular, long cell)
+  {
+    V3<T> areas[6];
+    T lengths[6];
+    for (int f = 0; f < 6; ++f)
+    {
+      areas[f] = faces[f].area;
+      lengths[f] = vsqrt(faces[f].area2);
+    }
+    storeLanes(quality_.cellDeterminant + cell, cellDeterminantKernel(areas, lengths, 6));
+    for (int l = 0; regular != (1 << laneCount<T>)-1 && l < laneCount<T>; ++l)
+    {
+      if (!(regular & (1 << l)))
+      {
+        FaceGeometry<double> laneFaces[6];
+        for (int f = 0; f < 6; ++f)
+        {
+          laneFaces[f].area = laneOf(faces[f].area, l);
+          laneFaces[f].area2 = dot(laneFaces[f].area, laneFaces[f].area);
+          double diagonals2[laneCount<T>];
+          extractLanes(faces[f].diagonals2, diagonals2);
+          laneFaces[f].diagonals2 = diagonals2[l];
+        }
+        quality_.cellDeterminant[cell + l] = cellDeterminantOfFaces(laneFaces, 0x3f);
+      }
     }
   }
 
@@ -480,12 +519,49 @@ private:
   int first_ = -1;
 };
 
+/// A cell with faces on the true boundary: which (bits 1 << side, hexFaces order).
+struct BoundaryCell
+{
+  long cell;
+  int i, j, k;
+  int sides;
+};
+
+/**
+ * The cell determinant of the cells with true boundary faces, which the grid pass counted
+ * as internal: measured again from the cell's corners with those faces left out (the
+ * cell's own nodes only, so the same bits whatever the other blocks, ranks or layers).
+ */
+void boundaryCellDeterminants(
+  const BlockView& view, std::vector<BoundaryCell>& cells, double* cellDeterminant)
+{
+  std::sort(cells.begin(), cells.end(),
+    [](const BoundaryCell& a, const BoundaryCell& b) { return a.cell < b.cell; });
+  for (std::size_t first = 0; first < cells.size();)
+  {
+    int sides = 0;
+    std::size_t last = first;
+    for (; last < cells.size() && cells[last].cell == cells[first].cell; ++last)
+    {
+      sides |= cells[last].sides;
+    }
+    const BoundaryCell& cell = cells[first];
+    P3 c[8];
+    view.cellCorners(cell.i, cell.j, cell.k, c);
+    FaceGeometry<double> faces[6];
+    hexFaceGeometry(c, faces);
+    cellDeterminant[cell.cell] = cellDeterminantOfFaces(faces, 0x3f & ~sides);
+    first = last;
+  }
+}
+
 /// Block-boundary faces: interfaces are measured with the other cell's centre, true
-/// boundaries with OpenFOAM's boundary skewness only.
+/// boundaries with OpenFOAM's boundary skewness only (and leave the cell determinant).
 void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
   const InterfaceTable& interfaces, const CellQualityPointers& quality)
 {
   const BlockView& view = views[blockIndex];
+  std::vector<BoundaryCell> boundaryCells;
   for (int side = 0; side < 6; ++side)
   {
     const bool lowerSide = side % 2 == 0;
@@ -535,9 +611,14 @@ void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
         {
           maxSkewness =
             std::max(maxSkewness, boundarySkewness(ownerCentre, outward, face.centre, q));
+          boundaryCells.push_back({ owner, ijk[0], ijk[1], ijk[2], 1 << side });
         }
       }
     }
+  }
+  if (quality.cellDeterminant)
+  {
+    boundaryCellDeterminants(view, boundaryCells, quality.cellDeterminant);
   }
 }
 
@@ -570,6 +651,10 @@ void evaluateBlock(const std::vector<BlockView>& views, int blockIndex,
     std::fill_n(quality.skewness + first, count, 0.0);
     std::fill_n(quality.aspectRatio + first, count, 0.0);
     std::fill_n(quality.scaledJacobian + first, count, 0.0);
+    if (quality.cellDeterminant)
+    {
+      std::fill_n(quality.cellDeterminant + first, count, 0.0);
+    }
   });
   // Layers in chunks of at least two, on threads when a runner is installed. A chunk
   // [k0, k1) first re-evaluates layer k0 - 1 (the same values again: idempotent writes and
@@ -670,7 +755,8 @@ std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBl
   {
     CellQualityArrays& q = quality[n];
     outputs[n] = { q.minAngle.data(), q.maxAngle.data(), q.nonOrthogonality.data(),
-      q.skewness.data(), q.aspectRatio.data(), q.scaledJacobian.data() };
+      q.skewness.data(), q.aspectRatio.data(), q.scaledJacobian.data(),
+      q.cellDeterminant.data() };
   }
   evaluateBlocks(views, views.size(), totalCells, periodic, outputs, progress);
   return quality;

@@ -2,7 +2,8 @@
  * @file Quality.h
  * @brief Per-cell quality of hexahedral structured grids: element angles (the paper's
  * criterion), OpenFOAM-style non-orthogonality and skewness (also across block
- * interfaces), aspect ratio and the Verdict hex scaled Jacobian.
+ * interfaces), aspect ratio, the Verdict hex scaled Jacobian and checkMesh's cell
+ * determinant.
  *
  * Hexahedron corners are in VTK order. Angles are in degrees.
  */
@@ -84,6 +85,24 @@ double faceSkewness(const Vec3& ownerCentre, const Vec3& neighbourCentre,
 double boundaryFaceSkewness(const Vec3& ownerCentre, const Vec3& faceArea,
   const Vec3& faceCentre, const std::array<Vec3, 4>& faceCorners);
 
+/**
+ * checkMesh's cell determinant (`checkMesh -allGeometry`, OpenFOAM's
+ * primitiveMeshTools::cellDeterminant) of a cell whose internal or coupled faces (faces
+ * shared with another cell, across a block interface or a periodic pair included; not
+ * walls, inlets, outlets) have the area vectors `faceAreas`: with a the mean of |S_f|,
+ * |det(sum (S_f/a)(S_f/a)^T)| / 8. 1 for a cube with six such faces, V^4/a^6 for a
+ * parallelepiped of volume V; 0 without faces or when the summed area is below 1e-300.
+ * checkMesh fails a cell under 1e-3: a thin cell, or a cell that lost a face to the
+ * boundary (a unit cube with one boundary face gives 1/2, with two opposite ones 0).
+ */
+double cellDeterminant(const std::vector<Vec3>& faceAreas);
+
+/// The cell determinant of a hexahedron (corners in VTK order) whose faces i0 i1 j0 j1
+/// k0 k1 (hexFaces order, 0..5 as block sides) count where `counted` is true, with the
+/// face area vectors of quadAreaAndCentre; faces without area are left out, as the
+/// polyMesh writer drops them.
+double hexCellDeterminant(const std::array<Vec3, 8>& corners, const std::array<bool, 6>& counted);
+
 /// Quality measures of every cell of a multiblock structured grid.
 struct StructuredBlock
 {
@@ -94,7 +113,7 @@ struct StructuredBlock
 struct CellQualityArrays
 {
   std::vector<double> minAngle, maxAngle, nonOrthogonality, skewness, aspectRatio,
-    scaledJacobian;
+    scaledJacobian, cellDeterminant;
 };
 
 /**
@@ -136,6 +155,12 @@ bool periodicSidesMatch(const std::vector<StructuredBlock>& blocks, const Period
  * vtkMeshQuality give 1e30) is the Verdict corner formula over the corners whose three
  * edges have length, plus the centre: a wedge gets the sine of its smallest corner angle,
  * an inverted one a negative value. hexScaledJacobian() stays Verdict-exact.
+ *
+ * CellDeterminant is checkMesh's (cellDeterminant()) over the faces OpenFOAM's mesh of the
+ * grid has as internal or coupled: every face inside a block, and the block-boundary faces
+ * paired here as interfaces or periodic faces; true boundary faces and faces with no area
+ * are left out. A periodic face counts with its own area vector, as in OpenFOAM (a cyclic
+ * face is a face of this cell; its partner's rotation does not enter).
  */
 std::vector<CellQualityArrays> computeGridQuality(const std::vector<StructuredBlock>& blocks,
   const std::function<void(double)>& progress = {});
@@ -158,6 +183,9 @@ struct CellQualityPointers
   double* skewness = nullptr;
   double* aspectRatio = nullptr;
   double* scaledJacobian = nullptr;
+  /// May stay null: the cell determinant is then not computed (callers that need the six
+  /// other measures only, e.g. an optimizer's objective).
+  double* cellDeterminant = nullptr;
 };
 
 /// Same as above, writing into caller-owned buffers (e.g. the arrays of the VTK output,

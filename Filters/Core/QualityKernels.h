@@ -846,11 +846,18 @@ inline P3 cellCentroidSpecialCase(const P3 (&c)[8])
 
 /// OpenFOAM's cell centre of every lane from the geometry of its six faces (outward area
 /// vectors, hexFaces order; the grid pass computes each face once for both its cells).
+/// `regular` (may be null) gets the lanes (bits) whose cell has no collapsed face and a
+/// volume: the lanes where cellDeterminantKernel's result holds.
 template <typename T>
-inline V3<T> cellCentroidFromFaces(const V3<T> (&c)[8], const FaceGeometry<T> (&faces)[6])
+inline V3<T> cellCentroidFromFaces(
+  const V3<T> (&c)[8], const FaceGeometry<T> (&faces)[6], int* regular = nullptr)
 {
   int usable = 0;
   V3<T> centre = cellCentroidKernel(usable, faces);
+  if (regular)
+  {
+    *regular = usable;
+  }
   for (int l = 0; usable != (1 << laneCount<T>)-1 && l < laneCount<T>; ++l)
   {
     if (!(usable & (1 << l)))
@@ -867,6 +874,76 @@ inline V3<T> cellCentroidFromFaces(const V3<T> (&c)[8], const FaceGeometry<T> (&
     }
   }
   return centre;
+}
+
+// ---------------------------------------------------------------------------------------
+// Cell determinant
+
+/**
+ * checkMesh's cell determinant (OpenFOAM primitiveMeshTools::cellDeterminant, under
+ * -allGeometry) of one cell from the area vectors S_f of its `count` internal or coupled
+ * faces and their lengths |S_f|: with a = mean |S_f|, T = sum (S_f/a)(S_f/a)^T, the value
+ * is |det T| / 8, 1 for a cube whose six faces all count. checkMesh fails a cell under
+ * 1e-3. The caller has left out the true boundary faces and the collapsed ones, and
+ * handles count 0 and a vanishing mean (cellDeterminantOfFaces). Scaling the area
+ * vectors first (one division for the cell, then multiplications) keeps T's entries of
+ * order 1 whatever the cell's size. The determinant is expanded as for OpenFOAM's
+ * symmTensor. Branch-free.
+ */
+template <typename T>
+inline T cellDeterminantKernel(const V3<T>* areas, const T* lengths, int count)
+{
+  T sum = lengths[0];
+  for (int f = 1; f < count; ++f)
+  {
+    sum = sum + lengths[f];
+  }
+  const T scale = double(count) / sum; // 1 / mean area
+  const T zero = splat<T>(0.0);
+  T xx = zero, xy = zero, xz = zero, yy = zero, yz = zero, zz = zero;
+  for (int f = 0; f < count; ++f)
+  {
+    const V3<T> s = { scale * areas[f].x, scale * areas[f].y, scale * areas[f].z };
+    xx = xx + s.x * s.x;
+    xy = xy + s.x * s.y;
+    xz = xz + s.x * s.z;
+    yy = yy + s.y * s.y;
+    yz = yz + s.y * s.z;
+    zz = zz + s.z * s.z;
+  }
+  const T det = ((xx * yy * zz + xy * yz * xz) + xz * xy * yz) - xx * yz * yz - xy * xy * zz -
+    xz * yy * xz;
+  return 0.125 * vabs(det);
+}
+
+/**
+ * The cell determinant from the cell's six faces (hexFaces order) of which the bits of
+ * `counted` (1 << f) are internal or coupled: collapsed faces (no area: a wedge's or a
+ * fan's collapsed edge, which the polyMesh writer drops) are left out as well; 0 when no
+ * face is left or the faces' summed area is under OpenFOAM's vSmall, as checkMesh has it.
+ * The sign of an area vector does not matter (T is quadratic in S_f).
+ */
+inline double cellDeterminantOfFaces(const FaceGeometry<double> (&faces)[6], int counted)
+{
+  P3 areas[6];
+  double lengths[6];
+  int count = 0;
+  double sum = 0.0;
+  for (int f = 0; f < 6; ++f)
+  {
+    if ((counted & (1 << f)) && !faceCollapsed(faces[f].area2, faces[f].diagonals2))
+    {
+      areas[count] = faces[f].area;
+      lengths[count] = std::sqrt(faces[f].area2);
+      sum += lengths[count];
+      ++count;
+    }
+  }
+  if (count == 0 || sum < vSmall)
+  {
+    return 0.0;
+  }
+  return cellDeterminantKernel(areas, lengths, count);
 }
 
 template <typename T>

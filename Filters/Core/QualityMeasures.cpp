@@ -317,6 +317,38 @@ Vec3 hexCentre(const std::array<Vec3, 8>& corners)
   return toVec3(cellCentroid(c));
 }
 
+double cellDeterminant(const std::vector<Vec3>& faceAreas)
+{
+  std::vector<P3> areas;
+  std::vector<double> lengths;
+  double sum = 0.0;
+  for (const Vec3& area : faceAreas)
+  {
+    areas.push_back(toP3(area));
+    lengths.push_back(area.norm());
+    sum += lengths.back();
+  }
+  if (areas.empty() || sum < vSmall)
+  {
+    return 0.0;
+  }
+  return cellDeterminantKernel(areas.data(), lengths.data(), static_cast<int>(areas.size()));
+}
+
+double hexCellDeterminant(const std::array<Vec3, 8>& corners, const std::array<bool, 6>& counted)
+{
+  P3 c[8];
+  loadCorners(corners, c);
+  FaceGeometry<double> faces[6];
+  hexFaceGeometry(c, faces);
+  int mask = 0;
+  for (int f = 0; f < 6; ++f)
+  {
+    mask |= counted[f] ? 1 << f : 0;
+  }
+  return cellDeterminantOfFaces(faces, mask);
+}
+
 void quadAreaAndCentre(
   const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Vec3& area, Vec3& centre)
 {

@@ -181,7 +181,7 @@ void checkGridMemory(
 
 double qualityMemoryBytes(double cells)
 {
-  return cells * (6.0 * 8.0 + 4.0);
+  return cells * (7.0 * 8.0 + 4.0); // seven measures (double) and BlockId (int)
 }
 } // namespace model
 } // namespace blockforge

@@ -71,7 +71,7 @@ double gridMemoryBytes(const BlockNodeCounts& blocks);
 void checkGridMemory(
   const BlockNodeCounts& blocks, double maximumGigabytes, const std::string& advice);
 
-/// Bytes of the quality stage's output arrays for `cells` cells (six measures, BlockId).
+/// Bytes of the quality stage's output arrays for `cells` cells (seven measures, BlockId).
 double qualityMemoryBytes(double cells);
 } // namespace model
 } // namespace blockforge

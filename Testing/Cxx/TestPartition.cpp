@@ -83,12 +83,13 @@ std::vector<CellQualityArrays> measureSubset(const MeshedCase& c, const std::vec
     const long cells = static_cast<long>(blocks[n].ni - 1) * (blocks[n].nj - 1) * (blocks[n].nk - 1);
     CellQualityArrays& q = quality[n];
     for (auto* values : { &q.minAngle, &q.maxAngle, &q.nonOrthogonality, &q.skewness,
-           &q.aspectRatio, &q.scaledJacobian })
+           &q.aspectRatio, &q.scaledJacobian, &q.cellDeterminant })
     {
       values->assign(cells, -1.0);
     }
     outputs.push_back({ q.minAngle.data(), q.maxAngle.data(), q.nonOrthogonality.data(),
-      q.skewness.data(), q.aspectRatio.data(), q.scaledJacobian.data() });
+      q.skewness.data(), q.aspectRatio.data(), q.scaledJacobian.data(),
+      q.cellDeterminant.data() });
   }
   computeGridQuality(blocks, neighbours.links, layers, outputs);
   return quality;
@@ -126,7 +127,8 @@ long differingCells(const std::vector<CellQualityArrays>& whole,
         test::sameBits(a.nonOrthogonality[cell], b.nonOrthogonality[cell]) &&
         test::sameBits(a.skewness[cell], b.skewness[cell]) &&
         test::sameBits(a.aspectRatio[cell], b.aspectRatio[cell]) &&
-        test::sameBits(a.scaledJacobian[cell], b.scaledJacobian[cell]));
+        test::sameBits(a.scaledJacobian[cell], b.scaledJacobian[cell]) &&
+        test::sameBits(a.cellDeterminant[cell], b.cellDeterminant[cell]));
     }
   }
   return differing;
@@ -212,6 +214,16 @@ TEST(Partition, WithoutNeighboursInterfacesAreBoundaries)
   }
   const std::vector<CellQualityArrays> alone = computeGridQuality(blocks);
   EXPECT_GT(differingCells(whole, alone, even), 100);
+  // The cell determinant alone: an interface measured as a boundary loses its face.
+  long determinants = 0;
+  for (std::size_t n = 0; n < even.size(); ++n)
+  {
+    for (std::size_t cell = 0; cell < alone[n].cellDeterminant.size(); ++cell)
+    {
+      determinants += alone[n].cellDeterminant[cell] != whole[even[n]].cellDeterminant[cell];
+    }
+  }
+  EXPECT_GT(determinants, 100);
 }
 
 TEST(Partition, NeighboursOfSubsets)

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <functional>
 #include <map>
@@ -563,4 +565,295 @@ TEST(Quality, SmallestMinAngleOfABlockIsTheSmallestOfItsCells)
   }
   EXPECT_NEAR(smallestMinAngle(sheared.xyz.data(), 3, 3, 3), 90.0 - 0.4 * degrees, 1e-12);
   EXPECT_EQ(smallestMinAngle(sheared.xyz.data(), 3, 3, 1), 180.0); // no cells
+}
+
+namespace
+{
+/// checkMesh's cell determinant of a parallelepiped with edge vectors e1, e2, e3 and all
+/// six faces internal: T = 2 sum_i S_i S_i^T / a^2 with S_i the three face area vectors,
+/// det(S_1 S_2 S_3) = V^2, so |det T| / 8 = V^4 / a^6, a = (|S_1| + |S_2| + |S_3|) / 3.
+double parallelepipedDeterminant(const Vec3& e1, const Vec3& e2, const Vec3& e3)
+{
+  const double volume = std::abs(e1.dot(e2.cross(e3)));
+  const double mean = (e2.cross(e3).norm() + e3.cross(e1).norm() + e1.cross(e2).norm()) / 3.0;
+  return std::pow(volume, 4) / std::pow(mean, 6);
+}
+
+Corners parallelepiped(const Vec3& e1, const Vec3& e2, const Vec3& e3)
+{
+  return { Vec3::Zero(), e1, e1 + e2, e2, e3, e1 + e3, e1 + e2 + e3, e2 + e3 };
+}
+
+/// Faces of cell (i, j, k) of a block of ci x cj x ck cells that are inside the block.
+std::array<bool, 6> insideFaces(int i, int j, int k, int ci, int cj, int ck)
+{
+  return { i > 0, i < ci - 1, j > 0, j < cj - 1, k > 0, k < ck - 1 };
+}
+
+void expectRelative(double actual, double expected, double bound)
+{
+  EXPECT_LE(std::abs(actual - expected), bound * std::abs(expected))
+    << actual << " against " << expected;
+}
+} // namespace
+
+TEST(Quality, CellDeterminantOfSingleCells)
+{
+  // A cube: six faces of area 1, T = diag(2, 2, 2), det 8, over 8: 1.
+  const std::array<bool, 6> all = { true, true, true, true, true, true };
+  EXPECT_NEAR(hexCellDeterminant(unitCube(), all), 1.0, 1e-15);
+  // Faces lost to the boundary: one (T = diag(1, 2, 2)): 1/2; two at an edge: 1/4; three
+  // at a corner: 1/8; two opposite ones (nothing spans x): 0; none left: 0.
+  EXPECT_NEAR(hexCellDeterminant(unitCube(), { false, true, true, true, true, true }), 0.5, 1e-15);
+  EXPECT_NEAR(hexCellDeterminant(unitCube(), { false, true, false, true, true, true }), 0.25, 1e-15);
+  EXPECT_NEAR(
+    hexCellDeterminant(unitCube(), { false, true, false, true, false, true }), 0.125, 1e-15);
+  EXPECT_NEAR(hexCellDeterminant(unitCube(), { false, false, true, true, true, true }), 0.0, 1e-15);
+  EXPECT_EQ(hexCellDeterminant(unitCube(), { false, false, false, false, false, false }), 0.0);
+  EXPECT_EQ(cellDeterminant({}), 0.0);
+  EXPECT_EQ(cellDeterminant({ Vec3::Zero(), Vec3::Zero() }), 0.0);
+  // Independent of the cell's size and of the area vectors' signs.
+  EXPECT_NEAR(cellDeterminant({ Vec3(-1e-8, 0, 0), Vec3(1e-8, 0, 0), Vec3(0, 1e-8, 0),
+                Vec3(0, -1e-8, 0), Vec3(0, 0, 1e-8), Vec3(0, 0, 1e-8) }),
+    1.0, 1e-14);
+
+  // A box a x b x c: (abc)^4 / ((ab + bc + ca) / 3)^6; a slab 1 x 1 x 1/29 is about
+  // checkMesh's limit 1e-3.
+  for (const Vec3& size : { Vec3(1, 2, 3), Vec3(0.1, 5, 0.7), Vec3(1, 1, 1.0 / 29) })
+  {
+    const Corners box = parallelepiped(
+      Vec3(size.x(), 0, 0), Vec3(0, size.y(), 0), Vec3(0, 0, size.z()));
+    const double abc = size.prod();
+    const double mean = (size.x() * size.y() + size.y() * size.z() + size.z() * size.x()) / 3;
+    const double expected = std::pow(abc, 4) / std::pow(mean, 6);
+    expectRelative(hexCellDeterminant(box, all), expected, 1e-12);
+    expectRelative(hexCellDeterminant(box, all),
+      parallelepipedDeterminant(box[1] - box[0], box[3] - box[0], box[4] - box[0]), 1e-12);
+  }
+  // Sheared: a parallelepiped leaning in two directions, V^4 / a^6.
+  const Vec3 e1(1.3, 0.2, -0.1), e2(0.4, 0.9, 0.15), e3(0.5, -0.3, 0.6);
+  expectRelative(
+    hexCellDeterminant(parallelepiped(e1, e2, e3), all), parallelepipedDeterminant(e1, e2, e3), 1e-12);
+  // The same with the face area vectors given directly.
+  expectRelative(cellDeterminant({ e2.cross(e3), -e2.cross(e3), e3.cross(e1), -e3.cross(e1),
+                   e1.cross(e2), -e1.cross(e2) }),
+    parallelepipedDeterminant(e1, e2, e3), 1e-12);
+}
+
+TEST(Quality, CellDeterminantOfBlocks)
+{
+  // One cube cell alone: every face a boundary face.
+  const Grid single = makeGrid(2, 2, 2, [](int i, int j, int k) { return Vec3(i, j, k); });
+  const auto one = computeGridQuality({ single.block() });
+  ASSERT_EQ(one[0].cellDeterminant.size(), 1u);
+  EXPECT_EQ(one[0].cellDeterminant[0], 0.0);
+
+  // 3 x 3 x 3 cubes: the centre 1, a face's centre cell 1/2, an edge's middle cell 1/4,
+  // a corner cell 1/8.
+  const Grid cubes = makeGrid(4, 4, 4, [](int i, int j, int k) { return Vec3(i, j, k); });
+  const auto q = computeGridQuality({ cubes.block() });
+  auto cell = [](int i, int j, int k) { return i + 3 * (j + 3 * k); };
+  EXPECT_NEAR(q[0].cellDeterminant[cell(1, 1, 1)], 1.0, 1e-12);
+  for (const int c : { cell(1, 1, 0), cell(0, 1, 1), cell(2, 1, 1), cell(1, 2, 1), cell(1, 1, 2) })
+  {
+    EXPECT_NEAR(q[0].cellDeterminant[c], 0.5, 1e-12) << c;
+  }
+  EXPECT_NEAR(q[0].cellDeterminant[cell(1, 0, 0)], 0.25, 1e-12);
+  EXPECT_NEAR(q[0].cellDeterminant[cell(2, 2, 2)], 0.125, 1e-12);
+
+  // Sheared parallelepipeds (an affine lattice), 7 x 5 x 4 cells so that the SIMD lanes
+  // take part: V^4 / a^6 inside, the single-cell function with the boundary faces left
+  // out on the block's sides.
+  const Vec3 e1(1.3, 0.2, -0.1), e2(0.4, 0.9, 0.15), e3(0.5, -0.3, 0.6);
+  const int ci = 7, cj = 5, ck = 4;
+  const Grid lattice = makeGrid(
+    ci + 1, cj + 1, ck + 1, [&](int i, int j, int k) { return Vec3(double(i) * e1 + double(j) * e2 + double(k) * e3); });
+  const auto sheared = computeGridQuality({ lattice.block() });
+  const double inside = parallelepipedDeterminant(e1, e2, e3);
+  for (int k = 0; k < ck; ++k)
+  {
+    for (int j = 0; j < cj; ++j)
+    {
+      for (int i = 0; i < ci; ++i)
+      {
+        const double value = sheared[0].cellDeterminant[i + ci * (j + cj * k)];
+        const std::array<bool, 6> counted = insideFaces(i, j, k, ci, cj, ck);
+        expectRelative(value, hexCellDeterminant(cellCorners(lattice, i, j, k), counted), 1e-12);
+        if (counted == std::array<bool, 6>{ true, true, true, true, true, true })
+        {
+          expectRelative(value, inside, 1e-12);
+        }
+      }
+    }
+  }
+  // A boundary face changes the value (the test above could fail).
+  EXPECT_LT(sheared[0].cellDeterminant[0], 0.5 * inside);
+}
+
+TEST(Quality, CellDeterminantAcrossInterfacesEqualsOneBlock)
+{
+  // A randomly perturbed block split along i into two blocks (and along k into a third):
+  // every cell's determinant equals the whole block's, and the single-cell function's.
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> jitter(-0.2, 0.2);
+  const int ni = 10, nj = 6, nk = 7;
+  std::vector<Vec3> offsets(ni * nj * nk);
+  for (Vec3& o : offsets)
+  {
+    o = Vec3(jitter(random), jitter(random), jitter(random));
+  }
+  auto at = [&](int i, int j, int k) -> Vec3
+  {
+    const bool boundaryNode = i == 0 || i == ni - 1 || j == 0 || j == nj - 1 || k == 0 || k == nk - 1;
+    return Vec3(i * 0.7 + 0.1 * j, j * 1.1 + 0.05 * i * i, k * 0.9 + 0.05 * j * i) +
+      (boundaryNode ? Vec3::Zero() : offsets[i + ni * (j + nj * k)]);
+  };
+  const Grid whole = makeGrid(ni, nj, nk, at);
+  const int split = 4, splitK = 3;
+  const Grid left = makeGrid(split + 1, nj, nk, at);
+  const Grid lowRight =
+    makeGrid(ni - split, nj, splitK + 1, [&](int i, int j, int k) { return at(i + split, j, k); });
+  const Grid highRight = makeGrid(
+    ni - split, nj, nk - splitK, [&](int i, int j, int k) { return at(i + split, j, k + splitK); });
+  const auto joined = computeGridQuality({ whole.block() });
+  const auto parts = computeGridQuality({ left.block(), lowRight.block(), highRight.block() });
+  const auto apart = computeGridQuality({ left.block() });
+  const int ci = ni - 1, cj = nj - 1, ck = nk - 1;
+  int interfaceCells = 0;
+  for (int k = 0; k < ck; ++k)
+  {
+    for (int j = 0; j < cj; ++j)
+    {
+      for (int i = 0; i < ci; ++i)
+      {
+        const double expected = joined[0].cellDeterminant[i + ci * (j + cj * k)];
+        ASSERT_GT(expected, 0.0); // finite, and every cell keeps faces spanning 3 directions
+        expectRelative(expected,
+          hexCellDeterminant(cellCorners(whole, i, j, k), insideFaces(i, j, k, ci, cj, ck)), 1e-12);
+        double value = 0.0;
+        if (i < split)
+        {
+          value = parts[0].cellDeterminant[i + split * (j + cj * k)];
+          if (i == split - 1)
+          {
+            // Alone, the left block's i1 side is a boundary.
+            EXPECT_GT(std::abs(apart[0].cellDeterminant[i + split * (j + cj * k)] - expected),
+              1e-3 * expected)
+              << i << " " << j << " " << k << ": " << expected;
+            ++interfaceCells;
+          }
+        }
+        else if (k < splitK)
+        {
+          value = parts[1].cellDeterminant[(i - split) + (ci - split) * (j + cj * k)];
+        }
+        else
+        {
+          value = parts[2].cellDeterminant[(i - split) + (ci - split) * (j + cj * (k - splitK))];
+        }
+        expectRelative(value, expected, 1e-13);
+      }
+    }
+  }
+  EXPECT_EQ(interfaceCells, cj * ck);
+}
+
+TEST(Quality, CellDeterminantAcrossPeriodicSidesEqualsUnrolledNeighbours)
+{
+  // An annular sector of 40 degrees about z, i around, j outwards, k along the axis; its
+  // i0 side is the periodic image of i1 rotated by -40 degrees. Each periodic face counts
+  // with its own area vector (the cell's own face; the partner's rotation only carries the
+  // partner's centre), so a cell at the periodic sides has the determinant of the same
+  // cell in a grid unrolled one more column on each side, where those faces are internal.
+  const int n = 6, nr = 4, nz = 3;
+  const double sector = 40.0 / degrees;
+  auto node = [&](int i, int j, int k)
+  {
+    const double theta = sector * (i + 0.2 * std::sin(2.0 * M_PI * i / n)) / n;
+    const double r = 1.0 + 0.3 * j + 0.04 * j * j + 0.02 * k * j;
+    return Vec3(r * std::cos(theta), r * std::sin(theta),
+      0.25 * k + 0.03 * j + 0.02 * std::cos(2.0 * M_PI * i / n));
+  };
+  const Grid periodicBlock = makeGrid(n + 1, nr, nz, node);
+  const Grid unrolled =
+    makeGrid(n + 3, nr, nz, [&](int i, int j, int k) { return node(i - 1, j, k); });
+  PeriodicSideLink link;
+  link.sourceBlock = 0;
+  link.sourceSide = 1;
+  link.imageBlock = 0;
+  link.imageSide = 0;
+  link.rotation = Eigen::AngleAxisd(-sector, Vec3::UnitZ()).toRotationMatrix();
+  ASSERT_TRUE(periodicSidesMatch({ periodicBlock.block() }, link));
+  const auto linked = computeGridQuality({ periodicBlock.block() }, { link });
+  const auto unlinked = computeGridQuality({ periodicBlock.block() });
+  const auto reference = computeGridQuality({ unrolled.block() });
+  const int cj = nr - 1, ck = nz - 1;
+  for (int k = 0; k < ck; ++k)
+  {
+    for (int j = 0; j < cj; ++j)
+    {
+      for (int i = 0; i < n; ++i)
+      {
+        const double value = linked[0].cellDeterminant[i + n * (j + cj * k)];
+        const double expected = reference[0].cellDeterminant[(i + 1) + (n + 2) * (j + cj * k)];
+        expectRelative(value, expected, 1e-13);
+        if (i == 0 || i == n - 1)
+        {
+          // Without the link the periodic faces are boundaries: the value differs.
+          EXPECT_GT(std::abs(unlinked[0].cellDeterminant[i + n * (j + cj * k)] - expected),
+            1e-3 * expected);
+        }
+      }
+    }
+  }
+}
+
+TEST(Quality, CellDeterminantLeavesOutCollapsedFaces)
+{
+  // A wedge on the axis x = 0 (the i = 0 side collapsed onto a line): the cells there are
+  // prisms, their collapsed face has no area and, as in the polyMesh, does not count.
+  const int ni = 4, nj = 4, nk = 3;
+  const Grid wedge =
+    makeGrid(ni, nj, nk, [](int i, int j, int k) { return Vec3(i, i * (j - 1.5) * 0.4, k); });
+  const auto q = computeGridQuality({ wedge.block() });
+  const int ci = ni - 1, cj = nj - 1, ck = nk - 1;
+  for (int k = 0; k < ck; ++k)
+  {
+    for (int j = 0; j < cj; ++j)
+    {
+      for (int i = 0; i < ci; ++i)
+      {
+        const double value = q[0].cellDeterminant[i + ci * (j + cj * k)];
+        ASSERT_FALSE(std::isnan(value));
+        std::array<bool, 6> counted = insideFaces(i, j, k, ci, cj, ck);
+        if (i == 0)
+        {
+          // a prism: both faces along i counted or not, the value is that of its 4 faces
+          const Corners c = cellCorners(wedge, i, j, k);
+          std::vector<Vec3> areas;
+          const int faces[6][4] = { { 0, 4, 7, 3 }, { 1, 2, 6, 5 }, { 0, 1, 5, 4 },
+            { 3, 7, 6, 2 }, { 0, 3, 2, 1 }, { 4, 5, 6, 7 } };
+          for (int f = 1; f < 6; ++f)
+          {
+            if (counted[f])
+            {
+              Vec3 area, centre;
+              quadAreaAndCentre(c[faces[f][0]], c[faces[f][1]], c[faces[f][2]], c[faces[f][3]],
+                area, centre);
+              areas.push_back(area);
+            }
+          }
+          expectRelative(value, cellDeterminant(areas), 1e-13);
+          counted[0] = true;
+          expectRelative(value, hexCellDeterminant(c, counted), 1e-13);
+        }
+        else
+        {
+          expectRelative(value, hexCellDeterminant(cellCorners(wedge, i, j, k), counted), 1e-12);
+        }
+      }
+    }
+  }
+  // a prism on the axis with a boundary face (k0) still spans the three directions
+  EXPECT_GT(q[0].cellDeterminant[0 + ci * (1 + cj * 0)], 0.0);
 }

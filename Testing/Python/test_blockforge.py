@@ -127,7 +127,7 @@ class GridQualityTest(unittest.TestCase):
         for name, block in named_leaves(grid):
             cell_data = block.GetCellData()
             for array in ("MinAngle", "MaxAngle", "NonOrthogonality", "Skewness",
-                          "AspectRatio", "ScaledJacobian", "BlockId"):
+                          "AspectRatio", "ScaledJacobian", "CellDeterminant", "BlockId"):
                 values = cell_data.GetArray(array)
                 self.assertIsNotNone(values, f"{array} missing on {name}")
                 self.assertEqual(values.GetNumberOfTuples(), block.GetNumberOfCells())
@@ -156,7 +156,10 @@ class GridQualityTest(unittest.TestCase):
         percent = grid.GetFieldData().GetArray("MinAngleClassPercent")
         self.assertAlmostEqual(sum(percent.GetValue(i) for i in range(5)), 100.0)
         statistics = quality.GetOutputDataObject(2)
-        self.assertEqual(statistics.GetNumberOfRows(), 6)
+        self.assertEqual(statistics.GetNumberOfRows(), 7)
+        self.assertEqual([statistics.GetValue(r, 0).ToString() for r in range(7)],
+                         ["MinAngle", "MaxAngle", "NonOrthogonality", "Skewness",
+                          "AspectRatio", "ScaledJacobian", "CellDeterminant"])
         summary = grid.GetFieldData().GetArray("ScaledJacobianSummary")
         low, mean, high = summary.GetTuple3(0)
         self.assertGreater(low, 0.0)
@@ -176,6 +179,10 @@ class GridQualityTest(unittest.TestCase):
             np.testing.assert_allclose(data["AspectRatio"], 1.0, atol=1e-12)
             np.testing.assert_allclose(data["NonOrthogonality"], 0.0, atol=1e-6)
             np.testing.assert_allclose(data["Skewness"], 0.0, atol=1e-9)
+            # 4 x 4 x 4 cubes per block, the two blocks side by side: 1 inside, 1/2 with one
+            # boundary face, 1/4 with two, 1/8 with three (the interface counts as inside)
+            determinant = np.asarray(data["CellDeterminant"])
+            self.assertEqual(sorted(set(np.round(determinant, 12))), [0.125, 0.25, 0.5, 1.0])
         counts = grid.GetFieldData().GetArray("MinAngleClassCounts")
         self.assertEqual([counts.GetValue(i) for i in range(5)], [0, 0, 0, 0, 2 * 64])
 

@@ -88,7 +88,7 @@ class ClientServer(unittest.TestCase):
             mine = blocks[name]
             np.testing.assert_array_equal(bftest.points(mine), bftest.points(block))
             for array in ("MinAngle", "MaxAngle", "NonOrthogonality", "Skewness",
-                          "AspectRatio", "ScaledJacobian", "BlockId"):
+                          "AspectRatio", "ScaledJacobian", "CellDeterminant", "BlockId"):
                 a = np.asarray(mine.GetCellData().GetArray(array))
                 b = np.asarray(block.GetCellData().GetArray(array))
                 np.testing.assert_array_equal(a, b, err_msg=f"{name} {array}")

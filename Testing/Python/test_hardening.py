@@ -157,11 +157,11 @@ class MemoryTest(unittest.TestCase):
         mesher.SetInputConnection(source.GetOutputPort())
         quality = blockforge.vtkGridQuality()
         quality.SetInputConnection(mesher.GetOutputPort())
-        quality.SetMaximumMemory(1e-6)  # 1 kB: the 8192 cells need 416 kB
+        quality.SetMaximumMemory(1e-6)  # 1 kB: the 8192 cells need 480 kB
         errors = bftest.ErrorCollector(quality)
         quality.Update()
         self.assertTrue(errors.messages)
-        self.assertIn("the quality measures would need 416 kB for 8.2e+03 cells, more than "
+        self.assertIn("the quality measures would need 480 kB for 8.2e+03 cells, more than "
                       "MaximumMemory (1.05 kB)", blockforge._message(errors.messages[0]))
 
     def test_preview(self):

@@ -75,7 +75,7 @@ def compare_fields(label, parallel, serial):
     if counts != reference:
         failures.append(f"{label}: MinAngle classes {counts} != {reference}")
     for measure in ("MinAngle", "MaxAngle", "NonOrthogonality", "Skewness", "AspectRatio",
-                    "ScaledJacobian"):
+                    "ScaledJacobian", "CellDeterminant"):
         a = mine.GetArray(measure + "Summary").GetTuple3(0)
         b = theirs.GetArray(measure + "Summary").GetTuple3(0)
         if a[0] != b[0] or a[2] != b[2] or abs(a[1] - b[1]) > 1e-12 * max(1.0, abs(b[1])):

@@ -7,7 +7,8 @@ named *_optimized) and as the template places them (optimize=False).
 Asserted: "Mesh OK"; periodic pairs written as cyclic patches whose points match under
 the rotation; under -allGeometry -allTopology no failed check except the ones listed per
 template (thin cells near walls and axes: the cell determinant); the per-cell
-non-orthogonality and skewness checkMesh writes (-writeFields) equal GridQuality's.
+non-orthogonality, skewness and cell determinant checkMesh writes (-writeFields) equal
+GridQuality's, and so does the number of cells under checkMesh's determinant limit.
 """
 import os
 import re
@@ -103,6 +104,22 @@ FAILED_AT_MOST = {}
 # rotations of each other, as ours are.
 CELL_QUALITY_BOUND = 1e-5
 
+# checkMesh's cell determinant (cellDeterminant) against GridQuality's CellDeterminant:
+# |det T| / 8 with T = sum (S_f/a)(S_f/a)^T over the internal and cyclic faces. Both take
+# the same face area vectors to round-off (the fan of OpenFOAM v1912; a prism's triangle
+# by OpenFOAM's 3-point formula, by GridQuality as a quad with a repeated corner) and sum
+# the faces in another order, so T's entries, of order 1, differ by a few 1e-16; the
+# determinant, a sum of triple products of order 1 to 10, then differs by some 1e-15
+# absolute, a relative error that grows as the determinant falls. Measured (stop 17): at
+# most 7.1e-15 absolute on every case; relative 3.4e-10 on the compressor's OH grid (a
+# cell of 9.9e-7), 6.4e-11 optimized, 2.2e-12 on Rotor 37, under 2e-14 on the H grids
+# and the three small templates. Hence relative 1e-9, plus 1e-13 absolute for cells far
+# under checkMesh's limit (a determinant of 1e-7 and less, where only the count matters).
+DETERMINANT_RELATIVE = 1e-9
+DETERMINANT_ABSOLUTE = 1e-13
+# checkMesh fails a cell whose determinant is under this (checkCellDeterminant's warnDet).
+DETERMINANT_LIMIT = 1e-3
+
 # The OpenFOAM patch type of every patch the writer writes, from the template's types
 # (wall -> wall, inlet/outlet/patch -> patch, symmetry -> symmetry, periodic -> cyclic).
 PASSAGE_PATCH_TYPES = {"hub": "wall", "shroud": "wall", "blade": "wall", "inlet": "patch",
@@ -145,7 +162,7 @@ class CheckMeshTest(unittest.TestCase):
             status, plain = foamtools.run_foam(["checkMesh"], case)
             status_all, full = foamtools.run_foam(
                 ["checkMesh", "-allGeometry", "-allTopology", "-writeFields",
-                 "(nonOrthoAngle skewness)"], case)
+                 "(nonOrthoAngle skewness cellDeterminant)"], case)
             cls.results[name] = {
                 "plain": foamtools.check_mesh_summary(plain), "plain_text": plain,
                 "all": foamtools.check_mesh_summary(full), "all_text": full,
@@ -241,6 +258,29 @@ class CheckMeshTest(unittest.TestCase):
                 ours = block_cell_array(result["grid"], "Skewness")
                 difference = np.abs(theirs - ours)
                 self.assertLess(np.max(difference), CELL_QUALITY_BOUND, int(np.argmax(difference)))
+
+    def test_cell_determinant_equals_grid_quality(self):
+        """checkMesh's cellDeterminant field (-writeFields) is GridQuality's CellDeterminant
+        cell for cell, and the cells under 1e-3 are the cells checkMesh counts as failing."""
+        for name, *_ in CASES:
+            with self.subTest(case=name):
+                result = self.results[name]
+                theirs = foamtools.read_cell_field(
+                    os.path.join(result["case"], "constant", "cellDeterminant"))
+                ours = block_cell_array(result["grid"], "CellDeterminant")
+                self.assertEqual(theirs.shape, ours.shape)
+                difference = np.abs(theirs - ours)
+                allowed = DETERMINANT_RELATIVE * np.abs(theirs) + DETERMINANT_ABSOLUTE
+                worst = int(np.argmax(difference / allowed))
+                self.assertTrue(np.all(difference <= allowed),
+                                f"cell {worst}: checkMesh {theirs[worst]!r}, "
+                                f"GridQuality {ours[worst]!r}")
+                failing = result["all"]["determinant_cells"] or 0
+                self.assertEqual(int(np.count_nonzero(ours < DETERMINANT_LIMIT)), failing)
+                self.assertEqual(int(np.count_nonzero(theirs < DETERMINANT_LIMIT)), failing)
+                # not vacuous: the cases span well over a decade of determinants
+                self.assertLess(float(theirs.min()), 0.5)
+                self.assertGreater(float(theirs.max()), 0.5)
 
     def test_compressor_fans_are_prisms(self):
         """The compressor at default parameters (o_fan_prisms 1): at its sharp edges both

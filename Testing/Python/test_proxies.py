@@ -47,7 +47,7 @@ class ProxyTest(unittest.TestCase):
         self.assertEqual(cells, 4 * 8 * 8 * 4)
         for block in leaves(grid):
             for name in ("MinAngle", "MaxAngle", "NonOrthogonality", "Skewness",
-                         "AspectRatio", "ScaledJacobian", "BlockId"):
+                         "AspectRatio", "ScaledJacobian", "CellDeterminant", "BlockId"):
                 self.assertIsNotNone(block.GetCellData().GetArray(name), name)
         table = servermanager.Fetch(quality, idx=1)
         self.assertEqual(table.GetNumberOfRows(), 5)
