@@ -218,7 +218,7 @@ void edgeLengths(
 /// face, so that every face is computed once.
 struct FaceArrays
 {
-  double *ax, *ay, *az, *cx, *cy, *cz, *area2, *diagonals2, *weightSum;
+  double *ax, *ay, *az, *cx, *cy, *cz, *area2, *diagonals2, *weightSum, *length;
 
   template <typename T>
   void store(long n, const FaceGeometry<T>& f) const
@@ -232,6 +232,7 @@ struct FaceArrays
     storeLanes(area2 + n, f.area2);
     storeLanes(diagonals2 + n, f.diagonals2);
     storeLanes(weightSum + n, f.weightSum);
+    storeLanes(length + n, f.length);
   }
   template <typename T>
   FaceGeometry<T> load(long n) const
@@ -242,6 +243,7 @@ struct FaceArrays
     f.area2 = loadLanes<T>(area2 + n);
     f.diagonals2 = loadLanes<T>(diagonals2 + n);
     f.weightSum = loadLanes<T>(weightSum + n);
+    f.length = loadLanes<T>(length + n);
     f.average = f.centre; // not used by the kernels
     return f;
   }
@@ -261,7 +263,7 @@ public:
     // between them, 2 layers of cell centres (x, y, z).
     // Upper faces: of a row (i), of the previous row (j), of the previous layer (k).
     const long size = 2 * 3 * plane_ + 2 * 2 * 2 * plane_ + 2 * plane_ + 2 * 3 * layerCells_ +
-      9 * (2 * static_cast<long>(view.ci) + layerCells_);
+      10 * (2 * static_cast<long>(view.ci) + layerCells_);
     if (scratch.capacity() < static_cast<std::size_t>(size))
     {
       scratch = std::vector<double>();
@@ -291,7 +293,7 @@ public:
     }
     auto faceArrays = [&take](long count) {
       return FaceArrays{ take(count), take(count), take(count), take(count), take(count),
-        take(count), take(count), take(count), take(count) };
+        take(count), take(count), take(count), take(count), take(count) };
     };
     iFaces_ = faceArrays(view.ci);
     jFaces_ = faceArrays(view.ci);
@@ -395,17 +397,24 @@ private:
     // this pass (the same bits as the cell below would give: chunks and neighbour layers
     // agree with one whole pass).
     const long inLayer = i + static_cast<long>(view_.ci) * j_;
+    // Face lengths |S_f| (the cell determinant's) are computed with the face, once.
+    const bool determinant = quality_.cellDeterminant != nullptr;
+    auto withLength = [determinant](FaceGeometry<T> face)
+    {
+      face.length = determinant ? vsqrt(face.area2) : splat<T>(0.0);
+      return face;
+    };
     FaceGeometry<T> faces[6];
     for (const int f : { 1, 3, 5 })
     {
-      faces[f] = hexFace(c, f);
+      faces[f] = withLength(hexFace(c, f));
     }
     iFaces_.store(i, faces[1]);
     FaceGeometry<T> below[3]; // lower i, j, k faces with area vectors into these cells
     const bool hasBelow[3] = { i > 0, j_ > 0, k_ > first_ };
-    below[0] = hasBelow[0] ? iFaces_.load<T>(i - 1) : lowerHexFace(c, 0);
-    below[1] = hasBelow[1] ? jFaces_.load<T>(i) : lowerHexFace(c, 1);
-    below[2] = hasBelow[2] ? kFaces_.load<T>(inLayer) : lowerHexFace(c, 2);
+    below[0] = hasBelow[0] ? iFaces_.load<T>(i - 1) : withLength(lowerHexFace(c, 0));
+    below[1] = hasBelow[1] ? jFaces_.load<T>(i) : withLength(lowerHexFace(c, 1));
+    below[2] = hasBelow[2] ? kFaces_.load<T>(inLayer) : withLength(lowerHexFace(c, 2));
     jFaces_.store(i, faces[3]);
     kFaces_.store(inLayer, faces[5]);
     for (int d = 0; d < 3; ++d)
@@ -414,7 +423,7 @@ private:
     }
     int regular = 0;
     const V3<T> centre = cellCentroidFromFaces(c, faces, &regular);
-    if (quality_.cellDeterminant)
+    if (determinant)
     {
       cellDeterminants(faces, regular, cell);
     }
@@ -452,7 +461,7 @@ private:
     for (int f = 0; f < 6; ++f)
     {
       areas[f] = faces[f].area;
-      lengths[f] = vsqrt(faces[f].area2);
+      lengths[f] = faces[f].length;
     }
     storeLanes(quality_.cellDeterminant + cell, cellDeterminantKernel(areas, lengths, 6));
     for (int l = 0; regular != (1 << laneCount<T>)-1 && l < laneCount<T>; ++l)
@@ -549,7 +558,11 @@ void boundaryCellDeterminants(
     P3 c[8];
     view.cellCorners(cell.i, cell.j, cell.k, c);
     FaceGeometry<double> faces[6];
-    hexFaceGeometry(c, faces);
+    for (int f = 0; f < 6; ++f)
+    {
+      const P3 q[4] = { c[hexFaces[f][0]], c[hexFaces[f][1]], c[hexFaces[f][2]], c[hexFaces[f][3]] };
+      faces[f] = quadFaceArea(q);
+    }
     cellDeterminant[cell.cell] = cellDeterminantOfFaces(faces, 0x3f & ~sides);
     first = last;
   }
@@ -611,7 +624,10 @@ void boundaryFaces(const std::vector<BlockView>& views, int blockIndex,
         {
           maxSkewness =
             std::max(maxSkewness, boundarySkewness(ownerCentre, outward, face.centre, q));
-          boundaryCells.push_back({ owner, ijk[0], ijk[1], ijk[2], 1 << side });
+          if (quality.cellDeterminant)
+          {
+            boundaryCells.push_back({ owner, ijk[0], ijk[1], ijk[2], 1 << side });
+          }
         }
       }
     }

@@ -111,8 +111,8 @@ CELL_QUALITY_BOUND = 1e-5
 # the faces in another order, so T's entries, of order 1, differ by a few 1e-16; the
 # determinant, a sum of triple products of order 1 to 10, then differs by some 1e-15
 # absolute, a relative error that grows as the determinant falls. Measured (stop 17): at
-# most 7.1e-15 absolute on every case; relative 3.4e-10 on the compressor's OH grid (a
-# cell of 9.9e-7), 6.4e-11 optimized, 2.2e-12 on Rotor 37, under 2e-14 on the H grids
+# most 6.8e-15 absolute on every case; relative 3.9e-10 on the compressor's OH grid (a
+# cell of 8e-6), 4.6e-11 optimized, 5.0e-12 on Rotor 37, under 2e-14 on the H grids
 # and the three small templates. Hence relative 1e-9, plus 1e-13 absolute for cells far
 # under checkMesh's limit (a determinant of 1e-7 and less, where only the count matters).
 DETERMINANT_RELATIVE = 1e-9
