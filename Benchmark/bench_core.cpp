@@ -7,7 +7,7 @@
  * - Mesher/<size>:      MultiBlockMesher construction (model check) + computeBoundaries()
  *                       + meshBlock() of every block into preallocated buffers [nodes/s];
  * - MeshBlocks/<size>:  meshBlock() of every block only (boundaries computed once);
- * - Quality/<size>:     computeGridQuality() of the grid (all six measures) [cells/s];
+ * - Quality/<size>:     computeGridQuality() of the grid (all seven measures) [cells/s];
  * - CheckCells/<size>:  findInvertedCells() of every block, the mesher's check of every
  *                       grid it hands out, to compare with MeshBlocks [cells/s];
  * and, as the limit to approach, on a unit cube with the same node count:

@@ -6,7 +6,7 @@
    BlockForge's resolved model document), both writing their grid to disk in binary.
    Wall time and peak RSS of each, the ratio; the two grids are cross-checked (cells,
    merged points, block edge nodes) and checkMesh validates the blockMesh grid once.
-2. vtkGridQuality (six measures, interfaces matched) against vtkMeshQuality (hex scaled
+2. vtkGridQuality (seven measures, interfaces matched) against vtkMeshQuality (hex scaled
    Jacobian only) on the same grids: cells/s and the ratio; the scaled Jacobians agree.
 3. Peak memory of BlockForge meshing against the grid's own arrays (points 24 B/node,
    BlockId 4 B/cell) at 1e6 and 1e7 cells.
@@ -642,7 +642,7 @@ def phase_blockmesh(work, runs, template, rows, notes, huge_pages):
 
 
 def phase_quality(sizes, runs, template, rows, notes, check=None, huge_pages=False):
-    rows.append(("GridQuality (6 measures) vs vtkMeshQuality (hex scaled Jacobian), "
+    rows.append(("GridQuality (7 measures) vs vtkMeshQuality (hex scaled Jacobian), "
                  "cells/s (time)", "", "", "", ""))
     variants = [(label, None) for label in sizes]
     if huge_pages and "1e6" in sizes:
