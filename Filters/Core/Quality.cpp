@@ -453,6 +453,14 @@ private:
   /// The cell determinant of lanes whose six faces all count (faces inside the block, or
   /// on its sides: boundaryFaces measures the cells with a true boundary face again).
   /// Lanes with a collapsed face or no volume (not `regular`) leave the collapsed faces out.
+  ///
+  /// Interface and periodic faces count with the cell's own area vector, as in OpenFOAM
+  /// (cellDeterminant sums over the faces of the cell, each with its own faceAreas entry;
+  /// a cyclic face is one of them). Across a periodic pair the partner's face is this
+  /// face rotated: rotated back it is -S_f (the same face seen from the other side), and
+  /// T is quadratic in S_f, so the sign does not matter either. What must not happen is
+  /// mixing frames: T from some faces rotated by R and others not is not R T R^T, whose
+  /// determinant would equal det T; using the cell's own faces only keeps one frame.
   template <typename T>
   void cellDeterminants(const FaceGeometry<T> (&faces)[6], int regular, long cell)
   {
