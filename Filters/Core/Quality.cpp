@@ -458,9 +458,9 @@ private:
   /// (cellDeterminant sums over the faces of the cell, each with its own faceAreas entry;
   /// a cyclic face is one of them). Across a periodic pair the partner's face is this
   /// face rotated: rotated back it is -S_f (the same face seen from the other side), and
-  /// T is quadratic in S_f, so the sign does not matter either. What must not happen is
-  /// mixing frames: T from some faces rotated by R and others not is not R T R^T, whose
-  /// determinant would equal det T; using the cell's own faces only keeps one frame.
+  /// T is quadratic in S_f, so the sign does not matter either. Rotating every face of the
+  /// cell by R would give R T R^T, whose determinant is det T; rotating only the periodic
+  /// ones (mixing frames) would not. Hence the cell's own faces, all in one frame.
   template <typename T>
   void cellDeterminants(const FaceGeometry<T> (&faces)[6], int regular, long cell)
   {
