@@ -156,6 +156,23 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   (Rotor 37's and the distributor's wake and inlet edges shrink the same way, by up to 2.8
 #   and 4.8 from mean to smallest cell, and pass checkMesh; lowered too, the optimizer ended
 #   at 46.06 deg on Rotor 37, below its 47.0).
+# - at a sharp edge (a fan on the tip, on hub or shroud) the strip in front of it (U_M) and
+#   the wake strip behind it (D_M) widen towards the inlet / outlet to at least in_share /
+#   out_share (0.35) of the pitch, about their middle (a_in/b_in, a_out/b_out: the O corners'
+#   H lines extended, each moved out by half the missing width): extended along the H lines
+#   they kept the width of the fan's O arc, about 3 mm of the compressor's 35-54 mm pitch
+#   (share 0.08-0.11), ten cells across against 6.5 mm along the span, and failed checkMesh's
+#   cell determinant (U_M 358, D_M 215 of 960 cells at density 1, placed: the inlet row,
+#   whose matched end cells shrank its middle to 0.11 mm, and the O arc's corner column).
+#   Widened: U_M 19, D_M 3 (placed), 18 / 0 (optimized); min angle placed 12.8 -> 15.6 deg,
+#   optimizer 22.71 -> 22.87 deg. Round, capped and sheared edges keep the O arc's width
+#   (in_share_round / out_share_round 0): their placed strips fail too (the distributor's
+#   shroud share 0.08-0.10: U_M 97, D_M 44), but the optimizer, which moves the inlet and
+#   outlet points, leaves 5 / 1 there, and widened (0.12-0.35) it ended at 43.0-46.9 deg on
+#   the distributor and Rotor 37 (47.12 / 47.40 unwidened; they need 47.0). The turning of
+#   lo_f / lo_r at a sharp edge (le_turn, te_turn) measures the H line's angle at its O corner
+#   along the widened line itself (compressor: placed U_L 55 -> 38 failing cells, min angle
+#   13.1 -> 15.6 deg, against the unwidened slope).
 blockforge: 2
 name: axial_passage_oh
 description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.
@@ -200,10 +217,10 @@ parameters:
   side_arc_flat: 2        # the blade sides' O-grid arcs (law `match` from the O corners' cells, `flat`): between their small end cells the shape of the law `ends` with this flatness, not cells grown by o_match to a uniform middle (2.7 times the mean cell at density 0.5) ...
   period_end: 0.1         # ... and the periodic lines beside them (law `ends`): end cells this fraction of their mean cell ...
   period_flat: 3.0        # ... and that flat in between, so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
-  in_share: 0.35          # at a sharp leading edge (a fan on the tip, o_fan) the upstream strip U_M's inlet edge spans at least this fraction of the pitch (widened about its middle) ...
-  out_share: 0.35         # ... and at a sharp trailing edge the wake strip D_M's outlet edge
-  in_share_round: 0       # the same at round, capped or sheared edges (0: the strips keep the O-grid's edge arc's width)
-  out_share_round: 0
+  in_share: 0.35          # at a sharp leading edge (a fan on the tip, o_fan, on hub or shroud) the upstream strip U_M's inlet edge spans at least this fraction of the pitch, widened about its middle (0: the O arc's width extended; the compressor's U_M 358 -> 19 failing determinant cells at density 1, placed; 0.25: 48, 0.45: 15 but U_L 38 -> 43) ...
+  out_share: 0.35         # ... and at a sharp trailing edge the wake strip D_M's outlet edge (compressor's D_M 215 -> 3)
+  in_share_round: 0       # the same at round, capped or sheared edges (0: the O arc's width extended, as before; 0.12-0.35 ended the optimizer at 43.0-46.9 deg on the distributor and Rotor 37, under their 47.0; 0.1 changes only the distributor's shroud, 47.24) ...
+  out_share_round: 0      # ... and at their trailing edges
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
   wake_at_most: 1         # at a sharp trailing edge (its edge block a fan, o_fan) the wake block's outlet edge starts from cells at most this many times its mean cell (law `match`, at_most), and D_L's and D_R's outlet edges grow from those: matched as the other edges (the geometric mean of the three edges' mean cells) the compressor's outlet cells were 1.0 mm at D_M's ends and 0.084 mm in its middle (mean 0.39 mm), 80 times longer than wide, twisted along the span: checkMesh's face tets (0: no limit)
 """
