@@ -156,6 +156,23 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   (Rotor 37's and the distributor's wake and inlet edges shrink the same way, by up to 2.8
 #   and 4.8 from mean to smallest cell, and pass checkMesh; lowered too, the optimizer ended
 #   at 46.06 deg on Rotor 37, below its 47.0).
+# - at a sharp edge (a fan on the tip, on hub or shroud) the strip in front of it (U_M) and
+#   the wake strip behind it (D_M) widen towards the inlet / outlet to at least in_share /
+#   out_share (0.35) of the pitch, about their middle (a_in/b_in, a_out/b_out: the O corners'
+#   H lines extended, each moved out by half the missing width): extended along the H lines
+#   they kept the width of the fan's O arc, about 3 mm of the compressor's 35-54 mm pitch
+#   (share 0.08-0.11), ten cells across against 6.5 mm along the span, and failed checkMesh's
+#   cell determinant (U_M 358, D_M 215 of 960 cells at density 1, placed: the inlet row,
+#   whose matched end cells shrank its middle to 0.11 mm, and the O arc's corner column).
+#   Widened: U_M 19, D_M 3 (placed), 18 / 0 (optimized); min angle placed 12.8 -> 15.6 deg,
+#   optimizer 22.71 -> 22.87 deg. Round, capped and sheared edges keep the O arc's width
+#   (in_share_round / out_share_round 0): their placed strips fail too (the distributor's
+#   shroud share 0.08-0.10: U_M 97, D_M 44), but the optimizer, which moves the inlet and
+#   outlet points, leaves 5 / 1 there, and widened (0.12-0.35) it ended at 43.0-46.9 deg on
+#   the distributor and Rotor 37 (47.12 / 47.40 unwidened; they need 47.0). The turning of
+#   lo_f / lo_r at a sharp edge (le_turn, te_turn) measures the H line's angle at its O corner
+#   along the widened line itself (compressor: placed U_L 55 -> 38 failing cells, min angle
+#   13.1 -> 15.6 deg, against the unwidened slope).
 blockforge: 2
 name: axial_passage_oh
 description: O-grid around the blade inside H blocks, one blade passage from hub, shroud and blade sections.
@@ -200,6 +217,10 @@ parameters:
   side_arc_flat: 2        # the blade sides' O-grid arcs (law `match` from the O corners' cells, `flat`): between their small end cells the shape of the law `ends` with this flatness, not cells grown by o_match to a uniform middle (2.7 times the mean cell at density 0.5) ...
   period_end: 0.1         # ... and the periodic lines beside them (law `ends`): end cells this fraction of their mean cell ...
   period_flat: 3.0        # ... and that flat in between, so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
+  in_share: 0.35          # at a sharp leading edge (a fan on the tip, o_fan, on hub or shroud) the upstream strip U_M's inlet edge spans at least this fraction of the pitch, widened about its middle (0: the O arc's width extended; the compressor's U_M 358 -> 19 failing determinant cells at density 1, placed; 0.25: 48, 0.45: 15 but U_L 38 -> 43) ...
+  out_share: 0.35         # ... and at a sharp trailing edge the wake strip D_M's outlet edge (compressor's D_M 215 -> 3)
+  in_share_round: 0       # the same at round, capped or sheared edges (0: the O arc's width extended, as before; 0.12-0.35 ended the optimizer at 43.0-46.9 deg on the distributor and Rotor 37, under their 47.0; 0.1 changes only the distributor's shroud, 47.24) ...
+  out_share_round: 0      # ... and at their trailing edges
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
   wake_at_most: 1         # at a sharp trailing edge (its edge block a fan, o_fan) the wake block's outlet edge starts from cells at most this many times its mean cell (law `match`, at_most), and D_L's and D_R's outlet edges grow from those: matched as the other edges (the geometric mean of the three edges' mean cells) the compressor's outlet cells were 1.0 mm at D_M's ends and 0.084 mm in its middle (mean 0.39 mm), 80 times longer than wide, twisted along the span: checkMesh's face tets (0: no limit)
 """
@@ -348,6 +369,14 @@ def template_text():
             # straight down the camber would leave the O curve there at a small angle)
             bisect = f'shear_{e} || off_{e}_{l}' if e == 'te' else f'shear_{e}'
             w(f'  {base}_x_{l}: "{bisect} ? {sign}{e}_by_{l}/{e}_bx_{l} : {base}_{l}"')
+        # The wake strips' inlet and outlet ends: the O corners' H lines extended to the inlet
+        # (outlet), widened about their middle to at least in_share (out_share) of the pitch
+        for e, f, end, sh, x in (('le', 'f', 'in', 'in_share', 'slope_in_x'), ('te', 'r', 'out', 'out_share', 'slope_out_x')):
+            dist = (lambda c: f'({c}_{l}.axial - inlet_axial)') if end == 'in' else (lambda c: f'(outlet_axial - {c}_{l}.axial)')
+            for c in ('oa', 'ob'):
+                w(f'  {c}_{end}0_{l}: "{c}_{f}_{l}.theta + {dist(c + "_" + f)}*{x}_{l}/rm_{l}"      # the H line from {c}_{f} extended to the {end}let')
+            # (the widening added to the extended lines: exactly 0 where the strip is wide enough)
+            w(f'  {end}_widen_{l}: "max(0, (off_{e}_h && off_{e}_s ? {sh}_round : {sh})*pitch - (ob_{end}0_{l} - oa_{end}0_{l}))"')
         # At a sharp edge (its edge block a fan, corners not sheared) the line across the
         # passage, from one side's O corner A to the other side's corner B of the blade one
         # pitch below, meets the blade where a high stagger leaves it: one of the two blocks
@@ -365,8 +394,10 @@ def template_text():
             w(f'  {e}_abx_{l}: "{abx}"      # A (side a) to B (side b, one pitch below), unrolled')
             w(f'  {e}_aby_{l}: "{aby}"')
             ab = (f'{e}_abx_{l}', f'{e}_aby_{l}')
-            # the H line's direction at its corner: upstream (-1, slope_in_x) at A; downstream (1, slope_out_x) at B
-            hx, hy = ('-1', f'slope_in_x_{l}') if e == 'le' else ('1', f'slope_out_x_{l}')
+            # the H line's direction at its corner: upstream towards a_in at A; downstream towards b_out at B
+            # (the line to the inlet / outlet point itself: a strip widened by in_share /
+            # out_share turns it from slope_in_x / slope_out_x)
+            hx, hy = (f'(inlet_axial - oa_f_{l}.axial)', f'(rm_{l}*(a_in_{l}.theta - oa_f_{l}.theta))') if e == 'le' else (f'(outlet_axial - ob_r_{l}.axial)', f'(rm_{l}*(b_out_{l}.theta - ob_r_{l}.theta))')
             # the O curve's direction from its corner along the side (a step bisect_step along it)
             corner = f'{B}_{f}_{l}' if e == 'le' else f'{A}_{f}_{l}'
             ox = f'({o_side}_{l}.axial - {corner}.axial)'
@@ -509,11 +540,13 @@ def template_text():
         w(f'  hi_f_{l}: {{periodic: lo_f_{l}}}')
         w(f'  hi_r_{l}: {{periodic: lo_r_{l}}}')
         w(f'  # inlet and outlet: on the axial planes, H lines leaving the O-grid along slope_in/out')
-        for v, src in (('lo_in', 'lo_f'), ('a_in', 'oa_f'), ('b_in', 'ob_f')):
-            w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "{src}_{l}.theta + ({src}_{l}.axial - inlet_axial)*slope_in_x_{l}/rm_{l}"}}')
+        w(f'  lo_in_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "lo_f_{l}.theta + (lo_f_{l}.axial - inlet_axial)*slope_in_x_{l}/rm_{l}"}}')
+        for v, sg in (('a_in', '-'), ('b_in', '+')):
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: inlet_axial, theta: "o{v}0_{l} {sg} in_widen_{l}/2"}}')
         w(f'  hi_in_{l}: {{periodic: lo_in_{l}}}')
-        for v, src in (('lo_out', 'lo_r'), ('a_out', 'oa_r'), ('b_out', 'ob_r')):
-            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "{src}_{l}.theta + (outlet_axial - {src}_{l}.axial)*slope_out_x_{l}/rm_{l}"}}')
+        w(f'  lo_out_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "lo_r_{l}.theta + (outlet_axial - lo_r_{l}.axial)*slope_out_x_{l}/rm_{l}"}}')
+        for v, sg in (('a_out', '-'), ('b_out', '+')):
+            w(f'  {v}_{l}: {{on_surface: {S}, axial: outlet_axial, theta: "o{v}0_{l} {sg} out_widen_{l}/2"}}')
         w(f'  hi_out_{l}: {{periodic: lo_out_{l}}}')
     w('')
     w('edges:')
