@@ -79,6 +79,9 @@ struct ControlProblem::Impl
   std::unique_ptr<InterfaceFaces> Interfaces;
   long long StartWeakFaces = 0;
   bool RefuseWeakFaces = true;
+  /// Cells failing checkMesh's cell determinant (BlockCells::failingCells), as of the
+  /// last weakFaces(), and the start's: the most a configuration may have.
+  long long FailingCells = 0, StartFailingCells = 0;
   /// The start grid's largest neighbour size ratio across block interfaces; a
   /// configuration may have max(this, Objective.maximumInterfaceRatio).
   double StartInterfaceRatio = 1.0;
@@ -125,14 +128,16 @@ struct ControlProblem::Impl
     Cells.resize(grids.size());
     std::vector<const BlockCells*> cells;
     long long weak = 0;
+    FailingCells = 0;
     for (std::size_t b = 0; b < grids.size(); ++b)
     {
       if (!Cells[b])
       {
-        Cells[b].reset(new BlockCells(grids[b]));
+        Cells[b].reset(new BlockCells(grids[b], &Interfaces->boundarySides(static_cast<int>(b))));
       }
       cells.push_back(Cells[b].get());
       weak += Cells[b]->weakFaces();
+      FailingCells += Cells[b]->failingCells();
     }
     return weak + Interfaces->weakFaces(grids, cells);
   }
@@ -156,6 +161,15 @@ struct ControlProblem::Impl
       measures.failure = std::to_string(measures.weakFaces) +
         " faces fail checkMesh's interpolation weight or volume ratio (" +
         std::to_string(StartWeakFaces) + " at the start)";
+      return measures;
+    }
+    measures.failingCells = FailingCells;
+    if (RefuseWeakFaces && FailingCells > StartFailingCells)
+    {
+      measures.feasible = false;
+      measures.objective = infeasibleObjective(FailingCells - StartFailingCells);
+      measures.failure = std::to_string(FailingCells) + " cells fail checkMesh's cell determinant (" +
+        std::to_string(StartFailingCells) + " at the start)";
       return measures;
     }
     if (RefuseWeakFaces && Objective.maximumInterfaceRatio > 0.0)
@@ -308,6 +322,7 @@ struct ControlProblem::Impl
       Interfaces.reset(new InterfaceFaces(grids, Plan->topology().periodicSideLinks()));
       Cells.clear();
       StartWeakFaces = weakFaces();
+      StartFailingCells = FailingCells;
       StartInterfaceRatio = Interfaces->largestRatio(grids).ratio;
       Current.clear();
       for (const ControlVariable& variable : Variables)

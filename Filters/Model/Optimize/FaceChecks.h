@@ -33,9 +33,10 @@ namespace blockforge
 {
 namespace optimize
 {
-/// checkMesh's limits (polyMesh::checkFaceWeight, checkVolRatio).
+/// checkMesh's limits (polyMesh::checkFaceWeight, checkVolRatio, checkCellDeterminant).
 constexpr double MinimumFaceWeight = 0.05;
 constexpr double MinimumVolumeRatio = 0.01;
+constexpr double MinimumCellDeterminant = 1.0e-3;
 
 /// Whether a face fails the interpolation weight or the volume ratio (area vector, face
 /// centre, the two cells' centres and volumes).
@@ -50,20 +51,29 @@ inline bool weakFace(const Vec3& area, const Vec3& centre, const Vec3& owner, co
     MinimumVolumeRatio * (std::max(ownerVolume, neighbourVolume) + vSmall);
 }
 
-/// OpenFOAM's cell centres and volumes of one block grid, and how many faces between its
-/// own cells fail (weakFace).
+/**
+ * OpenFOAM's cell centres and volumes of one block grid, and how many faces between its
+ * own cells fail (weakFace). With `boundarySides` (one entry per cell, i fastest: the bits
+ * 1 << side, 0..5 = i0 i1 j0 j1 k0 k1, of the cell's faces on the true boundary, as
+ * InterfaceFaces::boundarySides gives them), also how many cells fail checkMesh's cell
+ * determinant (Core's hexCellDeterminant with those faces left out, as GridQuality's
+ * CellDeterminant: below MinimumCellDeterminant).
+ */
 class BlockCells
 {
 public:
-  explicit BlockCells(const BlockGrid& grid);
+  explicit BlockCells(const BlockGrid& grid, const std::vector<unsigned char>* boundarySides = nullptr);
   const std::vector<Vec3>& centres() const { return Centres; }
   const std::vector<double>& volumes() const { return Volumes; }
   long long weakFaces() const { return Weak; }
+  /// Cells failing the cell determinant (0 without boundarySides).
+  long long failingCells() const { return Failing; }
 
 private:
   std::vector<Vec3> Centres;
   std::vector<double> Volumes;
   long long Weak = 0;
+  long long Failing = 0;
 };
 
 /**
@@ -95,6 +105,10 @@ public:
   /// The worst neighbour size ratio across the faces between blocks (periodic sides
   /// included) on a grid with the same block sizes: where it is and how large.
   InterfaceRatio largestRatio(const std::vector<BlockGrid>& blocks) const;
+  /// Per cell of block `block` (i fastest), the bits 1 << side of its faces on the true
+  /// boundary: block sides not paired here (GridQuality's pairing: the faces its cell
+  /// determinant leaves out).
+  const std::vector<unsigned char>& boundarySides(int block) const;
 
 private:
   struct Pairs;
@@ -103,5 +117,9 @@ private:
 
 /// Faces of the whole grid that fail (within blocks and between them).
 long long weakFaceCount(const std::vector<BlockGrid>& blocks, const std::vector<PeriodicSideLink>& periodic);
+
+/// Cells of the whole grid that fail checkMesh's cell determinant (GridQuality's
+/// CellDeterminant below MinimumCellDeterminant).
+long long failingCellCount(const std::vector<BlockGrid>& blocks, const std::vector<PeriodicSideLink>& periodic);
 } // namespace optimize
 } // namespace blockforge

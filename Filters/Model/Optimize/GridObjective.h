@@ -130,6 +130,9 @@ struct GridMeasures
   /// Faces failing checkMesh's interpolation weight or volume ratio (FaceChecks.h); a
   /// configuration with more than its start is infeasible. 0 when not measured.
   long long weakFaces = 0;
+  /// Cells failing checkMesh's cell determinant (FaceChecks.h BlockCells); a configuration
+  /// with more than its start is infeasible. 0 when not measured.
+  long long failingCells = 0;
   /// Largest neighbour size ratio across the faces between blocks (FaceChecks.h); 0 when
   /// not measured.
   double interfaceRatio = 0.0;
