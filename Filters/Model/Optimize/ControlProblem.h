@@ -32,7 +32,10 @@
  * A configuration is infeasible when its grid folds, or when it fails more of checkMesh's
  * interpolation-weight and volume-ratio faces than the start's grid (FaceChecks.h; e.g. a
  * fan's corner moved off the tip's arc while its feet stay on the tip): the smallest angle
- * does not see a wall cell beside one 20 times its width. It is infeasible too when two
+ * does not see a wall cell beside one 20 times its width; or when more of its cells fail
+ * checkMesh's cell determinant than the start's (FaceChecks.h: the O-grid's thin cells
+ * count too; counting only the cells off the walls' layers kept the turbine's angle
+ * better at density 1 but let it end with more failing cells at 0.5). It is infeasible too when two
  * cells across a block interface differ more than ObjectiveSettings::maximumInterfaceRatio
  * times (or than the start's grid's, where that is more; FaceChecks.h InterfaceRatio):
  * the inlet points sliding along the inlet (lo_in, b_in) and the O-grid's corner ob_f left
@@ -122,7 +125,7 @@ public:
 
   /**
    * Whether a configuration whose grid fails more of checkMesh's interpolation-weight and
-   * volume-ratio faces (FaceChecks.h) than the start's, or jumps more across a block
+   * volume-ratio faces or cell determinants (FaceChecks.h) than the start's, or jumps more across a block
    * interface than ObjectiveSettings::maximumInterfaceRatio allows, is infeasible (the
    * default), or only measured (GridMeasures::weakFaces).
    */

@@ -18,6 +18,14 @@
  * The same pairs give the neighbour size ratio across block interfaces (issue 8's
  * measure, InterfaceRatio), which the optimizer holds to a bound: the checks above fail
  * only at a jump of 19, while a jump of 3 to 5 already spoils a solver's gradients.
+ *
+ * And they tell which block-side faces are internal or coupled for checkMesh's cell
+ * determinant (Core's hexCellDeterminant, GridQuality's CellDeterminant; failed below
+ * 1e-3): BlockCells counts the failing cells, exactly checkMesh's count (the four OH
+ * passages at density 1, placed and optimized: 638, 309, 942, 362 and 474, 311, 1036, 388
+ * on both). The optimizer refuses a configuration with more of them than its start: its
+ * moves raised the count on Rotor 37 (309 -> 311, U_R 0 -> 27), the compressor (942 ->
+ * 1036) and the turbine (362 -> 388) at density 1.
  */
 #pragma once
 
