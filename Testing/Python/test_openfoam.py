@@ -50,9 +50,8 @@ ALLOWED_FAILURES = {
     # bottom and top layers, are slivers (aspect ratio 24-32).
     "wedge_sector": {"determinant"},
     # Thin cells on the blade (O-grid expansion k_o towards the wall, aspect ratio up to
-    # 45), and, as Benchmark/determinant_cells.py shows (stop 16), H cells matched to the
-    # O-grid's thin outer cells and the compressor's U_M / D_M by its sharp edges: issue 10
-    # still open for those. The O-grid's cells along the blade are graded (issue 8: `match`, `ends`,
+    # 45), and H cells, at most H_DETERMINANT_AT_MOST (test_determinant_cells_by_block):
+    # issue 10 still open for those. The O-grid's cells along the blade are graded (issue 8: `match`, `ends`,
     # `project_from`), so the interpolation weights and volume ratios that failed where the
     # edge blocks met the side blocks pass.
     "axial_passage_oh_distributor": {"determinant"},
@@ -119,6 +118,22 @@ DETERMINANT_RELATIVE = 1e-9
 DETERMINANT_ABSOLUTE = 1e-13
 # checkMesh fails a cell whose determinant is under this (checkCellDeterminant's warnDet).
 DETERMINANT_LIMIT = 1e-3
+
+# Cells under checkMesh's determinant limit outside the O-grid (the H blocks of the OH
+# passages), at most, at density 1 (stop 17, Benchmark/checkmesh.py's split). Issue 10
+# allows the determinant only where a template asks for thin wall cells: the O-grid's
+# layers round the blade (k_o towards the wall). The H cells left are those matched to the
+# O-grid's outer cell across the interface (M_L / M_R beside the sides, the rows of U_M /
+# D_M at the O-grid: as thin as that cell, issue 8's ratio about 1.5), on the hub and
+# shroud, where the wall face leaves the cell one face short in the span, and at the inlet
+# and outlet of U_M / D_M. Stop 16 had 341 / 86 / 913 / 63 placed and 127 / 66 / 340 / 51
+# optimized; held here so that they do not grow back while issue 10 stays open.
+H_DETERMINANT_AT_MOST = {
+    "axial_passage_oh_distributor": 171, "axial_passage_oh_rotor37": 32,
+    "axial_passage_oh_compressor": 180, "axial_passage_oh_turbine": 21,
+    "axial_passage_oh_distributor_optimized": 41, "axial_passage_oh_rotor37_optimized": 34,
+    "axial_passage_oh_compressor_optimized": 146, "axial_passage_oh_turbine_optimized": 7,
+}
 
 # The OpenFOAM patch type of every patch the writer writes, from the template's types
 # (wall -> wall, inlet/outlet/patch -> patch, symmetry -> symmetry, periodic -> cyclic).
@@ -281,6 +296,30 @@ class CheckMeshTest(unittest.TestCase):
                 # not vacuous: the cases span well over a decade of determinants
                 self.assertLess(float(theirs.min()), 0.5)
                 self.assertGreater(float(theirs.max()), 0.5)
+
+    def test_determinant_cells_by_block(self):
+        """Cells under checkMesh's determinant limit (GridQuality's CellDeterminant, equal to
+        checkMesh's: test_cell_determinant_equals_grid_quality) outside the O-grid: none on
+        the grids without one but the wedge's 20, at most H_DETERMINANT_AT_MOST on the OH
+        passages' H blocks."""
+        for name, *_ in CASES:
+            with self.subTest(case=name):
+                grid = self.results[name]["grid"]
+                failing = {block_name: int(np.count_nonzero(
+                    np.array(dsa.WrapDataObject(block).CellData["CellDeterminant"]) < DETERMINANT_LIMIT))
+                    for block_name, (block, _) in foamtools.blocks_of(grid).items()}
+                outside = {block_name: count for block_name, count in failing.items()
+                           if count and not block_name.startswith("O_")}
+                if name == "wedge_sector":
+                    self.assertEqual(sum(outside.values()), 20, outside)
+                else:
+                    self.assertLessEqual(sum(outside.values()),
+                                         H_DETERMINANT_AT_MOST.get(name, 0), outside)
+                if name.startswith("axial_passage_oh"):
+                    # the O-grid's wall layers hold the rest: most of the cells that fail
+                    inside = sum(count for block_name, count in failing.items()
+                                 if block_name.startswith("O_"))
+                    self.assertGreater(inside, sum(outside.values()), failing)
 
     def test_compressor_fans_are_prisms(self):
         """The compressor at default parameters (o_fan_prisms 1): at its sharp edges both
