@@ -547,13 +547,27 @@ struct FaceGeometry
  * where each fan triangle's area vector is simply q_k x q_k+1. Branch-free: see
  * scalarFace and usableLanes for the degenerate cases.
  */
+/// The corners relative to their average (set in `face`, with the squared diagonals
+/// faceCollapsed needs): what quadFace and quadFaceArea start from, the same bits.
+template <typename T>
+inline void centredCorners(const V3<T> (&p)[4], FaceGeometry<T>& face, V3<T> (&q)[4])
+{
+  face.average = 0.25 * ((p[0] + p[1]) + (p[2] + p[3]));
+  for (int corner = 0; corner < 4; ++corner)
+  {
+    q[corner] = p[corner] - face.average;
+  }
+  const V3<T> diagonal0 = q[2] - q[0], diagonal1 = q[3] - q[1];
+  face.diagonals2 = dot(diagonal0, diagonal0) + dot(diagonal1, diagonal1);
+}
+
 template <typename T>
 inline FaceGeometry<T> quadFace(const V3<T> (&p)[4])
 {
   FaceGeometry<T> face;
-  face.average = 0.25 * ((p[0] + p[1]) + (p[2] + p[3]));
-  const V3<T> q0 = p[0] - face.average, q1 = p[1] - face.average, q2 = p[2] - face.average,
-              q3 = p[3] - face.average;
+  V3<T> q[4];
+  centredCorners(p, face, q);
+  const V3<T> &q0 = q[0], &q1 = q[1], &q2 = q[2], &q3 = q[3];
   const V3<T> n0 = cross(q0, q1), n1 = cross(q1, q2), n2 = cross(q2, q3), n3 = cross(q3, q0);
   const V3<T> sumN = (n0 + n1) + (n2 + n3);
   face.area = 0.5 * sumN;
@@ -564,8 +578,6 @@ inline FaceGeometry<T> quadFace(const V3<T> (&p)[4])
   const V3<T> weighted = (w0 * (q0 + q1) + w1 * (q1 + q2)) + (w2 * (q2 + q3) + w3 * (q3 + q0));
   const T scale = 1.0 / (3.0 * face.weightSum);
   face.centre = face.average + scale * weighted;
-  const V3<T> diagonal0 = q2 - q0, diagonal1 = q3 - q1;
-  face.diagonals2 = dot(diagonal0, diagonal0) + dot(diagonal1, diagonal1);
   return face;
 }
 
@@ -575,14 +587,11 @@ template <typename T>
 inline FaceGeometry<T> quadFaceArea(const V3<T> (&p)[4])
 {
   FaceGeometry<T> face;
-  face.average = 0.25 * ((p[0] + p[1]) + (p[2] + p[3]));
-  const V3<T> q0 = p[0] - face.average, q1 = p[1] - face.average, q2 = p[2] - face.average,
-              q3 = p[3] - face.average;
-  const V3<T> sumN = (cross(q0, q1) + cross(q1, q2)) + (cross(q2, q3) + cross(q3, q0));
+  V3<T> q[4];
+  centredCorners(p, face, q);
+  const V3<T> sumN = (cross(q[0], q[1]) + cross(q[1], q[2])) + (cross(q[2], q[3]) + cross(q[3], q[0]));
   face.area = 0.5 * sumN;
   face.area2 = dot(face.area, face.area);
-  const V3<T> diagonal0 = q2 - q0, diagonal1 = q3 - q1;
-  face.diagonals2 = dot(diagonal0, diagonal0) + dot(diagonal1, diagonal1);
   face.centre = face.average;
   face.weightSum = splat<T>(0.0);
   return face;
