@@ -27,11 +27,14 @@ inline void quadFace(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
   centre = 0.25 * ((a + b) + (c + d));
 }
 
-/// Whether a face is collapsed (a prism's or a wedge's: no face of OpenFOAM's mesh).
-inline bool collapsed(const Vec3& area, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
+/// Whether a face of squared area `area2` is collapsed (a prism's or a wedge's: no face of
+/// OpenFOAM's mesh) or within `fraction` of it, for the corners a, b, c, d (the squared
+/// area against the squared diagonals' sum, squared).
+inline bool collapsed(double area2, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
+  double fraction = 1e-24)
 {
   const double diagonals2 = (c - a).squaredNorm() + (d - b).squaredNorm();
-  return area.squaredNorm() <= 1e-24 * diagonals2 * diagonals2;
+  return area2 <= fraction * diagonals2 * diagonals2;
 }
 } // namespace
 
@@ -89,10 +92,10 @@ BlockCells::BlockCells(const BlockGrid& grid, const std::vector<unsigned char>* 
           }
           Face& face = faces[d][f];
           quadFace(a, b, c, e, face.area, face.centre);
-          face.collapsed = collapsed(face.area, a, b, c, e);
-          const double diagonals2 = (c - a).squaredNorm() + (e - b).squaredNorm();
-          face.nearlyCollapsed = face.area.squaredNorm() <= 1e-20 * diagonals2 * diagonals2;
-          face.length = determinant ? face.area.norm() : 0.0;
+          const double area2 = face.area.squaredNorm();
+          face.collapsed = collapsed(area2, a, b, c, e);
+          face.nearlyCollapsed = determinant && collapsed(area2, a, b, c, e, 1e-20);
+          face.length = determinant ? std::sqrt(area2) : 0.0;
         }
       }
     }
@@ -196,7 +199,8 @@ BlockCells::BlockCells(const BlockGrid& grid, const std::vector<unsigned char>* 
           &faces[1][faceIndex(1, i, j, k)], &faces[1][faceIndex(1, i, j + 1, k)],
           &faces[2][faceIndex(2, i, j, k)], &faces[2][faceIndex(2, i, j, k + 1)] };
         bool exact = false;
-        double xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0, sum = 0.0;
+        P3 areas[6];
+        double lengths[6], sum = 0.0;
         int counted = 0;
         for (int f = 0; f < 6 && !exact; ++f)
         {
@@ -204,38 +208,21 @@ BlockCells::BlockCells(const BlockGrid& grid, const std::vector<unsigned char>* 
           {
             continue;
           }
-          if (cell[f]->nearlyCollapsed)
-          {
-            exact = true;
-            break;
-          }
+          exact = cell[f]->nearlyCollapsed;
           const Vec3& a = cell[f]->area;
-          xx += a.x() * a.x();
-          xy += a.x() * a.y();
-          xz += a.x() * a.z();
-          yy += a.y() * a.y();
-          yz += a.y() * a.z();
-          zz += a.z() * a.z();
-          sum += cell[f]->length;
+          areas[counted] = { a.x(), a.y(), a.z() };
+          lengths[counted] = cell[f]->length;
+          sum += lengths[counted];
           ++counted;
         }
         bool fails = true;
-        if (!exact && counted > 0 && sum >= quality::vSmall)
+        exact = exact || counted == 0 || sum < quality::vSmall;
+        if (!exact)
         {
-          const double det = ((xx * yy * zz + xy * yz * xz) + xz * xy * yz) - xx * yz * yz -
-            xy * xy * zz - xz * yy * xz;
-          const double scale = counted / sum;
-          const double scale2 = scale * scale;
-          const double value = 0.125 * std::abs(det) * (scale2 * scale2 * scale2);
-          if (!(std::abs(value - MinimumCellDeterminant) > 1e-6 * MinimumCellDeterminant))
-          {
-            exact = true;
-          }
+          // Core's formula on these area vectors (the cell's kernel in GridQuality)
+          const double value = quality::cellDeterminantKernel(areas, lengths, counted);
+          exact = !(std::abs(value - MinimumCellDeterminant) > 1e-6 * MinimumCellDeterminant);
           fails = value < MinimumCellDeterminant;
-        }
-        else if (!exact)
-        {
-          exact = true;
         }
         if (exact)
         {
@@ -356,7 +343,7 @@ long long InterfaceFaces::weakFaces(
     const Vec3 a = quality::toVec3(q[0]), b = quality::toVec3(q[1]), c = quality::toVec3(q[2]),
                d = quality::toVec3(q[3]);
     quadFace(a, b, c, d, area, centre);
-    if (collapsed(area, a, b, c, d))
+    if (collapsed(area.squaredNorm(), a, b, c, d))
     {
       continue;
     }
