@@ -27,13 +27,16 @@ inline void quadFace(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
   centre = 0.25 * ((a + b) + (c + d));
 }
 
-/// Whether a face of squared area `area2` is collapsed (a prism's or a wedge's: no face of
-/// OpenFOAM's mesh) or within `fraction` of it, for the corners a, b, c, d (the squared
-/// area against the squared diagonals' sum, squared).
-inline bool collapsed(double area2, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
-  double fraction = 1e-24)
+/// The sum of the squared diagonals of the face a, b, c, d (its size, for `collapsed`).
+inline double squaredDiagonals(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
 {
-  const double diagonals2 = (c - a).squaredNorm() + (d - b).squaredNorm();
+  return (c - a).squaredNorm() + (d - b).squaredNorm();
+}
+
+/// Whether a face of squared area `area2` and squared diagonals `diagonals2` is collapsed
+/// (a prism's or a wedge's: no face of OpenFOAM's mesh), or within `fraction` of it.
+inline bool collapsed(double area2, double diagonals2, double fraction = 1e-24)
+{
   return area2 <= fraction * diagonals2 * diagonals2;
 }
 } // namespace
@@ -92,9 +95,9 @@ BlockCells::BlockCells(const BlockGrid& grid, const std::vector<unsigned char>* 
           }
           Face& face = faces[d][f];
           quadFace(a, b, c, e, face.area, face.centre);
-          const double area2 = face.area.squaredNorm();
-          face.collapsed = collapsed(area2, a, b, c, e);
-          face.nearlyCollapsed = determinant && collapsed(area2, a, b, c, e, 1e-20);
+          const double area2 = face.area.squaredNorm(), diagonals2 = squaredDiagonals(a, b, c, e);
+          face.collapsed = collapsed(area2, diagonals2);
+          face.nearlyCollapsed = determinant && collapsed(area2, diagonals2, 1e-20);
           face.length = determinant ? std::sqrt(area2) : 0.0;
         }
       }
@@ -343,7 +346,7 @@ long long InterfaceFaces::weakFaces(
     const Vec3 a = quality::toVec3(q[0]), b = quality::toVec3(q[1]), c = quality::toVec3(q[2]),
                d = quality::toVec3(q[3]);
     quadFace(a, b, c, d, area, centre);
-    if (collapsed(area.squaredNorm(), a, b, c, d))
+    if (collapsed(area.squaredNorm(), squaredDiagonals(a, b, c, d)))
     {
       continue;
     }
