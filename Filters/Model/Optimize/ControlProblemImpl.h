@@ -79,9 +79,9 @@ struct ControlProblem::Impl
   std::unique_ptr<InterfaceFaces> Interfaces;
   long long StartWeakFaces = 0;
   bool RefuseWeakFaces = true;
-  /// Cells failing checkMesh's cell determinant (BlockCells::failingCells), as of the
-  /// last weakFaces(), and the start's: the most a configuration may have.
-  long long FailingCells = 0, StartFailingCells = 0;
+  /// Cells failing checkMesh's cell determinant (BlockCells::failingCells) at the start:
+  /// the most a configuration may have.
+  long long StartFailingCells = 0;
   /// The start grid's largest neighbour size ratio across block interfaces; a
   /// configuration may have max(this, Objective.maximumInterfaceRatio).
   double StartInterfaceRatio = 1.0;
@@ -120,15 +120,20 @@ struct ControlProblem::Impl
     return grids;
   }
 
-  /// Faces of the plan's grid that fail checkMesh's interpolation weight or volume ratio
-  /// (FaceChecks.h), measuring the cells of the blocks that changed only.
-  long long weakFaces()
+  /// What the plan's grid fails of checkMesh's checks (FaceChecks.h): faces failing the
+  /// interpolation weight or volume ratio, cells failing the cell determinant.
+  struct CheckCounts
+  {
+    long long weakFaces = 0, failingCells = 0;
+  };
+
+  /// The plan's grid's CheckCounts, measuring the cells of the blocks that changed only.
+  CheckCounts checkCounts()
   {
     const std::vector<BlockGrid> grids = planGrids();
     Cells.resize(grids.size());
     std::vector<const BlockCells*> cells;
-    long long weak = 0;
-    FailingCells = 0;
+    CheckCounts counts;
     for (std::size_t b = 0; b < grids.size(); ++b)
     {
       if (!Cells[b])
@@ -136,10 +141,11 @@ struct ControlProblem::Impl
         Cells[b].reset(new BlockCells(grids[b], &Interfaces->boundarySides(static_cast<int>(b))));
       }
       cells.push_back(Cells[b].get());
-      weak += Cells[b]->weakFaces();
-      FailingCells += Cells[b]->failingCells();
+      counts.weakFaces += Cells[b]->weakFaces();
+      counts.failingCells += Cells[b]->failingCells();
     }
-    return weak + Interfaces->weakFaces(grids, cells);
+    counts.weakFaces += Interfaces->weakFaces(grids, cells);
+    return counts;
   }
 
   /// A feasible measure with more weak faces than the start becomes infeasible: the
@@ -153,7 +159,8 @@ struct ControlProblem::Impl
     {
       return measures;
     }
-    measures.weakFaces = weakFaces();
+    const CheckCounts counts = checkCounts();
+    measures.weakFaces = counts.weakFaces;
     if (RefuseWeakFaces && measures.weakFaces > StartWeakFaces)
     {
       measures.feasible = false;
@@ -163,12 +170,12 @@ struct ControlProblem::Impl
         std::to_string(StartWeakFaces) + " at the start)";
       return measures;
     }
-    measures.failingCells = FailingCells;
-    if (RefuseWeakFaces && FailingCells > StartFailingCells)
+    measures.failingCells = counts.failingCells;
+    if (RefuseWeakFaces && measures.failingCells > StartFailingCells)
     {
       measures.feasible = false;
-      measures.objective = infeasibleObjective(FailingCells - StartFailingCells);
-      measures.failure = std::to_string(FailingCells) + " cells fail checkMesh's cell determinant (" +
+      measures.objective = infeasibleObjective(measures.failingCells - StartFailingCells);
+      measures.failure = std::to_string(measures.failingCells) + " cells fail checkMesh's cell determinant (" +
         std::to_string(StartFailingCells) + " at the start)";
       return measures;
     }
@@ -321,8 +328,9 @@ struct ControlProblem::Impl
       const std::vector<BlockGrid> grids = planGrids();
       Interfaces.reset(new InterfaceFaces(grids, Plan->topology().periodicSideLinks()));
       Cells.clear();
-      StartWeakFaces = weakFaces();
-      StartFailingCells = FailingCells;
+      const CheckCounts start = checkCounts();
+      StartWeakFaces = start.weakFaces;
+      StartFailingCells = start.failingCells;
       StartInterfaceRatio = Interfaces->largestRatio(grids).ratio;
       Current.clear();
       for (const ControlVariable& variable : Variables)
