@@ -31,6 +31,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT / "Testing" / "Python"))
 import foamtools  # noqa: E402
+import determinant_cells  # noqa: E402  (Benchmark/, the script's folder)
 
 MACHINES = [("distributor", ROOT / "Data" / "distributor" / "BladeGen.inf"),
             ("Rotor 37", ROOT / "Data" / "rotor37" / "turbogrid" / "BladeGen.inf"),
@@ -76,15 +77,9 @@ def determinant_split(grid, determinant):
     blocks = foamtools.blocks_of(grid)
     if not any(name.startswith("O_") for name in blocks):
         return ""
-    offset, o_grid, h_blocks = 0, 0, {}
-    for name, (_, dims) in blocks.items():
-        count = (dims[0] - 1) * (dims[1] - 1) * (dims[2] - 1)
-        failing = int(np.count_nonzero(determinant[offset:offset + count] < 1e-3))
-        offset += count
-        if name.startswith("O_"):
-            o_grid += failing
-        elif failing:
-            h_blocks[name] = failing
+    o_grid, h_blocks = determinant_cells.split_by_block(
+        list(blocks), [(d[0] - 1) * (d[1] - 1) * (d[2] - 1) for _, d in blocks.values()],
+        determinant)
     listed = ", ".join(f"{name} {count}" for name, count in h_blocks.items())
     return (f"O-grid {o_grid}, H blocks {sum(h_blocks.values())}"
             + (f": {listed}" if listed else "") + "; ")

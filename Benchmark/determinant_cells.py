@@ -45,19 +45,40 @@ def read_field(path):
     return np.array(body[start:body.index(b")", start)].split(), dtype=float)
 
 
-def main(argv):
-    if not argv:
-        print(__doc__)
-        return 1
+def split_by_block(names, counts, determinant):
+    """(cells under THRESHOLD in the O-grid's blocks O_* (the template's wall layers),
+    {other block: its cells under THRESHOLD, where any}) for blocks `names` of `counts`
+    cells each, whose cells `determinant` holds block by block."""
+    offset, o_grid, others = 0, 0, {}
+    for name, count in zip(names, counts):
+        failing = int(np.count_nonzero(determinant[offset:offset + count] < THRESHOLD))
+        offset += count
+        if name.startswith("O_"):
+            o_grid += failing
+        elif failing:
+            others[name] = failing
+    return o_grid, others
+
+
+def measure(argv, all_checks=False):
+    """Meshes with `blockforge ARGV` as an OpenFOAM case and as Plot3D, runs checkMesh
+    -writeFields '(cellDeterminant aspectRatio)' (with -allGeometry -allTopology when
+    `all_checks`) and returns the command line's output, checkMesh's, the determinant and
+    aspect ratio per cell, the Plot3D blocks and their names. Raises
+    subprocess.CalledProcessError when blockforge fails."""
     cli = os.environ.get("BLOCKFORGE_CLI", str(HERE.parent / "build" / "bin" / "blockforge"))
     with tempfile.TemporaryDirectory(prefix="blockforge-determinant-") as work:
         case = os.path.join(work, "case", "grid.foam")
         grid = os.path.join(work, "grid.xyz")
         for output in (case, grid):
-            subprocess.run([cli, *argv, "-o", output], check=True, stdout=subprocess.DEVNULL)
-        subprocess.run(["bash", "-c", "source /usr/share/openfoam/etc/bashrc >/dev/null 2>&1; "
-                        "checkMesh -case \"$0\" -writeFields '(cellDeterminant aspectRatio)'",
-                        os.path.dirname(case)], check=True, stdout=subprocess.DEVNULL)
+            run = subprocess.run([cli, *argv, "-o", output], check=True, capture_output=True,
+                                 text=True)
+        checks = "-allGeometry -allTopology " if all_checks else ""
+        # (checkMesh exits 1 when a check fails: the fields are written all the same)
+        report = subprocess.run(
+            ["bash", "-c", "source /usr/share/openfoam/etc/bashrc >/dev/null 2>&1; "
+             f"checkMesh -case \"$0\" {checks}-writeFields '(cellDeterminant aspectRatio)'",
+             os.path.dirname(case)], capture_output=True, text=True).stdout
         constant = os.path.join(os.path.dirname(case), "constant")
         determinant = read_field(os.path.join(constant, "cellDeterminant"))
         aspect = read_field(os.path.join(constant, "aspectRatio"))
@@ -67,6 +88,15 @@ def main(argv):
     if cells != determinant.size:
         raise RuntimeError(f"{cells} cells in the Plot3D blocks, {determinant.size} in the "
                            "polyMesh (prisms or another cell order)")
+    return run.stdout, report, determinant, aspect, blocks, names
+
+
+def main(argv):
+    if not argv:
+        print(__doc__)
+        return 1
+    _, _, determinant, aspect, blocks, names = measure(argv)
+    cells = determinant.size
     failing = int((determinant < THRESHOLD).sum())
     print(f"cells {cells}, under the determinant threshold {failing}")
     offset = 0

@@ -14,7 +14,6 @@ import os
 import re
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -30,39 +29,19 @@ INPUTS = {"dist": "Data/distributor/BladeGen.inf", "r37": "Data/rotor37/turbogri
 
 
 def main(argv):
-    cli = os.environ.get("BLOCKFORGE_CLI", str(ROOT / "build" / "bin" / "blockforge"))
     template = os.environ.get("TEMPLATE", str(ROOT / "Templates" / "axial_passage_oh.yaml"))
     for machine in os.environ.get("MACHINES", "dist,r37,comp,turb").split(","):
-        with tempfile.TemporaryDirectory(prefix="blockforge-sweep-") as work:
-            case = os.path.join(work, "case", "grid.foam")
-            grid = os.path.join(work, "grid.xyz")
-            try:
-                for output in (case, grid):
-                    run = subprocess.run([cli, template, "-i", str(ROOT / INPUTS[machine]), *argv,
-                                          "-o", output], check=True, capture_output=True, text=True)
-            except subprocess.CalledProcessError as error:
-                print(f"{machine}: failed: {error.stderr.strip()[-300:]}")
-                continue
-            optimizer = re.search(r"optimizer: smallest element angle ([^,]*)", run.stdout)
-            report = subprocess.run(
-                ["bash", "-c", "source /usr/share/openfoam/etc/bashrc >/dev/null 2>&1; checkMesh "
-                 "-case \"$0\" -allGeometry -allTopology -writeFields '(cellDeterminant)'",
-                 os.path.dirname(case)], capture_output=True, text=True).stdout
-            other = [line.strip() for line in re.findall(r"\*\*\*([^\n]*)", report)
-                     if "eterminant" not in line]
-            determinant = determinant_cells.read_field(
-                os.path.join(work, "case", "constant", "cellDeterminant"))
-            blocks = interface_ratios.read_plot3d(grid)
-            names = interface_ratios.block_names(grid, len(blocks))
-        offset, o_grid, h_blocks = 0, 0, {}
-        for name, g in zip(names, blocks):
-            count = int(np.prod([s - 1 for s in g.shape[:3]]))
-            failing = int((determinant[offset:offset + count] < determinant_cells.THRESHOLD).sum())
-            offset += count
-            if name.startswith("O_"):
-                o_grid += failing
-            elif failing:
-                h_blocks[name] = failing
+        try:
+            output, report, determinant, _, blocks, names = determinant_cells.measure(
+                [template, "-i", str(ROOT / INPUTS[machine]), *argv], all_checks=True)
+        except subprocess.CalledProcessError as error:
+            print(f"{machine}: failed: {error.stderr.strip()[-300:]}")
+            continue
+        optimizer = re.search(r"optimizer: smallest element angle ([^,]*)", output)
+        other = [line.strip() for line in re.findall(r"\*\*\*([^\n]*)", report)
+                 if "eterminant" not in line]
+        o_grid, h_blocks = determinant_cells.split_by_block(
+            names, [int(np.prod([s - 1 for s in g.shape[:3]])) for g in blocks], determinant)
         points = np.concatenate([g.reshape(-1, 3) for g in blocks])
         size = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
         ratios = interface_ratios.interface_ratios(blocks, size)
