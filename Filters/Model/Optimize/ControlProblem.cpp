@@ -93,6 +93,11 @@ void ControlProblem::refuseWeakFaces(bool refuse)
   P->RefuseWeakFaces = refuse;
 }
 
+void ControlProblem::setObjective(const ObjectiveSettings& objective)
+{
+  P->Objective = objective;
+}
+
 bool ControlProblem::mayGain(std::size_t variable, const GridMeasures& current) const
 {
   if (Variables.at(variable).inert)

@@ -130,6 +130,8 @@ public:
    * default), or only measured (GridMeasures::weakFaces).
    */
   void refuseWeakFaces(bool refuse);
+  /// What evaluate() measures from now on (the kind must stay the same).
+  void setObjective(const ObjectiveSettings& objective);
 
   /// Places the configuration, meshes it and measures its final cells. Never throws: a
   /// configuration the mesher refuses is infeasible, with the reason in `failure`.

@@ -82,6 +82,10 @@ struct ControlProblem::Impl
   /// Cells failing checkMesh's cell determinant (BlockCells::failingCells) at the start:
   /// the most a configuration may have.
   long long StartFailingCells = 0;
+  /// ... and of them the driven ones (Objective.failingCellsAwayFromWalls).
+  long long StartDrivenCells = 0;
+  /// Per block, the bits 1 << side of its sides on wall patches (BlockCells).
+  std::vector<unsigned char> WallSides;
   /// The start grid's largest neighbour size ratio across block interfaces; a
   /// configuration may have max(this, Objective.maximumInterfaceRatio).
   double StartInterfaceRatio = 1.0;
@@ -124,8 +128,13 @@ struct ControlProblem::Impl
   /// interpolation weight or volume ratio, cells failing the cell determinant.
   struct CheckCounts
   {
-    long long weakFaces = 0, failingCells = 0;
+    long long weakFaces = 0, failingCells = 0, drivenCells = 0;
   };
+
+  long long drivenCells(const BlockCells& cells) const
+  {
+    return Objective.failingCellsAwayFromWalls ? cells.failingAwayFromWalls() : cells.failingCells();
+  }
 
   /// The plan's grid's CheckCounts, measuring the cells of the blocks that changed only.
   CheckCounts checkCounts()
@@ -138,11 +147,13 @@ struct ControlProblem::Impl
     {
       if (!Cells[b])
       {
-        Cells[b].reset(new BlockCells(grids[b], &Interfaces->boundarySides(static_cast<int>(b))));
+        Cells[b].reset(new BlockCells(grids[b], &Interfaces->boundarySides(static_cast<int>(b)),
+          b < WallSides.size() ? WallSides[b] : 0));
       }
       cells.push_back(Cells[b].get());
       counts.weakFaces += Cells[b]->weakFaces();
       counts.failingCells += Cells[b]->failingCells();
+      counts.drivenCells += drivenCells(*Cells[b]);
     }
     counts.weakFaces += Interfaces->weakFaces(grids, cells);
     return counts;
@@ -178,6 +189,32 @@ struct ControlProblem::Impl
       measures.failure = std::to_string(measures.failingCells) + " cells fail checkMesh's cell determinant (" +
         std::to_string(StartFailingCells) + " at the start)";
       return measures;
+    }
+    measures.drivenFailingCells = counts.drivenCells;
+    if (RefuseWeakFaces && Objective.minimumAngle > 0.0 && measures.minAngle < Objective.minimumAngle)
+    {
+      measures.feasible = false;
+      // (grows with the shortfall, in hundredths of a degree)
+      measures.objective = infeasibleObjective(
+        1 + static_cast<long long>(100.0 * (Objective.minimumAngle - measures.minAngle)));
+      measures.failure = "smallest angle " + std::to_string(measures.minAngle) + " (at least " +
+        std::to_string(Objective.minimumAngle) + ")";
+      return measures;
+    }
+    if (RefuseWeakFaces && Objective.failingCellWeight > 0.0)
+    {
+      // (below the start's count: the objective falls with each cell that passes)
+      measures.objective += Objective.failingCellWeight *
+        static_cast<double>(counts.drivenCells - StartDrivenCells);
+      // blocks with driven failing cells may gain: the search's trial filter (mayGain)
+      // must not leave out the moves that change them
+      for (std::size_t b = 0; b < Cells.size() && b < measures.activeBlocks.size(); ++b)
+      {
+        if (drivenCells(*Cells[b]) > 0)
+        {
+          measures.activeBlocks[b] = 1;
+        }
+      }
     }
     if (RefuseWeakFaces && Objective.maximumInterfaceRatio > 0.0)
     {
@@ -328,9 +365,25 @@ struct ControlProblem::Impl
       const std::vector<BlockGrid> grids = planGrids();
       Interfaces.reset(new InterfaceFaces(grids, Plan->topology().periodicSideLinks()));
       Cells.clear();
+      WallSides.assign(grids.size(), 0);
+      for (const model::Patch& patch : Plan->model().patches)
+      {
+        if (patch.type != "wall")
+        {
+          continue;
+        }
+        for (const model::BlockFace& face : patch.faces)
+        {
+          if (face.block >= 0 && static_cast<std::size_t>(face.block) < WallSides.size())
+          {
+            WallSides[face.block] |= static_cast<unsigned char>(1 << face.face);
+          }
+        }
+      }
       const CheckCounts start = checkCounts();
       StartWeakFaces = start.weakFaces;
       StartFailingCells = start.failingCells;
+      StartDrivenCells = start.drivenCells;
       StartInterfaceRatio = Interfaces->largestRatio(grids).ratio;
       Current.clear();
       for (const ControlVariable& variable : Variables)

@@ -41,7 +41,8 @@ inline bool collapsed(double area2, double diagonals2, double fraction = 1e-24)
 }
 } // namespace
 
-BlockCells::BlockCells(const BlockGrid& grid, const std::vector<unsigned char>* boundarySides)
+BlockCells::BlockCells(
+  const BlockGrid& grid, const std::vector<unsigned char>* boundarySides, unsigned char wallSides)
 {
   const int ni = grid.ni, nj = grid.nj, nk = grid.nk;
   const int ci = std::max(ni - 1, 0), cj = std::max(nj - 1, 0), ck = std::max(nk - 1, 0);
@@ -239,7 +240,40 @@ BlockCells::BlockCells(const BlockGrid& grid, const std::vector<unsigned char>* 
           }
           fails = !(hexCellDeterminant(corners, counts) >= MinimumCellDeterminant);
         }
-        Failing += fails ? 1 : 0;
+        if (!fails)
+        {
+          continue;
+        }
+        ++Failing;
+        // a wall-layer cell: thin along a direction that runs to a wall side of the block
+        // (its mean edge along it under WallLayerRatio of its longest mean edge)
+        double lengths3[3];
+        for (int d = 0; d < 3; ++d)
+        {
+          const int e[3] = { d == 0, d == 1, d == 2 };
+          lengths3[d] = 0.0;
+          for (int a = 0; a < 2; ++a)
+          {
+            for (int b = 0; b < 2; ++b)
+            {
+              // the edge along d at offsets (a, b) in the other two directions
+              const int o[3] = { d == 0 ? 0 : a, d == 0 ? a : (d == 1 ? 0 : b), d == 2 ? 0 : b };
+              lengths3[d] += (node(i + o[0] + e[0], j + o[1] + e[1], k + o[2] + e[2]) -
+                node(i + o[0], j + o[1], k + o[2])).norm();
+            }
+          }
+        }
+        const double longest = std::max({ lengths3[0], lengths3[1], lengths3[2] });
+        bool wallLayer = false;
+        for (int d = 0; d < 3; ++d)
+        {
+          wallLayer = wallLayer ||
+            ((wallSides & (3u << (2 * d))) && lengths3[d] < WallLayerRatio * longest);
+        }
+        if (!wallLayer)
+        {
+          ++FailingAway;
+        }
       }
     }
   }

@@ -45,6 +45,9 @@ namespace optimize
 constexpr double MinimumFaceWeight = 0.05;
 constexpr double MinimumVolumeRatio = 0.01;
 constexpr double MinimumCellDeterminant = 1.0e-3;
+/// A failing cell whose mean edge along a direction that runs to a wall side of its block
+/// is under this fraction of its longest mean edge is a wall-layer cell (BlockCells).
+constexpr double WallLayerRatio = 0.1;
 
 /// Whether a face fails the interpolation weight or the volume ratio (area vector, face
 /// centre, the two cells' centres and volumes).
@@ -70,18 +73,26 @@ inline bool weakFace(const Vec3& area, const Vec3& centre, const Vec3& owner, co
 class BlockCells
 {
 public:
-  explicit BlockCells(const BlockGrid& grid, const std::vector<unsigned char>* boundarySides = nullptr);
+  /// `wallSides`: the bits 1 << side of the block's sides on wall patches; a failing cell
+  /// whose mean edge along a direction that runs to such a side is under WallLayerRatio of
+  /// its longest is a wall-layer cell (thin because the template clusters its cells to
+  /// that wall).
+  explicit BlockCells(const BlockGrid& grid, const std::vector<unsigned char>* boundarySides = nullptr,
+    unsigned char wallSides = 0);
   const std::vector<Vec3>& centres() const { return Centres; }
   const std::vector<double>& volumes() const { return Volumes; }
   long long weakFaces() const { return Weak; }
   /// Cells failing the cell determinant (0 without boundarySides).
   long long failingCells() const { return Failing; }
+  /// Of failingCells(), those that are not wall-layer cells (see the constructor).
+  long long failingAwayFromWalls() const { return FailingAway; }
 
 private:
   std::vector<Vec3> Centres;
   std::vector<double> Volumes;
   long long Weak = 0;
   long long Failing = 0;
+  long long FailingAway = 0;
 };
 
 /**

@@ -60,6 +60,20 @@ struct ObjectiveSettings
   /// trials on the distributor instead of 427); 1.6: 47.40 / 47.12 (the same trial counts);
   /// 1.7 and 2.0: 47.29 / 47.22 (unguarded 47.29 / 47.22).
   double maximumInterfaceRatio = 1.6;
+  /// Issue 10: degrees of objective per cell failing checkMesh's cell determinant (the
+  /// count failingCellsAwayFromWalls selects, less the start's), added to the angle
+  /// objective; 0: the count is only refused above the start's. The optimizer's second
+  /// search (OptimizerSettings::cellSearchAllowance) sets it; alone, as a penalty from the
+  /// start, it cost angle on every machine (Optimizer.h).
+  double failingCellWeight = 0.0;
+  /// Which failing cells failingCellWeight counts: true, those that are not wall-layer
+  /// cells (BlockCells::failingAwayFromWalls: the O-grid's wall layers fail by the
+  /// template's request); false, all.
+  bool failingCellsAwayFromWalls = false;
+  /// A configuration whose smallest element angle is below this (degrees) is infeasible
+  /// (ControlProblem); 0: not held. The optimizer's second search (OptimizerSettings::
+  /// cellSearchAllowance) holds the first's end angle less the allowance.
+  double minimumAngle = 0.0;
 };
 
 /// One block grid: ni x nj x nk nodes, 3 doubles per node, i fastest.
@@ -133,6 +147,9 @@ struct GridMeasures
   /// Cells failing checkMesh's cell determinant (FaceChecks.h BlockCells); a configuration
   /// with more than its start is infeasible. 0 when not measured.
   long long failingCells = 0;
+  /// The failing cells that drive the search (ObjectiveSettings::failingCellsAwayFromWalls:
+  /// those that are not wall-layer cells, or all); 0 when not measured.
+  long long drivenFailingCells = 0;
   /// Largest neighbour size ratio across the faces between blocks (FaceChecks.h); 0 when
   /// not measured.
   double interfaceRatio = 0.0;

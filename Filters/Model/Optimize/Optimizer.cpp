@@ -70,7 +70,6 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
     requested.maximumMemory, "lower the density multiplier or the cell counts");
   const std::chrono::steady_clock::time_point begin = std::chrono::steady_clock::now();
   OptimizerSettings settings = requested;
-  settings.densityMultiplier = measuredDensity(model, requested.densityMultiplier);
   OptimizerResult result;
   result.densityMultiplier = settings.densityMultiplier;
   // The input as it is gives the "before" of the class counts (an input that folds or
@@ -124,6 +123,47 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
       return problem.mayGain(variable, current);
     },
     [&] { problem.reject(); });
+  if (settings.cellSearchAllowance > 0.0 && settings.cellSearchWeight > 0.0 &&
+    settings.cellSearchEvaluations > 1 && result.search.bestMeasures.feasible &&
+    settings.objective.kind != ObjectiveKind::NonOrthogonality)
+  {
+    // Issue 10: the second search, from the first's end point (its history follows the
+    // first's; its start is that end point's evaluation again)
+    ObjectiveSettings cells = settings.objective;
+    cells.failingCellWeight = settings.cellSearchWeight;
+    cells.failingCellsAwayFromWalls = true;
+    cells.minimumAngle = result.search.bestMeasures.minAngle - settings.cellSearchAllowance;
+    problem.setObjective(cells);
+    SearchSettings second = settings.search;
+    second.maxEvaluations = settings.cellSearchEvaluations;
+    second.stallAfter = settings.cellSearchEvaluations;
+    second.angleAllowance = settings.cellSearchAllowance;
+    second.initialStep = settings.cellSearchStep;
+    const SearchResult phase = search(result.search.best, problem.low(), problem.high(),
+      settings.objective.kind,
+      [&](const std::vector<double>& x) { return problem.evaluate(x); }, second, progress,
+      [&](std::size_t variable, const GridMeasures& current) {
+        return problem.mayGain(variable, current);
+      },
+      [&] { problem.reject(); });
+    problem.setObjective(settings.objective);
+    if (phase.best != result.search.best)
+    {
+      result.search.best = phase.best;
+      result.search.bestMeasures = phase.bestMeasures;
+    }
+    const double offset = result.search.seconds;
+    for (HistoryEntry entry : phase.history)
+    {
+      entry.evaluation += result.search.evaluations;
+      entry.seconds += offset;
+      result.search.history.push_back(entry);
+    }
+    result.search.evaluations += phase.evaluations;
+    result.search.skipped += phase.skipped;
+    result.search.seconds += phase.seconds;
+    result.search.stopReason += "; cell search: " + phase.stopReason;
+  }
   result.after = result.search.bestMeasures;
   if (settings.moves.empty())
   {

@@ -63,6 +63,7 @@ struct SearchState
   std::chrono::steady_clock::time_point begin;
   SearchResult* result = nullptr;
   double bestObjective = 0.0;
+  double angleAllowance = 0.0;
 
   std::vector<double> toModel(const std::vector<double>& u) const
   {
@@ -78,6 +79,14 @@ struct SearchState
   {
     GridMeasures measures = (*evaluate)(x);
     SearchResult& out = *result;
+    GridMeasures reference;
+    if (out.evaluations > 0)
+    {
+      reference.feasible = out.start.feasible;
+      reference.invertedCells = out.start.invertedCells;
+      reference.minAngle = out.start.minAngle - angleAllowance;
+      reference.maxNonOrthogonality = out.start.maxNonOrthogonality;
+    }
     ++trials;
     HistoryEntry entry;
     entry.evaluation = ++out.evaluations;
@@ -95,7 +104,7 @@ struct SearchState
       bestObjective = measures.objective;
     }
     else if (measures.feasible && measures.objective < bestObjective &&
-      notWorse(measures, out.start, kind))
+      notWorse(measures, reference, kind))
     {
       out.bestMeasures = measures;
       out.best = x;
@@ -258,6 +267,7 @@ SearchResult search(const std::vector<double>& start, const std::vector<double>&
   state.maxEvaluations = std::max(1, settings.maxEvaluations);
   state.begin = std::chrono::steady_clock::now();
   state.result = &result;
+  state.angleAllowance = settings.angleAllowance;
   state.range.resize(n);
   std::vector<double> lowU(n), highU(n), stepU(n), u(n, 0.0);
   bool movable = false;

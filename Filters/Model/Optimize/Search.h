@@ -51,6 +51,9 @@ struct SearchSettings
   /// often much smaller than the bounds: a few percent keeps the first steps inside;
   /// BOBYQA does better with 0.02).
   double initialStep = 0.05;
+  /// The best configuration may be this many degrees below the start's smallest angle
+  /// (notWorse against the start less this); 0: no worse than the start.
+  double angleAllowance = 0.0;
 };
 
 /// One evaluation of the search, in order.
