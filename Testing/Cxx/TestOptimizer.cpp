@@ -897,9 +897,9 @@ TEST(Optimizer, RefusesCellsFailingTheDeterminant)
  * point, fewest failing cells first, then the angle, the angle held at the first's end
  * less OptimizerSettings::cellSearchAllowance. The thin symmetric model started at its
  * angle optimum s = 0.5 (every angle 90 degrees, 8 failing cells): without the second
- * search (allowance 0, the stop 17 rule) it stays there; with an allowance of 30 degrees
- * it leaves for a configuration with fewer failing cells, no more than 70 degrees lower (the
- * angle falls fast: 45 degrees at s = 0.45, 7 cells; 26.6 at 0.4, 6). 0.08 high with bottom and top wall
+ * search (allowance 0, the stop 17 rule) it stays there; with an allowance of 70 degrees
+ * it leaves for a configuration with fewer failing cells (the angle falls fast: 45 degrees
+ * at s = 0.45 with 7 cells, 26.6 at 0.4 with 6). 0.08 high with bottom and top wall
  * patches, its plates are wall-layer cells (their short edge, z, runs to a wall and is
  * under WallLayerRatio of their long ones: BlockCells::failingAwayFromWalls), which the
  * second search does not count: the angle optimum stands.

@@ -322,8 +322,9 @@ class NativeCommandLineTest(unittest.TestCase):
 
     def test_objective_non_orthogonality(self):
         """--objective non-orthogonality: both command lines write the same bytes, and the
-        grid's largest non-orthogonality is lower than with the default objective (the
-        smallest angle), which raises it on the distributor's O-grid."""
+        grid's largest non-orthogonality is well below the placed grid's (the default
+        objective, the smallest angle, raised it on the distributor's O-grid until its
+        second search, stop 18)."""
         folder = bftest.output_path("objective")
         shutil.rmtree(folder, ignore_errors=True)
         arguments = [AXIAL_OH, "-i", DISTRIBUTOR_INF]
@@ -344,8 +345,10 @@ class NativeCommandLineTest(unittest.TestCase):
                                         shallow=False), objective)
         # At the template's defaults (stop 14): 51.97 against 66.98 (64.37 as placed). With
         # n_span 8, as this test ran until stop 13 to save time, the grids of stop 14 give
-        # 51.55 against 51.25: there the min-angle run does not raise it.
-        self.assertLess(largest["non-orthogonality"], largest["min-angle"] - 5.0, largest)
+        # 51.55 against 51.25: there the min-angle run does not raise it. Since stop 18 the
+        # min-angle run's second search (fewer cells failing checkMesh's determinant) lowers
+        # it too: 42.69 against 42.04 (67.71 at stop 17); held to beat the placed grid.
+        self.assertLess(largest["non-orthogonality"], 64.37 - 5.0, largest)
         run = subprocess.run([CLI, CYLINDER, "--objective", "smoothness", "-o", "x.foam"],
                              capture_output=True, text=True)
         self.assertEqual(run.returncode, 2)
@@ -436,9 +439,12 @@ class NativeCommandLineTest(unittest.TestCase):
     def test_max_interface_ratio(self):
         """--max-interface-ratio R: the optimizer holds the neighbour cell-size ratio across
         block interfaces to max(R, the placed grid's); 0 lets it go. On Rotor 37 at density 1
-        the unheld optimum jumps 3.24 between U_M and U_R at the inlet (stop 17; the
-        distributor's, 2.50 at stop 16, is 1.52 since the O-grid's k_o 1.25); held at the
-        default 1.6 it stays within. Both command lines pass it on alike."""
+        the unheld optimum jumped 3.24 between U_M and U_R at the inlet (stop 17; the
+        distributor's, 2.50 at stop 16, is 1.52 since the O-grid's k_o 1.25); since stop 18
+        the optimizer's second search takes away U_R's thin inlet cells (they failed
+        checkMesh's cell determinant) and with them the jump: 1.49 unheld, another grid than
+        the held one (1.59); held at the default 1.6 it stays within. Both command lines
+        pass it on alike."""
         sys.path.insert(0, os.path.join(SOURCE, "Benchmark"))
         try:
             import interface_ratios
@@ -465,7 +471,8 @@ class NativeCommandLineTest(unittest.TestCase):
             self.assertEqual(run.returncode, 0, run.stderr)
             ratios[label] = largest_ratio(path)
         self.assertLessEqual(ratios["held"], 1.6 + 1e-9)
-        self.assertGreater(ratios["free"], 2.0)
+        self.assertFalse(filecmp.cmp(os.path.join(folder, "free", "grid.xyz"),
+                                     os.path.join(folder, "held", "grid.xyz"), shallow=False))
         self.assertTrue(filecmp.cmp(os.path.join(folder, "free", "grid.xyz"),
                                     os.path.join(folder, "free_python", "grid.xyz"),
                                     shallow=False))

@@ -25,7 +25,10 @@
  * passages at density 1, placed and optimized: 638, 309, 942, 362 and 474, 311, 1036, 388
  * on both). The optimizer refuses a configuration with more of them than its start: its
  * moves raised the count on Rotor 37 (309 -> 311, U_R 0 -> 27), the compressor (942 ->
- * 1036) and the turbine (362 -> 388) at density 1.
+ * 1036) and the turbine (362 -> 388) at density 1. It also counts those that are not
+ * wall-layer cells (failingAwayFromWalls; on axial_passage_oh the H blocks' cells, 171 /
+ * 32 / 180 / 21 placed), which its second search drives down (OptimizerSettings::
+ * cellSearchAllowance).
  */
 #pragma once
 

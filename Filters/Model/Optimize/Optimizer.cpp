@@ -123,9 +123,12 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
       return problem.mayGain(variable, current);
     },
     [&] { problem.reject(); });
-  if (settings.cellSearchAllowance > 0.0 && settings.cellSearchWeight > 0.0 &&
-    settings.cellSearchEvaluations > 1 && result.search.bestMeasures.feasible &&
-    settings.objective.kind != ObjectiveKind::NonOrthogonality)
+  // (the trial budget covers both searches: the second takes what the first left, at most
+  // cellSearchEvaluations)
+  const int cellTrials = std::min(settings.cellSearchEvaluations,
+    settings.search.maxEvaluations - result.search.evaluations - result.search.skipped);
+  if (settings.cellSearchAllowance > 0.0 && settings.cellSearchWeight > 0.0 && cellTrials > 1 &&
+    result.search.bestMeasures.feasible && settings.objective.kind != ObjectiveKind::NonOrthogonality)
   {
     // Issue 10: the second search, from the first's end point (its history follows the
     // first's; its start is that end point's evaluation again)
@@ -135,8 +138,8 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
     cells.minimumAngle = result.search.bestMeasures.minAngle - settings.cellSearchAllowance;
     problem.setObjective(cells);
     SearchSettings second = settings.search;
-    second.maxEvaluations = settings.cellSearchEvaluations;
-    second.stallAfter = settings.cellSearchEvaluations;
+    second.maxEvaluations = cellTrials;
+    second.stallAfter = cellTrials;
     second.angleAllowance = settings.cellSearchAllowance;
     second.initialStep = settings.cellSearchStep;
     const SearchResult phase = search(result.search.best, problem.low(), problem.high(),

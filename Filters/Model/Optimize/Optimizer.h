@@ -58,8 +58,9 @@ struct OptimizerSettings
   /// (degrees; 0: no second search). axial_passage_oh at density 1, H blocks' failing
   /// cells and end angle (distributor / Rotor 37 / compressor / turbine): one search
   /// 49 / 31 / 129 / 8 at 47.40 / 47.38 / 23.25 / 34.63 degrees; with the second search
-  /// (0.35, step 0.1) 25 / 2 / 65 / 7 at 47.34 / 47.46 / 23.41 / 35.69 (the second search
-  /// also raises the angle where the count ties), 1.3-1.7 times the trials. Tried and
+  /// (0.35, step 0.1, the rest of the 700 trials) 28 / 2 / 65 / 7 at 47.40 / 47.45 / 23.41
+  /// / 35.69 (the second search also raises the angle where the count ties), 1.3-1.7 times
+  /// the trials (given 300 beyond the first's on the distributor: 25 at 47.34). Tried and
   /// left (stop 18, figures in README): the count as a penalty from the start
   /// (failingCellWeight 0.03-1, all cells or away from walls: 18-28 H cells on the
   /// distributor but at 44.2-45.3 degrees, Rotor 37 0-2 at 41.9-46.6), lexicographic from
@@ -69,8 +70,9 @@ struct OptimizerSettings
   /// 73 / 4, 0.01-0.02: Rotor 37 keeps its 31.
   double cellSearchAllowance = 0.35;
   double cellSearchWeight = 100.0;
-  /// The second search's trial budget (600: 26 / 6 / 66 / 4 at 48.00 / 47.99 degrees,
-  /// 2.2 times the trials) and first step (SearchSettings::initialStep).
+  /// The second search's trial budget, at most what the first left of SearchSettings::
+  /// maxEvaluations (600 beyond the first's: 26 / 6 / 66 / 4 at 48.00 / 47.99 degrees,
+  /// 2.2 times the trials), and its first step (SearchSettings::initialStep).
   int cellSearchEvaluations = 300;
   double cellSearchStep = 0.1;
 };
