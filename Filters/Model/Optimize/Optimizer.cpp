@@ -70,6 +70,7 @@ OptimizerResult optimizeModel(const model::BlockModel& model, model::CarrierGeom
     requested.maximumMemory, "lower the density multiplier or the cell counts");
   const std::chrono::steady_clock::time_point begin = std::chrono::steady_clock::now();
   OptimizerSettings settings = requested;
+  settings.densityMultiplier = measuredDensity(model, requested.densityMultiplier);
   OptimizerResult result;
   result.densityMultiplier = settings.densityMultiplier;
   // The input as it is gives the "before" of the class counts (an input that folds or
