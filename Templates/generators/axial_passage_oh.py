@@ -155,7 +155,18 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   tets (20 faces at density 1). Round and capped trailing edges keep the geometric mean
 #   (Rotor 37's and the distributor's wake and inlet edges shrink the same way, by up to 2.8
 #   and 4.8 from mean to smallest cell, and pass checkMesh; lowered too, the optimizer ended
-#   at 46.06 deg on Rotor 37, below its 47.0).
+#   at 46.06 deg on Rotor 37, below its 47.0). Since stop 18 (issue 10) the wake edge at a
+#   round, capped or sheared trailing edge is capped too (out_at_most_round 0.8), and the
+#   strip U_M's inlet edge at every leading edge (in_at_most 1): its matched end cells
+#   shrank its middle to 1.1 mm at the distributor's shroud against 31 mm along the axis
+#   and 39 mm of span, a row with two boundary faces (inlet, shroud) that checkMesh's cell
+#   determinant leaves out; the optimizer slid Rotor 37's b_in towards hi_in and left U_R's
+#   inlet cells 0.06-0.5 mm wide. With 12 cells from the O-grid to the inlet and outlet
+#   (n_up, n_down; 8 before) the inlet and outlet rows are 17 mm long instead of 31 on the
+#   distributor. H cells failing the determinant at density 1, placed / optimized:
+#   distributor 171 / 49 -> 78 / 31, Rotor 37 32 / 31 -> 24 / 10, compressor 180 / 129 ->
+#   180 / 109, turbine 21 / 8 -> 16 / 8; optimizer 47.40 / 47.38 / 23.25 / 34.63 deg ->
+#   48.28 / 47.09 / 23.39 / 38.94.
 # - at a sharp edge (a fan on the tip, on hub or shroud) the strip in front of it (U_M) and
 #   the wake strip behind it (D_M) widen towards the inlet / outlet to at least in_share /
 #   out_share (0.35) of the pitch, about their middle (a_in/b_in, a_out/b_out: the O corners'
@@ -200,8 +211,8 @@ parameters:
   upstream: 0.5           # inlet distance upstream of the first leading edge [blade axial lengths]
   downstream: 0.5         # outlet distance downstream of the last trailing edge [blade axial lengths]
   extend: 0               # extend hub and shroud along their end tangents by this fraction of their length (0: inlet/outlet stop at the contour ends when those are nearer)
-  n_up: 8                 # cells from inlet to the O-grid
-  n_down: 8               # cells from the O-grid to the outlet
+  n_up: 12                # cells from inlet to the O-grid (8 before stop 18: the match laws grow from the O-grid's outer cell by o_match to a uniform rest, and with 8 the inlet row was 31 mm long on the distributor against U_M's 4 mm across and 39 mm of span, failing checkMesh's cell determinant at the inlet, a boundary face it leaves out; with 12 it is 17 mm: see in_at_most)
+  n_down: 12              # cells from the O-grid to the outlet (likewise, 8 before)
   n_pitch: 6              # cells across each H column beside the O-grid
   min_pitch: 5            # coarsened (density multiplier below 1; min_cells) the H columns beside the O-grid keep at least this many cells across: from the O corner's small matched cell the match laws need a few cells to grow to the periodic line (3 cells at density 0.5: the distributor's U_M against U_R 2.54, the compressor's U_L against U_M 3.73)
   min_side: 12            # ... the blade sides at least this many cells along (9 at density 0.5: Rotor 37's long wall cells on its curved, twisted suction side fail checkMesh's face tets)
@@ -222,7 +233,9 @@ parameters:
   in_share_round: 0       # the same at round, capped or sheared edges (0: the O arc's width extended, as before; 0.12-0.35 ended the optimizer at 43.0-46.9 deg on the distributor and Rotor 37, under their 47.0; 0.1 changes only the distributor's shroud, 47.24) ...
   out_share_round: 0      # ... and at their trailing edges
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
-  wake_at_most: 1         # at a sharp trailing edge (its edge block a fan, o_fan) the wake block's outlet edge starts from cells at most this many times its mean cell (law `match`, at_most), and D_L's and D_R's outlet edges grow from those: matched as the other edges (the geometric mean of the three edges' mean cells) the compressor's outlet cells were 1.0 mm at D_M's ends and 0.084 mm in its middle (mean 0.39 mm), 80 times longer than wide, twisted along the span: checkMesh's face tets (0: no limit)
+  in_at_most: 1           # the upstream strip U_M's inlet edge: its end cells at most this many times its mean cell (law `match`, at_most; 0: no limit), and U_L's and U_R's inlet edges grow from those. Matched to one another alone, the three inlet edges started U_M's from the geometric mean of their mean cells (U_L's and U_R's six across a pitch) and shrank it towards its middle: the distributor's inlet cells 10.9 mm at U_M's ends and 1.1 mm in its middle at the shroud (mean 4 mm) against 31 mm along the axis and 39 mm of span failed checkMesh's cell determinant (U_M 71 cells placed); and the optimizer, which moves the inlet points, slid Rotor 37's b_in towards hi_in, U_R's inlet edge 1.3 mm long at the hub, its cells 0.06-0.5 mm (U_R 26 cells optimized)
+  out_at_most_round: 0.8  # ... the same for the wake strip D_M's outlet edge at a round, capped or sheared trailing edge (wake_cap; 0: no limit, as before stop 18; 1 ended the optimizer at 46.88 / 45.03 deg on the distributor / Rotor 37, 1.5 at 46.58 deg on the distributor: its end point moves with it, see period_end) ...
+  wake_at_most: 1         # ... and at a sharp one: at a sharp trailing edge (its edge block a fan, o_fan) the wake block's outlet edge starts from cells at most this many times its mean cell (law `match`, at_most), and D_L's and D_R's outlet edges grow from those: matched as the other edges (the geometric mean of the three edges' mean cells) the compressor's outlet cells were 1.0 mm at D_M's ends and 0.084 mm in its middle (mean 0.39 mm), 80 times longer than wide, twisted along the span: checkMesh's face tets (0: no limit)
 """
 
 FOOTER = """blocks:
@@ -231,7 +244,7 @@ FOOTER = """blocks:
   O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
   O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, 1], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
   U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
-  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: {i: end_widths, j: adaptive}}
+  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E1: {match: o_match, at_most: in_at_most}, E5: {match: o_match, at_most: in_at_most}}}, interpolation: {i: end_widths, j: adaptive}}
   U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
   M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end, period_end], flat: period_flat}, E8: {ends: [period_end, period_end], flat: period_flat}}}}
   M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end, period_end], flat: period_flat}, E6: {ends: [period_end, period_end], flat: period_flat}}}}
@@ -421,7 +434,7 @@ def template_text():
         gap('ogap_le', 'ob_f', 'oa_f'); gap('ogap_a', 'oa_f', 'oa_r'); gap('ogap_te', 'oa_r', 'ob_r'); gap('ogap_b', 'ob_r', 'ob_f')
     for e in ('le', 'te'):
         w(f'  shear_{e}: "({e}_shear_h || {e}_shear_s) && round_{e}_h && round_{e}_s && {e}_ty_h*{e}_ty_s > 0"      # 1: the corners at this edge are sheared (both layers)')
-    w('  wake_cap: "off_te_h && off_te_s ? 0 : wake_at_most"      # the wake block\'s outlet edge: its end cells at most this many times its mean cell (0: no limit) where the trailing edge is sharp on hub or shroud (a fan on the tip)')
+    w('  wake_cap: "off_te_h && off_te_s ? out_at_most_round : wake_at_most"      # the wake block\'s outlet edge: its end cells at most this many times its mean cell (0: no limit), wake_at_most where the trailing edge is sharp on hub or shroud (a fan on the tip)')
     w('')
     w('carriers:')
     w('  hub: {revolve: hub, axis: machine, extend: extend}')
