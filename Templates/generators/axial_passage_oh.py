@@ -119,7 +119,8 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   keep an open corner there;
 # - every H edge `match`: the H blocks start from the O-grid's outer cells and the edge
 #   blocks' and sides' cells and grow towards the inlet, outlet and periodic lines; the
-#   periodic lines beside the sides `ends` (period_end, period_flat), so that their nodes
+#   periodic lines beside the sides `ends` (period_end, or period_follow times the sides'
+#   relative end cells, per layer; period_flat), so that their nodes
 #   lie at nearly the fractions of the sides' matched outer arcs (the H blocks between
 #   them are not sheared along the blade);
 # - coarsened (density multiplier below 1) the blocks keep at least min_pitch cells across
@@ -228,6 +229,7 @@ parameters:
   side_arc_flat: 2        # the blade sides' O-grid arcs (law `match` from the O corners' cells, `flat`): between their small end cells the shape of the law `ends` with this flatness, not cells grown by o_match to a uniform middle (2.7 times the mean cell at density 0.5) ...
   period_end: 0.11        # ... and the periodic lines beside them (law `ends`): end cells this fraction of their mean cell (near the sides' arcs' end cells, which are the O-grid's outer radial cell: with k_o 1.25 and k_span 1.05 at 0.1 the optimizer ended at 44.6 deg on the distributor, at 0.11 47.7; 0.105 / 0.115 45.1 / 45.7 deg on the distributor / Rotor 37: the optimizer's end point moves by 2-3 deg with it) ...
   period_flat: 3.0        # ... and that flat in between, so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
+  period_follow: 0       # ... or, above 0, the periodic lines' end cells this many times the sides' O arcs' end cells relative to their mean cell (the O-grid's outer radial cell over the side's length / n_side, per layer; period_end then unused), so that they follow a thicker O-grid: with o_width 0.045, k_o 1.4 the sides' arcs start from 0.25-0.29 of their mean cell against the periodic lines' 0.11, the H lines fan at the corners and the optimizer ended at 34.1 deg on the distributor, 43.7 on Rotor 37; with 1 (and period_flat 2, the sides' side_arc_flat) 46.1 / 47.5, H cells under checkMesh's determinant placed 16 / 4 / 18 / 0 (M_L, M_R: 0 on distributor and Rotor 37), but the turbine's O_te wall cells by its cap then have 12 faces under the interpolation weight (placed); at the default o_width / k_o 1 gives 42.8 / 44.1 deg (0.11 against 0.14-0.16 on the distributor's sides), so 0
   in_share: 0.35          # at a sharp leading edge (a fan on the tip, o_fan, on hub or shroud) the upstream strip U_M's inlet edge spans at least this fraction of the pitch, widened about its middle (0: the O arc's width extended; the compressor's U_M 358 -> 19 failing determinant cells at density 1, placed; 0.25: 48, 0.45: 15 but U_L 38 -> 43) ...
   out_share: 0.35         # ... and at a sharp trailing edge the wake strip D_M's outlet edge (compressor's D_M 215 -> 3)
   in_share_round: 0       # the same at round, capped or sheared edges (0: the O arc's width extended, as before; 0.12-0.35 ended the optimizer at 43.0-46.9 deg on the distributor and Rotor 37, under their 47.0; 0.1 changes only the distributor's shroud, 47.24) ...
@@ -246,8 +248,8 @@ FOOTER = """blocks:
   U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
   U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E1: {match: o_match, at_most: in_at_most}, E5: {match: o_match, at_most: in_at_most}}}, interpolation: {i: end_widths, j: adaptive}}
   U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
-  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end, period_end], flat: period_flat}, E8: {ends: [period_end, period_end], flat: period_flat}}}}
-  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end, period_end], flat: period_flat}, E6: {ends: [period_end, period_end], flat: period_flat}}}}
+  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end_h, period_end_h], flat: period_flat}, E8: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
+  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end_h, period_end_h], flat: period_flat}, E6: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
   D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
   D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E3: {match: o_match, at_most: wake_cap}, E7: {match: o_match, at_most: wake_cap}}}, interpolation: {i: end_widths, j: adaptive}}
   D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
@@ -435,6 +437,16 @@ def template_text():
     for e in ('le', 'te'):
         w(f'  shear_{e}: "({e}_shear_h || {e}_shear_s) && round_{e}_h && round_{e}_s && {e}_ty_h*{e}_ty_s > 0"      # 1: the corners at this edge are sheared (both layers)')
     w('  wake_cap: "off_te_h && off_te_s ? out_at_most_round : wake_at_most"      # the wake block\'s outlet edge: its end cells at most this many times its mean cell (0: no limit), wake_at_most where the trailing edge is sharp on hub or shroud (a fan on the tip)')
+    # the periodic lines' end cells (law `ends`, relative to their mean cell): period_end, or
+    # with period_follow the O-grid's outer radial cell (geometric k_o over n_o cells, the
+    # cell the sides' O arcs start from) over the sides' mean cell (their length, a polyline
+    # through the O corners and the sides' mid-points, over n_side), times period_follow
+    w('  o_cell: "abs(k_o - 1) < 1e-9 ? 1/n_o : (k_o - 1)*k_o^(n_o - 1)/(k_o^n_o - 1)"      # the O-grid\'s outer radial cell, fraction of its width')
+    d3 = lambda p, q: f'sqrt(({p}.x - {q}.x)^2 + ({p}.y - {q}.y)^2 + ({p}.z - {q}.z)^2)'
+    for l in L:
+        sa = f'({d3(f"oa_f_{l}", f"oa_m_{l}")} + {d3(f"oa_m_{l}", f"oa_r_{l}")})'
+        sb = f'({d3(f"ob_f_{l}", f"ob_m_{l}")} + {d3(f"ob_m_{l}", f"ob_r_{l}")})'
+        w(f'  period_end_{l}: "period_follow > 0 ? period_follow*o_width*chord_{l}*o_cell*n_side*(1/{sa} + 1/{sb})/2 : period_end"      # the periodic lines\' end cells over their mean cell')
     w('')
     w('carriers:')
     w('  hub: {revolve: hub, axis: machine, extend: extend}')
