@@ -119,7 +119,8 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   keep an open corner there;
 # - every H edge `match`: the H blocks start from the O-grid's outer cells and the edge
 #   blocks' and sides' cells and grow towards the inlet, outlet and periodic lines; the
-#   periodic lines beside the sides `ends` (period_end, period_flat), so that their nodes
+#   periodic lines beside the sides `ends` (period_end, or period_follow times the sides'
+#   relative end cells, per layer; period_flat), so that their nodes
 #   lie at nearly the fractions of the sides' matched outer arcs (the H blocks between
 #   them are not sheared along the blade);
 # - coarsened (density multiplier below 1) the blocks keep at least min_pitch cells across
@@ -155,7 +156,18 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   tets (20 faces at density 1). Round and capped trailing edges keep the geometric mean
 #   (Rotor 37's and the distributor's wake and inlet edges shrink the same way, by up to 2.8
 #   and 4.8 from mean to smallest cell, and pass checkMesh; lowered too, the optimizer ended
-#   at 46.06 deg on Rotor 37, below its 47.0).
+#   at 46.06 deg on Rotor 37, below its 47.0). Since stop 18 (issue 10) the wake edge at a
+#   round, capped or sheared trailing edge is capped too (out_at_most_round 0.8), and the
+#   strip U_M's inlet edge at every leading edge (in_at_most 1): its matched end cells
+#   shrank its middle to 1.1 mm at the distributor's shroud against 31 mm along the axis
+#   and 39 mm of span, a row with two boundary faces (inlet, shroud) that checkMesh's cell
+#   determinant leaves out; the optimizer slid Rotor 37's b_in towards hi_in and left U_R's
+#   inlet cells 0.06-0.5 mm wide. With 12 cells from the O-grid to the inlet and outlet
+#   (n_up, n_down; 8 before) the inlet and outlet rows are 17 mm long instead of 31 on the
+#   distributor. H cells failing the determinant at density 1, placed / optimized:
+#   distributor 171 / 49 -> 78 / 31, Rotor 37 32 / 31 -> 24 / 10, compressor 180 / 129 ->
+#   180 / 109, turbine 21 / 8 -> 16 / 8; optimizer 47.40 / 47.38 / 23.25 / 34.63 deg ->
+#   48.28 / 47.09 / 23.39 / 38.94.
 # - at a sharp edge (a fan on the tip, on hub or shroud) the strip in front of it (U_M) and
 #   the wake strip behind it (D_M) widen towards the inlet / outlet to at least in_share /
 #   out_share (0.35) of the pitch, about their middle (a_in/b_in, a_out/b_out: the O corners'
@@ -200,8 +212,8 @@ parameters:
   upstream: 0.5           # inlet distance upstream of the first leading edge [blade axial lengths]
   downstream: 0.5         # outlet distance downstream of the last trailing edge [blade axial lengths]
   extend: 0               # extend hub and shroud along their end tangents by this fraction of their length (0: inlet/outlet stop at the contour ends when those are nearer)
-  n_up: 8                 # cells from inlet to the O-grid
-  n_down: 8               # cells from the O-grid to the outlet
+  n_up: 12                # cells from inlet to the O-grid (8 before stop 18: the match laws grow from the O-grid's outer cell by o_match to a uniform rest, and with 8 the inlet row was 31 mm long on the distributor against U_M's 4 mm across and 39 mm of span, failing checkMesh's cell determinant at the inlet, a boundary face it leaves out; with 12 it is 17 mm: see in_at_most)
+  n_down: 12              # cells from the O-grid to the outlet (likewise, 8 before)
   n_pitch: 6              # cells across each H column beside the O-grid
   min_pitch: 5            # coarsened (density multiplier below 1; min_cells) the H columns beside the O-grid keep at least this many cells across: from the O corner's small matched cell the match laws need a few cells to grow to the periodic line (3 cells at density 0.5: the distributor's U_M against U_R 2.54, the compressor's U_L against U_M 3.73)
   min_side: 12            # ... the blade sides at least this many cells along (9 at density 0.5: Rotor 37's long wall cells on its curved, twisted suction side fail checkMesh's face tets)
@@ -210,19 +222,22 @@ parameters:
   n_le: 10                # cells around the leading edge
   n_te: 10                # cells around the trailing edge
   n_side: 18              # cells along each blade side (16 left the turbine's grid at density 0.5 0.59 % off its volume: its sides' middle cells, between the O corners' small ones, chord its cambered O-grid sides)
-  n_o: 6                  # cells across the O-grid
+  n_o: 5                  # cells across the O-grid (6 before stop 18: with 5 and k_o 1.35 the O-grid's outer radial cell is 0.0100 chords instead of 0.0081, its wall cell 0.0030 instead of 0.0027; see k_o, period_follow)
   n_span: 12              # cells from hub to shroud
-  k_o: 1.25               # expansion ratio away from the blade in the O-grid: its outer cell (0.0081 chords; 0.0069 with 1.15) is what the H blocks beside it start with (`match`), and checkMesh's cell determinant fails H cells that thin against their length along the blade and the span (distributor M_L / M_R 104 / 81 -> 39 / 36 at density 1, placed); thicker still (1.3-1.4, or o_width 0.04-0.05) the optimizer ends at 41-45 deg on the distributor (the O corners' cells, the group cell of the arcs and H edges there, grow with it), 1.28-1.3 leave the compressor's optimized U_M with face tets
+  k_o: 1.35               # expansion ratio away from the blade in the O-grid (1.25 with n_o 6 before stop 18: see period_follow for the figures of 1.35 with n_o 5): its outer cell (0.0100 chords; 1.25 with n_o 6 0.0081, 1.15 0.0069) is what the H blocks beside it start with (`match`), and checkMesh's cell determinant fails H cells that thin against their length along the blade and the span (distributor M_L / M_R 104 / 81 -> 39 / 36 at density 1, placed); thicker still (1.3-1.4, or o_width 0.04-0.05) the optimizer ends at 41-45 deg on the distributor (the O corners' cells, the group cell of the arcs and H edges there, grow with it), 1.28-1.3 leave the compressor's optimized U_M with face tets
   k_span: 1.1             # expansion ratio away from hub and shroud (two-sided): the cells on hub and shroud have no face there to count in checkMesh's cell determinant, so a thin H cell beside the O-grid fails it sooner there (the distributor's M_L at the hub); shorter spanwise (1.1: 0.034 instead of 0.041 m on the distributor) fewer fail (H cells 193 -> 171 on the distributor, 48 -> 32 on Rotor 37), the optimizer's angles the same within 0.2 deg; 1.15 gives the compressor face tets
   side_arc_flat: 2        # the blade sides' O-grid arcs (law `match` from the O corners' cells, `flat`): between their small end cells the shape of the law `ends` with this flatness, not cells grown by o_match to a uniform middle (2.7 times the mean cell at density 0.5) ...
   period_end: 0.11        # ... and the periodic lines beside them (law `ends`): end cells this fraction of their mean cell (near the sides' arcs' end cells, which are the O-grid's outer radial cell: with k_o 1.25 and k_span 1.05 at 0.1 the optimizer ended at 44.6 deg on the distributor, at 0.11 47.7; 0.105 / 0.115 45.1 / 45.7 deg on the distributor / Rotor 37: the optimizer's end point moves by 2-3 deg with it) ...
-  period_flat: 3.0        # ... and that flat in between, so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
+  period_flat: 2.0        # ... and that flat in between (3 with period_end; 2 with period_follow, the sides' side_arc_flat), so that the H blocks between them are little sheared along the blade (0.07 with flat 1 beside sides grown by o_match: the optimizer ended at 37.5 deg on the distributor)
+  period_follow: 1.25     # ... or, above 0, the periodic lines' end cells this many times the sides' O arcs' end cells relative to their mean cell (the O-grid's outer radial cell over the side's length / n_side, per layer; period_end then unused), so that they follow a thicker O-grid: with o_width 0.045, k_o 1.4 the sides' arcs start from 0.25-0.29 of their mean cell against the periodic lines' 0.11, the H lines fan at the corners and the optimizer ended at 34.1 deg on the distributor, 43.7 on Rotor 37; with 1 (and period_flat 2, the sides' side_arc_flat) 46.1 / 47.5, H cells under checkMesh's determinant placed 16 / 4 / 18 / 0 (M_L, M_R: 0 on distributor and Rotor 37), but the turbine's O_te wall cells by its cap then have 12 faces under the interpolation weight (placed); at main's O-grid (k_o 1.25, n_o 6) 1 gave 42.8 / 44.1 deg (0.11 against 0.14-0.16 on the distributor's sides). Since stop 18 (issue 10) 1.25 with k_o 1.35, n_o 5, period_flat 2 (o_width 0.03): H cells failing the determinant at density 1 placed / optimized distributor 78 / 24 -> 27 / 2, Rotor 37 24 / 4 -> 3 / 0, compressor 180 / 67 -> 45 / 22, turbine 16 / 3 -> 1 / 0 (the optimizer's second search, main f8be49d); optimizer 48.28 / 47.12 / 23.55 / 40.54 -> 50.15 / 47.79 / 23.32 / 42.40 deg; neighbours (distributor / Rotor 37) period_follow 1.2 / 1.3 49.09 / 47.84, 49.81 / 46.87, k_o 1.33 / 1.37 46.28 / 48.08, 47.76 / 47.29 deg (a ridge like period_end's). A's thicker O-grid (o_width 0.04, k_o 1.35, n_o 5, period_follow 1.1: 47.58 deg with n_up 8) ends the distributor at 40-43 deg with n_up 12 whatever period_follow (M_L's corner at oa_r on the hub against M_R's by ob_f; Templates/README.md)
   in_share: 0.35          # at a sharp leading edge (a fan on the tip, o_fan, on hub or shroud) the upstream strip U_M's inlet edge spans at least this fraction of the pitch, widened about its middle (0: the O arc's width extended; the compressor's U_M 358 -> 19 failing determinant cells at density 1, placed; 0.25: 48, 0.45: 15 but U_L 38 -> 43) ...
   out_share: 0.35         # ... and at a sharp trailing edge the wake strip D_M's outlet edge (compressor's D_M 215 -> 3)
   in_share_round: 0       # the same at round, capped or sheared edges (0: the O arc's width extended, as before; 0.12-0.35 ended the optimizer at 43.0-46.9 deg on the distributor and Rotor 37, under their 47.0; 0.1 changes only the distributor's shroud, 47.24) ...
   out_share_round: 0      # ... and at their trailing edges
   o_match: 2.0            # `match` law (O-grid arcs, H blocks): cells grow by at most this from cell to cell away from an interface
-  wake_at_most: 1         # at a sharp trailing edge (its edge block a fan, o_fan) the wake block's outlet edge starts from cells at most this many times its mean cell (law `match`, at_most), and D_L's and D_R's outlet edges grow from those: matched as the other edges (the geometric mean of the three edges' mean cells) the compressor's outlet cells were 1.0 mm at D_M's ends and 0.084 mm in its middle (mean 0.39 mm), 80 times longer than wide, twisted along the span: checkMesh's face tets (0: no limit)
+  in_at_most: 1           # the upstream strip U_M's inlet edge: its end cells at most this many times its mean cell (law `match`, at_most; 0: no limit), and U_L's and U_R's inlet edges grow from those. Matched to one another alone, the three inlet edges started U_M's from the geometric mean of their mean cells (U_L's and U_R's six across a pitch) and shrank it towards its middle: the distributor's inlet cells 10.9 mm at U_M's ends and 1.1 mm in its middle at the shroud (mean 4 mm) against 31 mm along the axis and 39 mm of span failed checkMesh's cell determinant (U_M 71 cells placed); and the optimizer, which moves the inlet points, slid Rotor 37's b_in towards hi_in, U_R's inlet edge 1.3 mm long at the hub, its cells 0.06-0.5 mm (U_R 26 cells optimized)
+  out_at_most_round: 0.8  # ... the same for the wake strip D_M's outlet edge at a round, capped or sheared trailing edge (wake_cap; 0: no limit, as before stop 18; 1 ended the optimizer at 46.88 / 45.03 deg on the distributor / Rotor 37, 1.5 at 46.58 deg on the distributor: its end point moves with it, see period_end) ...
+  wake_at_most: 1         # ... and at a sharp one: at a sharp trailing edge (its edge block a fan, o_fan) the wake block's outlet edge starts from cells at most this many times its mean cell (law `match`, at_most), and D_L's and D_R's outlet edges grow from those: matched as the other edges (the geometric mean of the three edges' mean cells) the compressor's outlet cells were 1.0 mm at D_M's ends and 0.084 mm in its middle (mean 0.39 mm), 80 times longer than wide, twisted along the span: checkMesh's face tets (0: no limit)
 """
 
 FOOTER = """blocks:
@@ -231,10 +246,10 @@ FOOTER = """blocks:
   O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
   O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, 1], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {two_sided: k_span}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
   U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
-  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: {i: end_widths, j: adaptive}}
+  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E1: {match: o_match, at_most: in_at_most}, E5: {match: o_match, at_most: in_at_most}}}, interpolation: {i: end_widths, j: adaptive}}
   U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
-  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end, period_end], flat: period_flat}, E8: {ends: [period_end, period_end], flat: period_flat}}}}
-  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end, period_end], flat: period_flat}, E6: {ends: [period_end, period_end], flat: period_flat}}}}
+  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E4: {ends: [period_end_h, period_end_h], flat: period_flat}, E8: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
+  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {two_sided: k_span}, edges: {E2: {ends: [period_end_h, period_end_h], flat: period_flat}, E6: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
   D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
   D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}, edges: {E3: {match: o_match, at_most: wake_cap}, E7: {match: o_match, at_most: wake_cap}}}, interpolation: {i: end_widths, j: adaptive}}
   D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {two_sided: k_span}}, interpolation: end_cells}
@@ -421,7 +436,17 @@ def template_text():
         gap('ogap_le', 'ob_f', 'oa_f'); gap('ogap_a', 'oa_f', 'oa_r'); gap('ogap_te', 'oa_r', 'ob_r'); gap('ogap_b', 'ob_r', 'ob_f')
     for e in ('le', 'te'):
         w(f'  shear_{e}: "({e}_shear_h || {e}_shear_s) && round_{e}_h && round_{e}_s && {e}_ty_h*{e}_ty_s > 0"      # 1: the corners at this edge are sheared (both layers)')
-    w('  wake_cap: "off_te_h && off_te_s ? 0 : wake_at_most"      # the wake block\'s outlet edge: its end cells at most this many times its mean cell (0: no limit) where the trailing edge is sharp on hub or shroud (a fan on the tip)')
+    w('  wake_cap: "off_te_h && off_te_s ? out_at_most_round : wake_at_most"      # the wake block\'s outlet edge: its end cells at most this many times its mean cell (0: no limit), wake_at_most where the trailing edge is sharp on hub or shroud (a fan on the tip)')
+    # the periodic lines' end cells (law `ends`, relative to their mean cell): period_end, or
+    # with period_follow the O-grid's outer radial cell (geometric k_o over n_o cells, the
+    # cell the sides' O arcs start from) over the sides' mean cell (their length, a polyline
+    # through the O corners and the sides' mid-points, over n_side), times period_follow
+    w('  o_cell: "abs(k_o - 1) < 1e-9 ? 1/n_o : (k_o - 1)*k_o^(n_o - 1)/(k_o^n_o - 1)"      # the O-grid\'s outer radial cell, fraction of its width')
+    d3 = lambda p, q: f'sqrt(({p}.x - {q}.x)^2 + ({p}.y - {q}.y)^2 + ({p}.z - {q}.z)^2)'
+    for l in L:
+        sa = f'({d3(f"oa_f_{l}", f"oa_m_{l}")} + {d3(f"oa_m_{l}", f"oa_r_{l}")})'
+        sb = f'({d3(f"ob_f_{l}", f"ob_m_{l}")} + {d3(f"ob_m_{l}", f"ob_r_{l}")})'
+        w(f'  period_end_{l}: "period_follow > 0 ? period_follow*o_width*chord_{l}*o_cell*n_side*(1/{sa} + 1/{sb})/2 : period_end"      # the periodic lines\' end cells over their mean cell')
     w('')
     w('carriers:')
     w('  hub: {revolve: hub, axis: machine, extend: extend}')
