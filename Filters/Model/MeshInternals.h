@@ -216,22 +216,6 @@ inline double endCell(const UniqueEdge& edge, int end)
 /// ends decide, so a projected edge takes its source's nodes in the right order.
 bool runsAgainst(const BlockModel& model, const UniqueEdge& edge, const UniqueEdge& source);
 /**
- * EXPERIMENT (stop 18, helper D; reverted in the next commit, kept for the record): feet
- * bunched inside a projected edge (`params`, its node parameters, 0 to 1): where the outer
- * nodes round a convex corner of the blade (the turbine's cap corners) all have their
- * normal feet on the corner, a run of cells inside the edge is each narrower than a fifth
- * of both cells beside it (turbine O_te: 0.002-0.003 mm between 0.06 and 0.3 mm). The run
- * is spread round its middle node: cell sizes d + 0.5 |x - corner| until they meet the
- * projected cells, d such that they fill the nodes in between. It removes the turbine's
- * interpolation-weight faces placed (A's setting: 1 / 46 -> 0 / 0 at densities 2 / 4) but
- * the fan's feet moved off the corner shear its wall cells by the fan's angle (the O-corner
- * foot lies 0.06-0.08 mm before the cap corner, so the fan spreads onto the cap): defaults
- * at density 1 O_te|D_M 1.40 -> 1.75, at density 2 min angle 24.5 -> 21.6, optimized
- * 40.4 -> 29.1 deg with 8 weak faces. A one-sided ramp did the same (min angle 17.9 at
- * density 4, face tets optimized).
- */
-void spreadFootBunches(std::vector<double>& params);
-/**
  * Node parameters of projected edge `e`: the closest points on its curve of the interior
  * nodes of the edge it projects from (whose parameters must be current), as arc-length
  * fractions; fails naming both edges when their cell counts differ or the projections are

@@ -176,94 +176,6 @@ constexpr double FanSideRatio = 1.35;
 /// between cells whose centres lie more than 19 times as far from their face.
 constexpr double FanSideGrowth = 10.0;
 
-/// A run of feet inside an edge narrower each than this fraction of both cells beside it
-/// is a bunch (spreadFootBunches) ...
-constexpr double bunchFloor = 0.2;
-/// ... spread round its middle node (the corner): the cells grow from it by at most this
-/// from one to the next (issue 8's neighbour ratio) until they meet the projected ones.
-constexpr double bunchGrowth = 1.5;
-
-} // namespace
-
-void spreadFootBunches(std::vector<double>& params)
-{
-  const int cells = static_cast<int>(params.size()) - 1;
-  if (cells < 4)
-  {
-    return;
-  }
-  const auto width = [&](int i) { return params[i + 1] - params[i]; };
-  const double k = bunchGrowth - 1.0; // the cell size grows by k times the distance
-  for (int s = 1; s + 1 < cells;)
-  {
-    const double before = width(s - 1);
-    if (!(width(s) < bunchFloor * before))
-    {
-      ++s;
-      continue;
-    }
-    int e = s;
-    double widest = width(s);
-    while (e + 2 < cells && width(e + 1) < bunchFloor * before)
-    {
-      ++e;
-      widest = std::max(widest, width(e));
-    }
-    if (!(widest < bunchFloor * width(e + 1)))
-    {
-      ++s; // a narrower run may start inside it (a valley within a valley)
-      continue;
-    }
-    // The corner: the run's middle node. Cell sizes d + k |x - corner| from it, where
-    // they are below the projected cells: from the last node on either side whose
-    // projected cell (away from the corner) is still within them, or the edge's end.
-    const int middle = s + (e - s + 1) / 2;
-    const double corner = params[middle];
-    const auto size = [&](double d, double x) { return d + k * std::abs(x - corner); };
-    const auto landings = [&](double d, int& left, int& right) {
-      right = e + 1;
-      while (right < cells && width(right) > size(d, params[right]))
-      {
-        ++right;
-      }
-      left = s;
-      while (left > 0 && width(left - 1) > size(d, params[left]))
-      {
-        --left;
-      }
-    };
-    // cells the sizes give from `corner` to x (negative before it)
-    const auto count = [&](double d, double x) {
-      const double n = std::log(size(d, x) / d) / k;
-      return x < corner ? -n : n;
-    };
-    // the corner cell d for which the sizes give as many cells as the nodes span
-    double low = 1e-9 * (params[cells] - params[0]), high = std::max(before, width(e + 1));
-    for (int round = 0; round < 100; ++round)
-    {
-      const double d = std::sqrt(low * high);
-      int left = 0, right = 0;
-      landings(d, left, right);
-      (count(d, params[right]) - count(d, params[left]) > right - left ? low : high) = d;
-    }
-    const double d = high;
-    int left = 0, right = 0;
-    landings(d, left, right);
-    const double from = count(d, params[left]), to = count(d, params[right]);
-    const double start = params[left], end = params[right];
-    for (int i = left + 1; i < right; ++i)
-    {
-      const double n = from + (to - from) * (i - left) / (right - left);
-      const double x = corner + (n < 0.0 ? -1.0 : 1.0) * d * (std::exp(k * std::abs(n)) - 1.0) / k;
-      params[i] = std::min(std::max(x, start), end);
-    }
-    s = std::max(right, s + 1);
-  }
-}
-
-namespace
-{
-
 /// The end cell length of `edge` at vertex `v` (one of its ends).
 double cellAtVertex(const UniqueEdge& edge, int v)
 {
@@ -713,7 +625,6 @@ void projectEdgeParameters(const BlockModel& model, const std::vector<NamedCurve
   widenTip([&](int i) { return params[i]; }, [&](int i, double v) { params[i] = v; });
   widenTip([&](int i) { return 1.0 - params[n - 1 - i]; },
     [&](int i, double v) { params[n - 1 - i] = 1.0 - v; });
-  spreadFootBunches(params);
   const DistributionLaw law = lawAlongEdge(model, edge, use);
   if (law.fadeStart > 0.0 || law.fadeEnd > 0.0)
   {
