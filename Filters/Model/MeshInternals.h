@@ -216,6 +216,27 @@ inline double endCell(const UniqueEdge& edge, int end)
 /// ends decide, so a projected edge takes its source's nodes in the right order.
 bool runsAgainst(const BlockModel& model, const UniqueEdge& edge, const UniqueEdge& source);
 /**
+ * Feet bunched on a convex corner inside a projected edge (`params`, its node parameters, 0
+ * to 1; `feet` and `outer`, the projected feet and the source's nodes, the edge's ends
+ * included). Round a cap's corner (any blunt or capped edge) the outer nodes on the O
+ * curve's arc round it all have their normal feet on the corner: a fan of lines whose
+ * wall cells are slivers (the turbine's O_te and O_a: 0.002-0.003 mm between 0.06 mm of
+ * flank and 0.3 mm of cap), and checkMesh's interpolation weight fails between them and
+ * the next cells (turbine, template candidate of stop 18: 1 / 46 faces at densities 2 / 4
+ * placed; defaults 7 at 4, 14 / 6 optimized at 2 / 4). A run of cells each narrower than
+ * a fifth of both cells beside it is spread round the corner: the run's node whose line
+ * (foot to outer node) lies most nearly along the corner's bisector stays on the corner,
+ * the nodes before it go before it and those after it after it (spread all to one side,
+ * the fan's lines lie along the wall there: min angle 24.5 -> 17.9 deg, face tets), the
+ * cells growing from the corner by 1.5 (d + 0.5 |x - corner|, and no more than the
+ * landing cell plus 0.5 times the distance to it) until they meet the projected cells,
+ * d such that they fill the nodes in between. Where that still leaves cells more than
+ * FanSideGrowth (10) apart (too few cells: the turbine's cap at density 1), the feet stay
+ * as projected. Nodes outside a spread run keep their bits.
+ */
+void spreadFootBunches(std::vector<double>& params, const std::vector<Vec3>& feet,
+  const std::vector<Vec3>& outer);
+/**
  * Node parameters of projected edge `e`: the closest points on its curve of the interior
  * nodes of the edge it projects from (whose parameters must be current), as arc-length
  * fractions; fails naming both edges when their cell counts differ or the projections are

@@ -13,8 +13,12 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 using namespace blockforge;
 using namespace blockforge::model;
@@ -821,5 +825,110 @@ TEST(ProjectedEdges, FeetBesideAFanGrowFromItsWallCell)
     EXPECT_LT(side[0] / fan, 1.5);
     EXPECT_GT(side[0] / fan, 1.2);
     expectFeetRampToTheNormalFeet(grid, side, true);
+  }
+}
+
+namespace
+{
+/**
+ * A blunt corner: the blade's flank y = 0 from x = -1 meets its cap x = 0 (down to y = -1)
+ * round a corner of radius 0.01 about (-0.01, -0.01), the blade edge a spline through
+ * points of it from a = (-1, 0) to b = (0, -1); the outer edge is the same path offset by
+ * 0.3 (radius 0.31 round the corner), graded evenly, and the blade edge is projected from
+ * it. Symmetric about the line x = y. The outer nodes on the 0.31 arc have their normal
+ * feet on the 0.01 one: projected alone, those cells are 0.05 (density 1) to 0.04
+ * (density 4) of the cells beside them, a fan of lines from the corner.
+ */
+std::string bluntCorner()
+{
+  const auto path = [](double offset) {
+    const double r = 0.01 + offset;
+    std::vector<std::pair<double, double>> points;
+    for (const double x : { -0.75, -0.5, -0.25, -0.1 })
+    {
+      points.push_back({ x, offset });
+    }
+    for (int degrees = 90; degrees >= 0; degrees -= 15)
+    {
+      const double t = degrees * std::acos(-1.0) / 180.0;
+      points.push_back({ -0.01 + r * std::cos(t), -0.01 + r * std::sin(t) });
+    }
+    for (const double y : { -0.1, -0.25, -0.5, -0.75 })
+    {
+      points.push_back({ offset, y });
+    }
+    return points;
+  };
+  const auto list = [](const std::vector<std::pair<double, double>>& points, const char* z) {
+    std::string text;
+    char buffer[96];
+    for (const auto& [x, y] : points)
+    {
+      std::snprintf(buffer, sizeof buffer, "%s[%.17g, %.17g, %s]", text.empty() ? "" : ", ", x, y, z);
+      text += buffer;
+    }
+    return text;
+  };
+  std::string text = "blockforge: 1\nvertices:\n";
+  for (const char* z : { "0", "1" })
+  {
+    const std::string k = z;
+    text += "  a" + k + ": [-1, 0, " + k + "]\n  b" + k + ": [0, -1, " + k + "]\n  c" + k +
+      ": [0.3, -1, " + k + "]\n  d" + k + ": [-1, 0.3, " + k + "]\n";
+  }
+  text += "edges:\n";
+  for (const char* z : { "0", "1" })
+  {
+    const std::string k = z;
+    text += "  blade" + k + ": {spline: [a" + k + ", b" + k + "], points: [" + list(path(0.0), z) + "]}\n" +
+      "  outer" + k + ": {spline: [d" + k + ", c" + k + "], points: [" + list(path(0.3), z) + "]}\n";
+  }
+  text += "blocks:\n"
+          "  W: {vertices: [a0, b0, c0, d0, a1, b1, c1, d1], cells: [12, 4, 1], grading: "
+          "{j: {geometric: 1.3}, edges: {E1: {project_from: outer0}, E5: {project_from: outer1}}}}\n";
+  return text;
+}
+} // namespace
+
+TEST(ProjectedEdges, FeetBunchedRoundABluntCornerAreSpreadRoundIt)
+{
+  // The feet bunched on the corner (spreadFootBunches) are spread round it: the run's node
+  // whose outer node lies along the corner's bisector stays on the corner, the others go
+  // to either side, the cells growing from the corner by about 1.5 until they meet the
+  // projected ones. No wall cell is then under a fifth of both its neighbours (projected
+  // alone: 0.05 / 0.04 / 0.04 of them at densities 1 / 2 / 4, as the turbine's cap
+  // corners: 0.003 mm between 0.06 and 0.3 mm, where checkMesh's interpolation weight
+  // failed); the feet stay symmetric, one stays on the corner, and the grid does not fold.
+  const BlockModel model = parseTemplate(bluntCorner(), "blunt.yaml");
+  for (const double density : { 1.0, 2.0, 4.0 })
+  {
+    SCOPED_TRACE(density);
+    const test::Grid grid = test::meshAll(model, density);
+    const int n = grid.nodes[0][0];
+    std::vector<double> cells;
+    for (int i = 0; i + 1 < n; ++i)
+    {
+      cells.push_back((node(grid, 0, i + 1, 0, 0) - node(grid, 0, i, 0, 0)).norm());
+    }
+    // the foot on the corner (the middle one, by symmetry), and the cells on either side
+    const int c = n / 2;
+    const Vec3 corner(-0.01 + 0.01 * std::sqrt(0.5), -0.01 + 0.01 * std::sqrt(0.5), 0.0);
+    EXPECT_LT((node(grid, 0, c, 0, 0) - corner).norm(), 0.002);
+    std::printf("density %g: cells from the corner %.4g %.4g %.4g (%.4g at the edge's middle)\n",
+      density, cells[c], cells[c + 1], cells[c + 2], cells[n / 4]);
+    // spread: the corner's cells at least a fifth of the next ones (projected alone: 0.04)
+    // and of the flank's cells, the run beside it within 2 from cell to cell
+    EXPECT_GT(cells[c] / cells[c + 1], 0.2);
+    EXPECT_LT(cells[c] / cells[c + 1], 5.0);
+    EXPECT_GT(cells[c + 1] / cells[c + 2], 0.5);
+    EXPECT_LT(cells[c + 1] / cells[c + 2], 2.0);
+    EXPECT_GT(cells[c] / cells[n / 4], 0.1);
+    for (int i = 1; i + 1 < n; ++i)
+    {
+      const Vec3 foot = node(grid, 0, i, 0, 0);
+      const Vec3 mirror = node(grid, 0, n - 1 - i, 0, 0);
+      EXPECT_NEAR(foot.x(), mirror.y(), 1e-9) << i;
+      EXPECT_NEAR(foot.y(), mirror.x(), 1e-9) << i;
+    }
   }
 }
