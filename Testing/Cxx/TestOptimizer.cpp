@@ -814,7 +814,9 @@ TEST(FaceChecks, CountsTheCellsCheckMeshFailsByDeterminant)
       expected += determinant < MinimumCellDeterminant ? 1 : 0;
     }
   }
-  EXPECT_GT(expected, 100);
+  // (a count to compare, not a figure to hold: 309 at stop 17; a thicker O-grid outer cell
+  // leaves 74)
+  EXPECT_GT(expected, 50);
   EXPECT_EQ(failingCellCount(blocks, periodic), expected);
 }
 
