@@ -131,12 +131,15 @@ DETERMINANT_LIMIT = 1e-3
 # optimizer refuses trials with more failing cells (all blocks) than its start (stop 17,
 # FaceChecks), its searches take other paths: optimized H cells 41 / 34 / 146 / 7 -> 49 /
 # 31 / 129 / 8 (all cells 474 / 311 / 1036 / 388 -> 483 / 309 / 925 / 355, placed 638 /
-# 309 / 942 / 362).
+# 309 / 942 / 362). Stop 18: U_M's inlet edge and the wake edge capped at their mean cell
+# (`in_at_most`, `out_at_most_round`), 12 cells up- and downstream, and the optimizer's
+# second search for fewer failing cells away from walls: placed 78 / 24 / 180 / 16,
+# optimized 24 / 4 / 67 / 3.
 H_DETERMINANT_AT_MOST = {
-    "axial_passage_oh_distributor": 171, "axial_passage_oh_rotor37": 32,
-    "axial_passage_oh_compressor": 180, "axial_passage_oh_turbine": 21,
-    "axial_passage_oh_distributor_optimized": 49, "axial_passage_oh_rotor37_optimized": 31,
-    "axial_passage_oh_compressor_optimized": 129, "axial_passage_oh_turbine_optimized": 8,
+    "axial_passage_oh_distributor": 78, "axial_passage_oh_rotor37": 24,
+    "axial_passage_oh_compressor": 180, "axial_passage_oh_turbine": 16,
+    "axial_passage_oh_distributor_optimized": 24, "axial_passage_oh_rotor37_optimized": 4,
+    "axial_passage_oh_compressor_optimized": 67, "axial_passage_oh_turbine_optimized": 3,
 }
 
 # The OpenFOAM patch type of every patch the writer writes, from the template's types
