@@ -215,11 +215,12 @@ void spreadFootBunches(std::vector<double>& params, const std::vector<Vec3>& fee
       ++s; // a narrower run may start inside it (a valley within a valley)
       continue;
     }
-    // The corner: the run's middle node. Cell sizes d + k |x - corner| from it, where
-    // they are below the projected cells: from the last node on either side whose
-    // projected cell (away from the corner) is still within them, or the edge's end.
-    // the run's node whose outer node lies most nearly along the corner's bisector (the
-    // fan's middle line) stays on the corner, the ones before it go before it
+    // The corner: the run's node whose line (foot to outer node) lies most nearly along
+    // the corner's bisector (the fan's middle line; the run's middle node without feet and
+    // outer nodes) stays on it, the ones before it go before it. Cell sizes d + k |x -
+    // corner| from it, where they are below the projected cells: from the last node on
+    // either side whose projected cell (away from the corner) is still within them, or the
+    // edge's end.
     int middle = s + (e - s + 1) / 2;
     if (feet.size() == params.size() && outer.size() == params.size())
     {

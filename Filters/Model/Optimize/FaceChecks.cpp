@@ -251,13 +251,16 @@ BlockCells::BlockCells(
         for (int d = 0; d < 3; ++d)
         {
           const int e[3] = { d == 0, d == 1, d == 2 };
+          const int first = d == 0 ? 1 : 0, second = d == 2 ? 1 : 2; // the other two directions
           lengths3[d] = 0.0;
           for (int a = 0; a < 2; ++a)
           {
             for (int b = 0; b < 2; ++b)
             {
-              // the edge along d at offsets (a, b) in the other two directions
-              const int o[3] = { d == 0 ? 0 : a, d == 0 ? a : (d == 1 ? 0 : b), d == 2 ? 0 : b };
+              // the edge along d at offsets a, b along the other two directions
+              int o[3] = { 0, 0, 0 };
+              o[first] = a;
+              o[second] = b;
               lengths3[d] += (node(i + o[0] + e[0], j + o[1] + e[1], k + o[2] + e[2]) -
                 node(i + o[0], j + o[1], k + o[2])).norm();
             }

@@ -64,6 +64,9 @@ struct SearchState
   SearchResult* result = nullptr;
   double bestObjective = 0.0;
   double angleAllowance = 0.0;
+  /// What a better configuration must not be worse than (notWorse): the start, its
+  /// smallest angle lowered by angleAllowance; set with the start.
+  GridMeasures reference;
 
   std::vector<double> toModel(const std::vector<double>& u) const
   {
@@ -79,14 +82,6 @@ struct SearchState
   {
     GridMeasures measures = (*evaluate)(x);
     SearchResult& out = *result;
-    GridMeasures reference;
-    if (out.evaluations > 0)
-    {
-      reference.feasible = out.start.feasible;
-      reference.invertedCells = out.start.invertedCells;
-      reference.minAngle = out.start.minAngle - angleAllowance;
-      reference.maxNonOrthogonality = out.start.maxNonOrthogonality;
-    }
     ++trials;
     HistoryEntry entry;
     entry.evaluation = ++out.evaluations;
@@ -102,6 +97,10 @@ struct SearchState
       out.bestMeasures = measures;
       out.best = x;
       bestObjective = measures.objective;
+      reference.feasible = measures.feasible;
+      reference.invertedCells = measures.invertedCells;
+      reference.minAngle = measures.minAngle - angleAllowance;
+      reference.maxNonOrthogonality = measures.maxNonOrthogonality;
     }
     else if (measures.feasible && measures.objective < bestObjective &&
       notWorse(measures, reference, kind))
