@@ -445,8 +445,11 @@ def template_text():
     w('  o_cell: "abs(k_o - 1) < 1e-9 ? 1/n_o : (k_o - 1)*k_o^(n_o - 1)/(k_o^n_o - 1)"      # the O-grid\'s outer radial cell, fraction of its width')
     d3 = lambda p, q: f'sqrt(({p}.x - {q}.x)^2 + ({p}.y - {q}.y)^2 + ({p}.z - {q}.z)^2)'
     for l in L:
-        sa = f'({d3(f"oa_f_{l}", f"oa_m_{l}")} + {d3(f"oa_m_{l}", f"oa_r_{l}")})'
-        sb = f'({d3(f"ob_f_{l}", f"ob_m_{l}")} + {d3(f"ob_m_{l}", f"ob_r_{l}")})'
+        # (through the corners' and mid-points' fixed twins, where the template placed them: a
+        # grading follows no moves, so one of the moved corners would leave the live model's
+        # grid other than the template's with the corner given there, TestMeshPlan)
+        sa = f'({d3(f"oa_f0_{l}", f"oa_m0_{l}")} + {d3(f"oa_m0_{l}", f"oa_r0_{l}")})'
+        sb = f'({d3(f"ob_f0_{l}", f"ob_m0_{l}")} + {d3(f"ob_m0_{l}", f"ob_r0_{l}")})'
         w(f'  period_end_{l}: "period_follow > 0 ? period_follow*o_width*chord_{l}*o_cell*n_side*(1/{sa} + 1/{sb})/2 : period_end"      # the periodic lines\' end cells over their mean cell')
     w('')
     w('carriers:')
@@ -528,7 +531,11 @@ def template_text():
                 w(f'  kb{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{limb}", fixed: true}}')
                 w(f'  rb{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"kb{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
                 corner = f'(shear_{e} ? {corner} : {distance2(f"rb{b}_{l}")})'
-            w(f'  {v}_{l}: {{on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {corner} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}}}')
+            rule = f'on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {corner} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}'
+            w(f'  {v}_{l}: {{{rule}}}')
+            # its twin where the template placed it (fixed: the optimizer does not move it),
+            # for what must not follow the corner's moves (period_end_*)
+            w(f'  {v}0_{l}: {{{rule}, fixed: true}}')
             # the foot's source: the corner; with o_fan_prisms (the default), at a sharp edge's
             # fan (fan_{e}) the O curve's point off the tip (both feet then one point: the fan's
             # blade arc collapses into the tip, its wall cells prisms). That point is a search
@@ -554,6 +561,11 @@ def template_text():
         w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "shear_le || shear_te ? fb_r_{l}.s + dir_{l}*({gb} - rint({gb} - 0.5))/2 : le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
         w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')
         w(f'  ob_m_{l}: {{project: b_m_{l}, onto: o_{l}}}')
+        # their twins where the template placed them (fixed), for period_end_*
+        for side, at in (('a', f"shear_le || shear_te ? fa_f_{l}.s + dir_{l}*({ga} - rint({ga} - 0.5))/2 : le_{l}.s + dir_{l}*side_a_{l}/2"),
+                         ('b', f"shear_le || shear_te ? fb_r_{l}.s + dir_{l}*({gb} - rint({gb} - 0.5))/2 : le_{l}.s - dir_{l}*(1 - side_a_{l})/2")):
+            w(f'  {side}_m0_{l}: {{on_curve: blade_{l}, at: "{at}", fixed: true}}')
+            w(f'  o{side}_m0_{l}: {{project: {side}_m0_{l}, onto: o_{l}, fixed: true}}')
         w(f'  # mid-passage points between side a and the side b of the blade one pitch below')
         # (at a sharp edge lo_f / lo_r leave the middle across it: {e}_turn above)
         for f in ('f', 'm', 'r'):

@@ -507,22 +507,21 @@ TEST(OptimizerPassage, RejectedTrialsPutBackGiveTheSameSearch)
   // moved back by the next evaluation: every evaluation, the steps and the result the same,
   // bit for bit, on the O-grid with distribution skews (laws the plan does not keep;
   // without putting those back the distributor's search differs within these 300
-  // evaluations). axial_passage_oh grades no direction `ends` on all four edges away from
-  // the periodic faces any more (its O arcs `match`), so its spanwise laws are made
-  // `ends` here: the O blocks and the edge H blocks get spanwise skews.
+  // evaluations). axial_passage_oh's spanwise laws are `ends` in every block (since stop
+  // 19: end-wall layers), so the O blocks and the edge H blocks have spanwise skews.
   Loaded loaded;
   {
     const model::TemplateInputs inputs = test::readTemplateInputs(
       std::string(BLOCKFORGE_SOURCE_DIR) + "/Data/distributor/BladeGen.inf");
-    std::string text = test::readText(test::templatePath("axial_passage_oh.yaml"));
-    const std::string twoSided = "k: {two_sided: k_span}", ends = "k: {ends: [0.75, 0.75]}";
-    int replaced = 0;
-    for (std::size_t at = text.find(twoSided); at != std::string::npos;
-         at = text.find(twoSided, at + ends.size()), ++replaced)
+    const std::string text = test::readText(test::templatePath("axial_passage_oh.yaml"));
+    const std::string ends = "k: {ends: [span_end, span_end]";
+    int spanwiseEnds = 0;
+    for (std::size_t at = text.find(ends); at != std::string::npos;
+         at = text.find(ends, at + ends.size()))
     {
-      text.replace(at, twoSided.size(), ends);
+      ++spanwiseEnds;
     }
-    ASSERT_EQ(replaced, 12); // every block's spanwise direction
+    ASSERT_EQ(spanwiseEnds, 12); // every block's spanwise direction
     loaded.model =
       model::parseTemplate(text, "axial_passage_oh.yaml", {}, &inputs, &loaded.geometry);
   }
