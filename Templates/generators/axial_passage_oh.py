@@ -194,6 +194,7 @@ machine: {theta_zero: sections}   # theta = 0 through the blade, so the passage 
 
 parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
+  o_width_sharp: 0.04     # (stop 19) ... this on a layer where an edge's camber is staggered beyond 90 deg - o_shear but the edge is sharp (its edge block a fan, o_fan), so that the corners there cannot be sheared: the H rows across the passage then meet the blade at about 90 deg - stagger (the compressor's shroud: 16-25 deg), and the H cells beside the O-grid, matched to its outer cell along those rows, are that sine thinner across: checkMesh's cell determinant (compressor H cells at density 1 placed / optimized 27 / 2 -> ...). Decided on the probe curve o0 (the O curve at o_width from fixed helpers); 0: o_width everywhere
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction ...
   o_corner_fan: 65deg     # ... this far at a sharp edge whose edge block is a fan on the tip (o_fan): further round, so that the H blocks beside the blade keep an open corner there
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
@@ -219,6 +220,7 @@ parameters:
   min_side: 12            # ... the blade sides at least this many cells along (9 at density 0.5: Rotor 37's long wall cells on its curved, twisted suction side fail checkMesh's face tets)
   min_up: 8               # ... the upstream and downstream blocks at least these many from the O-grid to the inlet and outlet: the match laws grow from the O-grid's outer cell by at most o_match only with that many (4 at density 0.5: by 2.75 on Rotor 37, whose wake block's long last cells fail face tets at the outlet)
   min_down: 8
+  min_span: 8             # ... and every block at least this many cells from hub to shroud (stop 19). At density 0.5 (6 cells with the spanwise law `ends` 0.5 flat 2, the middle ones 1.3 times the mean) the compressor's wall cells beside its fans (O_b i 2, k 2-3) failed checkMesh's face tets: the twisted blade warps a wall cell's outer face by +-0.26 mm over its 7.8 mm along the blade and 16.5 mm of span, against a wall cell 0.53 mm thick, whose radial line leans 35 deg where the side's feet are graded up from the fan (rampFeet); warp grows with the cell's area, the wall cell only with the O-grid's width over its fewer cells. With 8: no face tets, compressor H cells under the determinant at density 0.5 placed / optimized 24 / 16 -> 8 / 5
   n_le: 10                # cells around the leading edge
   n_te: 10                # cells around the trailing edge
   n_side: 18              # cells along each blade side (16 left the turbine's grid at density 0.5 0.59 % off its volume: its sides' middle cells, between the O corners' small ones, chord its cambered O-grid sides)
@@ -242,18 +244,18 @@ parameters:
 """
 
 FOOTER = """blocks:
-  O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_le_h}, E5: {project_from: ol_le_s}}}}
-  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, 1], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_a_h}, E5: {project_from: ol_a_s}}}}
-  O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
-  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, 1], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
-  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
-  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {match: o_match, at_most: in_at_most}, E5: {match: o_match, at_most: in_at_most}}}, interpolation: {i: end_widths, j: adaptive}}
-  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
-  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E4: {ends: [period_end_h, period_end_h], flat: period_flat}, E8: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
-  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, 1], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E2: {ends: [period_end_h, period_end_h], flat: period_flat}, E6: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
-  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
-  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E3: {match: o_match, at_most: wake_cap}, E7: {match: o_match, at_most: wake_cap}}}, interpolation: {i: end_widths, j: adaptive}}
-  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, 1], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
+  O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], min_cells: [1, 1, min_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_le_h}, E5: {project_from: ol_le_s}}}}
+  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, min_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_a_h}, E5: {project_from: ol_a_s}}}}
+  O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], min_cells: [1, 1, min_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
+  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, min_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
+  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
+  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {match: o_match, at_most: in_at_most}, E5: {match: o_match, at_most: in_at_most}}}, interpolation: {i: end_widths, j: adaptive}}
+  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
+  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, min_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E4: {ends: [period_end_h, period_end_h], flat: period_flat}, E8: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
+  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, min_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E2: {ends: [period_end_h, period_end_h], flat: period_flat}, E6: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
+  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
+  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E3: {match: o_match, at_most: wake_cap}, E7: {match: o_match, at_most: wake_cap}}}, interpolation: {i: end_widths, j: adaptive}}
+  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
 
 faces:
   hub_faces: {on_surface: hub, faces: [O_le.k0, O_a.k0, O_te.k0, O_b.k0, U_L.k0, U_M.k0, U_R.k0, M_L.k0, M_R.k0, D_L.k0, D_M.k0, D_R.k0]}
@@ -348,6 +350,14 @@ def template_text():
             fy0 = f'rm_{l}*({e}f_{l}.theta - (pfa_{e}_{l}.theta + pfb_{e}_{l}.theta)/2)'
             w(f'  {e}_fux_{l}: "({fx0})/sqrt(({fx0})^2 + ({fy0})^2)"      # camber direction at the edge, from fixed helpers')
             w(f'  {e}_fuy_{l}: "({fy0})/sqrt(({fx0})^2 + ({fy0})^2)"')
+            # its normal towards side a (fixed helpers; for the probe curve o0's corners)
+            ax = f'(pfa_{e}_{l}.axial - pfb_{e}_{l}.axial)'
+            ay = f'(rm_{l}*(pfa_{e}_{l}.theta - pfb_{e}_{l}.theta))'
+            ux, uy = f'{e}_fux_{l}', f'{e}_fuy_{l}'
+            vx0 = f'({ax} - ({ax}*{ux} + {ay}*{uy})*{ux})'
+            vy0 = f'({ay} - ({ax}*{ux} + {ay}*{uy})*{uy})'
+            w(f'  {e}_fvx_{l}: "{vx0}/sqrt({vx0}^2 + {vy0}^2)"      # unit normal of the camber at the edge towards side a, fixed helpers')
+            w(f'  {e}_fvy_{l}: "{vy0}/sqrt({vx0}^2 + {vy0}^2)"')
             camber = f'shear_camber > 0.5 && abs({e}_fuy_{l}) > abs({e}_cy_{l})'
             w(f'  {e}_tx_{l}: "{camber} ? {sg}{e}_fux_{l} : {e}_cx_{l}"')
             w(f'  {e}_ty_{l}: "{camber} ? {sg}{e}_fuy_{l} : {e}_cy_{l}"')
@@ -362,6 +372,14 @@ def template_text():
         span = lambda p, q: f'sqrt(({p}.axial - {q}.axial)^2 + (rm_{l}*({p}.theta - {q}.theta))^2)'
         for e, a, b in (('le', 'a_f', 'b_f'), ('te', 'a_r', 'b_r')):
             w(f'  round_{e}_{l}: "{span(f"h{a}_{l}", f"h{b}_{l}")} <= o_fan*{span(f"g{a}_{l}", f"g{b}_{l}")}"')
+        # o_width_sharp: the same round test on the probe curve o0 (the O curve at o_width from
+        # fixed helpers: o_{l} itself cannot decide its own width), with the stagger of the
+        # camber at the edge (fixed helpers) against o_shear
+        for e, a, b in (('le', 'a_f', 'b_f'), ('te', 'a_r', 'b_r')):
+            w(f'  round0_{e}_{l}: "{span(f"p{a}_{l}", f"p{b}_{l}")} <= o_fan*{span(f"gp{a}_{l}", f"gp{b}_{l}")}"')
+            w(f'  stagger0_{e}_{l}: "abs({e}_fuy_{l})*tan(o_shear) > abs({e}_fux_{l})"      # 1: the camber at the edge wants the shear (o_shear)')
+        w(f'  chord0_{l}: "sqrt((tef_{l}.axial - lef_{l}.axial)^2 + (rm_{l}*(tef_{l}.theta - lef_{l}.theta))^2)"      # chord from fixed helpers')
+        w(f'  o_width_{l}: "o_width_sharp > 0 && ((stagger0_le_{l} && (round0_le_h && round0_le_s) < 0.5) || (stagger0_te_{l} && (round0_te_h && round0_te_s) < 0.5)) ? o_width_sharp : o_width"      # the O-grid width on this layer')
         # an edge is sheared on both layers or on none (a corner moved on one layer only would
         # twist the edge block between hub and shroud): shear_le/te below
         w(f'  sb_f_{l}: "shear_le && le_ty_{l} > 0"      # ob_f moved downstream along side b')
@@ -450,7 +468,7 @@ def template_text():
         # grid other than the template's with the corner given there, TestMeshPlan)
         sa = f'({d3(f"oa_f0_{l}", f"oa_m0_{l}")} + {d3(f"oa_m0_{l}", f"oa_r0_{l}")})'
         sb = f'({d3(f"ob_f0_{l}", f"ob_m0_{l}")} + {d3(f"ob_m0_{l}", f"ob_r0_{l}")})'
-        w(f'  period_end_{l}: "period_follow > 0 ? period_follow*o_width*chord_{l}*o_cell*n_side*(1/{sa} + 1/{sb})/2 : period_end"      # the periodic lines\' end cells over their mean cell')
+        w(f'  period_end_{l}: "period_follow > 0 ? period_follow*o_width_{l}*chord_{l}*o_cell*n_side*(1/{sa} + 1/{sb})/2 : period_end"      # the periodic lines\' end cells over their mean cell')
     w('')
     w('carriers:')
     w('  hub: {revolve: hub, axis: machine, extend: extend}')
@@ -458,7 +476,8 @@ def template_text():
     w('  blade: {gordon: sections, blending: spline, closed: true, align: axial}   # every section: leading edge at s = 0.25, trailing edge at 0.75')
     for l, S in L.items():
         w(f'  blade_{l}: {{intersect: [blade, {S}]}}')
-        w(f'  o_{l}: {{offset: blade_{l}, on: {S}, distance: "o_width*chord_{l}"}}      # outer boundary of the O-grid')
+        w(f'  o0_{l}: {{offset: blade_{l}, on: {S}, distance: "o_width*chord0_{l}"}}      # probe curve: the O curve at o_width from fixed helpers (o_width_sharp)')
+        w(f'  o_{l}: {{offset: blade_{l}, on: {S}, distance: "o_width_{l}*chord_{l}"}}      # outer boundary of the O-grid')
         w(f'  lo_{l}: {{surface_curve: {S}, through: [lo_f_{l}, lo_m_{l}, lo_r_{l}]}}      # periodic_low line, mid-passage')
     w('')
     w('vertices:')
@@ -480,6 +499,15 @@ def template_text():
             w(f'  pfb_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sb} dir_{l}*probe", fixed: true}}')
         w(f'  ole_{l}: {{project: le_{l}, onto: o_{l}}}')
         w(f'  ote_{l}: {{project: te_{l}, onto: o_{l}}}')
+        # the probe curve o0's o_corner points (p) and their feet (gp), from fixed helpers: round0_le/te
+        w(f'  ole0_{l}: {{on_curve: o0_{l}, at: {{min: "(x - lef_{l}.x)^2 + (y - lef_{l}.y)^2 + (z - lef_{l}.z)^2"}}, fixed: true}}')
+        w(f'  ote0_{l}: {{on_curve: o0_{l}, at: {{min: "(x - tef_{l}.x)^2 + (y - tef_{l}.y)^2 + (z - tef_{l}.z)^2"}}, fixed: true}}')
+        for v, e, side, towards in (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+')):
+            dx = f'(cos(o_corner)*{e}_fux_{l} {side} sin(o_corner)*{e}_fvx_{l})'
+            dy = f'(cos(o_corner)*{e}_fuy_{l} {side} sin(o_corner)*{e}_fvy_{l})'
+            far = f'o{e}0_{l}.s {towards} dir_{l}*o_window'
+            w(f'  p{v[1:]}_{l}: {{on_curve: o0_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}0_{l}.s, {far})", "max(o{e}0_{l}.s, {far})"]}}, fixed: true}}')
+            w(f'  gp{v[1:]}_{l}: {{on_curve: blade_{l}, at: {{min: "(x - p{v[1:]}_{l}.x)^2 + (y - p{v[1:]}_{l}.y)^2 + (z - p{v[1:]}_{l}.z)^2", within: ["{e}f_{l}.s - 0.25", "{e}f_{l}.s + 0.25"]}}, fixed: true}}')
         # each corner is searched on its own side only: from the edge towards side a (b)
         corners = (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+'))
         partners = {'a_f': 'b_f', 'b_f': 'a_f', 'a_r': 'b_r', 'b_r': 'a_r'}
