@@ -294,6 +294,9 @@ def template_text():
     for l, S in L.items():
         w(f'  # --- {S} (_{l}): lengths in the unrolled (axial, r*theta) plane at r = rm_{l}')
         w(f'  rm_{l}: le_{l}.radius')
+        w(f'  rm0_{l}: lef_{l}.radius      # the same from the fixed copy of the edge (o_width_sharp)')
+        w(f'  fwd0_{l}: "tef_{l}.s < lef_{l}.s ? tef_{l}.s - lef_{l}.s + 1 : tef_{l}.s - lef_{l}.s"      # fwd from the fixed copies of the edges (o_width_sharp)')
+        w(f'  dir0_{l}: "sin(fm0_{l}.theta - bm0_{l}.theta) < 0 ? 1 : -1"      # dir from fixed helpers (o_width_sharp)')
         w(f'  fwd_{l}: "te_{l}.s < le_{l}.s ? te_{l}.s - le_{l}.s + 1 : te_{l}.s - le_{l}.s"        # u from le to te, increasing u')
         w(f'  dir_{l}: "sin(fm_{l}.theta - bm_{l}.theta) < 0 ? 1 : -1"   # +1: side a (towards periodic_low) lies in increasing u from le')
         w(f'  side_a_{l}: "dir_{l} > 0 ? fwd_{l} : 1 - fwd_{l}"')
@@ -350,10 +353,14 @@ def template_text():
             fy0 = f'rm_{l}*({e}f_{l}.theta - (pfa_{e}_{l}.theta + pfb_{e}_{l}.theta)/2)'
             w(f'  {e}_fux_{l}: "({fx0})/sqrt(({fx0})^2 + ({fy0})^2)"      # camber direction at the edge, from fixed helpers')
             w(f'  {e}_fuy_{l}: "({fy0})/sqrt(({fx0})^2 + ({fy0})^2)"')
-            # its normal towards side a (fixed helpers; for the probe curve o0's corners)
+            # the same at the fixed radius rm0 (o_width_sharp's decision, which feeds the O curve
+            # and period_end: from fixed helpers alone) and its normal towards side a
+            gy0 = f'rm0_{l}*({e}f_{l}.theta - (pfa_{e}_{l}.theta + pfb_{e}_{l}.theta)/2)'
+            w(f'  {e}_gux_{l}: "({fx0})/sqrt(({fx0})^2 + ({gy0})^2)"      # camber direction at the edge, fixed helpers and radius')
+            w(f'  {e}_guy_{l}: "({gy0})/sqrt(({fx0})^2 + ({gy0})^2)"')
             ax = f'(pfa_{e}_{l}.axial - pfb_{e}_{l}.axial)'
-            ay = f'(rm_{l}*(pfa_{e}_{l}.theta - pfb_{e}_{l}.theta))'
-            ux, uy = f'{e}_fux_{l}', f'{e}_fuy_{l}'
+            ay = f'(rm0_{l}*(pfa_{e}_{l}.theta - pfb_{e}_{l}.theta))'
+            ux, uy = f'{e}_gux_{l}', f'{e}_guy_{l}'
             vx0 = f'({ax} - ({ax}*{ux} + {ay}*{uy})*{ux})'
             vy0 = f'({ay} - ({ax}*{ux} + {ay}*{uy})*{uy})'
             w(f'  {e}_fvx_{l}: "{vx0}/sqrt({vx0}^2 + {vy0}^2)"      # unit normal of the camber at the edge towards side a, fixed helpers')
@@ -372,13 +379,14 @@ def template_text():
         span = lambda p, q: f'sqrt(({p}.axial - {q}.axial)^2 + (rm_{l}*({p}.theta - {q}.theta))^2)'
         for e, a, b in (('le', 'a_f', 'b_f'), ('te', 'a_r', 'b_r')):
             w(f'  round_{e}_{l}: "{span(f"h{a}_{l}", f"h{b}_{l}")} <= o_fan*{span(f"g{a}_{l}", f"g{b}_{l}")}"')
+        span0 = lambda p, q: f'sqrt(({p}.axial - {q}.axial)^2 + (rm0_{l}*({p}.theta - {q}.theta))^2)'
         # o_width_sharp: the same round test on the probe curve o0 (the O curve at o_width from
         # fixed helpers: o_{l} itself cannot decide its own width), with the stagger of the
         # camber at the edge (fixed helpers) against o_shear
         for e, a, b in (('le', 'a_f', 'b_f'), ('te', 'a_r', 'b_r')):
-            w(f'  round0_{e}_{l}: "{span(f"p{a}_{l}", f"p{b}_{l}")} <= o_fan*{span(f"gp{a}_{l}", f"gp{b}_{l}")}"')
-            w(f'  stagger0_{e}_{l}: "abs({e}_fuy_{l})*tan(o_shear) > abs({e}_fux_{l})"      # 1: the camber at the edge wants the shear (o_shear)')
-        w(f'  chord0_{l}: "sqrt((tef_{l}.axial - lef_{l}.axial)^2 + (rm_{l}*(tef_{l}.theta - lef_{l}.theta))^2)"      # chord from fixed helpers')
+            w(f'  round0_{e}_{l}: "{span0(f"p{a}_{l}", f"p{b}_{l}")} <= o_fan*{span0(f"gp{a}_{l}", f"gp{b}_{l}")}"')
+            w(f'  stagger0_{e}_{l}: "abs({e}_guy_{l})*tan(o_shear) > abs({e}_gux_{l})"      # 1: the camber at the edge wants the shear (o_shear)')
+        w(f'  chord0_{l}: "sqrt((tef_{l}.axial - lef_{l}.axial)^2 + (rm0_{l}*(tef_{l}.theta - lef_{l}.theta))^2)"      # chord from fixed helpers')
         w(f'  o_width_{l}: "o_width_sharp > 0 && ((stagger0_le_{l} && (round0_le_h && round0_le_s) < 0.5) || (stagger0_te_{l} && (round0_te_h && round0_te_s) < 0.5)) ? o_width_sharp : o_width"      # the O-grid width on this layer')
         # an edge is sheared on both layers or on none (a corner moved on one layer only would
         # twist the edge block between hub and shroud): shear_le/te below
@@ -500,13 +508,15 @@ def template_text():
         w(f'  ole_{l}: {{project: le_{l}, onto: o_{l}}}')
         w(f'  ote_{l}: {{project: te_{l}, onto: o_{l}}}')
         # the probe curve o0's o_corner points (p) and their feet (gp), from fixed helpers: round0_le/te
+        w(f'  fm0_{l}: {{on_curve: blade_{l}, at: "lef_{l}.s + fwd0_{l}/2", fixed: true}}')
+        w(f'  bm0_{l}: {{on_curve: blade_{l}, at: "lef_{l}.s + fwd0_{l}/2 + 0.5", fixed: true}}')
         w(f'  ole0_{l}: {{on_curve: o0_{l}, at: {{min: "(x - lef_{l}.x)^2 + (y - lef_{l}.y)^2 + (z - lef_{l}.z)^2"}}, fixed: true}}')
         w(f'  ote0_{l}: {{on_curve: o0_{l}, at: {{min: "(x - tef_{l}.x)^2 + (y - tef_{l}.y)^2 + (z - tef_{l}.z)^2"}}, fixed: true}}')
         for v, e, side, towards in (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+')):
-            dx = f'(cos(o_corner)*{e}_fux_{l} {side} sin(o_corner)*{e}_fvx_{l})'
-            dy = f'(cos(o_corner)*{e}_fuy_{l} {side} sin(o_corner)*{e}_fvy_{l})'
-            far = f'o{e}0_{l}.s {towards} dir_{l}*o_window'
-            w(f'  p{v[1:]}_{l}: {{on_curve: o0_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}0_{l}.s, {far})", "max(o{e}0_{l}.s, {far})"]}}, fixed: true}}')
+            dx = f'(cos(o_corner)*{e}_gux_{l} {side} sin(o_corner)*{e}_fvx_{l})'
+            dy = f'(cos(o_corner)*{e}_guy_{l} {side} sin(o_corner)*{e}_fvy_{l})'
+            far = f'o{e}0_{l}.s {towards} dir0_{l}*o_window'
+            w(f'  p{v[1:]}_{l}: {{on_curve: o0_{l}, at: {{max: "{dx}*axial + {dy}*rm0_{l}*theta", within: ["min(o{e}0_{l}.s, {far})", "max(o{e}0_{l}.s, {far})"]}}, fixed: true}}')
             w(f'  gp{v[1:]}_{l}: {{on_curve: blade_{l}, at: {{min: "(x - p{v[1:]}_{l}.x)^2 + (y - p{v[1:]}_{l}.y)^2 + (z - p{v[1:]}_{l}.z)^2", within: ["{e}f_{l}.s - 0.25", "{e}f_{l}.s + 0.25"]}}, fixed: true}}')
         # each corner is searched on its own side only: from the edge towards side a (b)
         corners = (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+'))
