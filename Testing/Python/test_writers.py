@@ -160,7 +160,7 @@ class FoamFormatsTest(unittest.TestCase):
             reader.Update()
             internal = reader.GetOutput().GetBlock(0)
             result.append((internal.GetNumberOfCells(), bftest.points(internal)))
-        self.assertEqual(result[0][0], 2772)  # density 0.5 (the template's min_cells: 1356 without)
+        self.assertEqual(result[0][0], 3696)  # density 0.5 (the template's min_cells: 1356 without; 2772 before min_span)
         self.assertEqual(result[0][0], result[1][0])
         self.assertTrue(np.array_equal(result[0][1], result[1][1]))
 
