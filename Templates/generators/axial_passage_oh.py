@@ -127,7 +127,14 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   the H columns, min_side along the blade sides, min_up / min_down from the O-grid to
 #   the inlet / outlet (min_cells): with fewer, the match laws cannot grow from the O-grid's
 #   small cells by o_match to the periodic lines, inlet and outlet (the cells jump at the
-#   interfaces, or the last cells are long and fail checkMesh's face tets).
+#   interfaces, or the last cells are long and fail checkMesh's face tets); and min_span
+#   from hub to shroud (stop 19: the twisted blade warps a long, wide wall cell's outer face
+#   by more than the wall cell's half thickness, face tets on the compressor at density 0.5).
+# - on a layer where an edge's camber is staggered beyond 90 deg - o_shear but the edge is
+#   sharp (a fan: its corners cannot be sheared) the O-grid is o_width_sharp wide instead of
+#   o_width (stop 19): the H rows across the passage meet the blade there at about
+#   90 deg - stagger, and the H cells beside the O-grid, matched to its outer cell along
+#   those rows, are that sine thinner across (checkMesh's cell determinant; the compressor).
 # - the O-grid's outer faces follow the blade faces (faces `follow: opposite`): made from
 #   their edges alone they were the ruled surface between the hub and shroud offsets, and
 #   the O-grid half as thick at mid-span beside a bulging side (Rotor 37: its outer cells
