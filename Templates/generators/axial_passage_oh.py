@@ -201,7 +201,7 @@ machine: {theta_zero: sections}   # theta = 0 through the blade, so the passage 
 
 parameters:
   o_width: 0.03           # O-grid width [chords of the hub/shroud section]
-  o_width_sharp: 0.04     # (stop 19) ... this on a layer where an edge's camber is staggered beyond 90 deg - o_shear but the edge is sharp (its edge block a fan, o_fan), so that the corners there cannot be sheared: the H rows across the passage then meet the blade at about 90 deg - stagger (the compressor's shroud: 16-25 deg), and the H cells beside the O-grid, matched to its outer cell along those rows, are that sine thinner across: checkMesh's cell determinant. Compressor (both layers), H cells placed at densities 0.5 / 1 / 2 24 / 27 / 87 -> 3 / 5 / 14 (with min_span), optimized 16 / 2 / 0 -> 0 / 0 / 0, optimizer 23.06 -> 25.36 deg at density 1; 0.035 / 0.0375 8 / 7 placed at density 1, 0.045-0.05 the same counts as 0.04. Decided on the probe curve o0 (the O curve at o_width from fixed helpers: o_h / o_s cannot decide their own width); other machines keep o_width (the same grids). 0: o_width everywhere
+  o_width_sharp: 0.04     # (stop 19) ... this on a layer where an edge's camber is staggered beyond 90 deg - o_shear but the edge is sharp (its edge block a fan, o_fan), so that the corners there cannot be sheared: the H rows across the passage then meet the blade at about 90 deg - stagger (the compressor's shroud: 16-25 deg), and the H cells beside the O-grid, matched to its outer cell along those rows, are that sine thinner across: checkMesh's cell determinant. Compressor (both layers), H cells placed at densities 0.5 / 1 / 2 24 / 27 / 87 -> 3 / 5 / 14 (with min_span), optimized 16 / 2 / 0 -> 0 / 0 / 0, optimizer 23.06 -> 25.26 deg at density 1; 0.035 / 0.0375 8 / 7 placed at density 1, 0.045-0.05 the same counts as 0.04. Decided on the probe curve o0 (the O curve at o_width from fixed helpers: o_h / o_s cannot decide their own width); other machines keep o_width (the same grids). 0: o_width everywhere
   o_corner: 60deg         # the O-grid corners' normals lean this far from the edge camber direction ...
   o_corner_fan: 65deg     # ... this far at a sharp edge whose edge block is a fan on the tip (o_fan): further round, so that the H blocks beside the blade keep an open corner there
   o_window: 0.15          # each corner is searched this far along its side (fraction of the O curve) from the edge
@@ -323,7 +323,11 @@ def template_text():
         for e, (a, b) in (('le', ('a_f', 'b_f')), ('te', ('a_r', 'b_r'))):
             outer = f'sqrt((r{a}_{l}.axial - r{b}_{l}.axial)^2 + (rm_{l}*(r{a}_{l}.theta - r{b}_{l}.theta))^2)'
             inner = f'sqrt((k{a}_{l}.axial - k{b}_{l}.axial)^2 + (rm_{l}*(k{a}_{l}.theta - k{b}_{l}.theta))^2)'
-            w(f'  off1_{e}_{l}: "{outer} <= o_fan*{inner}"      # this layer alone (off_{e}: both layers)')
+            # (this layer alone, from fixed helpers: kf where k starts, rm0; decided on both
+            # layers below, it must not follow {e}'s moves on the other layer)
+            inner0 = f'sqrt((kf{a}_{l}.axial - kf{b}_{l}.axial)^2 + (rm0_{l}*(kf{a}_{l}.theta - kf{b}_{l}.theta))^2)'
+            outer0 = f'sqrt((r{a}_{l}.axial - r{b}_{l}.axial)^2 + (rm0_{l}*(r{a}_{l}.theta - r{b}_{l}.theta))^2)'
+            w(f'  off1_{e}_{l}: "{outer0} <= o_fan*{inner0}"      # this layer alone (off_{e}: both layers)')
             # with o_fan_prisms, a fan's feet are one point (t below); the same test on fixed
             # helpers (kf: where k starts), so that the feet do not follow {e} (which off_{e}
             # follows through k and rm, and which the optimizer moves: 25 % more work)
