@@ -291,10 +291,16 @@ def template_text():
     w('  outlet_axial: "min(outlet_wanted, min(hub.axial_max, shroud.axial_max) - 1e-9*blade_axial)"')
     for l, S in L.items():
         w(f'  # --- {S} (_{l}): lengths in the unrolled (axial, r*theta) plane at r = rm_{l}')
-        w(f'  rm_{l}: le_{l}.radius')
+        w(f'  rm_{l}: lef_{l}.radius')      # (the fixed twin: a reference radius follows no moves)
         w(f'  fwd_{l}: "te_{l}.s < le_{l}.s ? te_{l}.s - le_{l}.s + 1 : te_{l}.s - le_{l}.s"        # u from le to te, increasing u')
         w(f'  dir_{l}: "sin(fm_{l}.theta - bm_{l}.theta) < 0 ? 1 : -1"   # +1: side a (towards periodic_low) lies in increasing u from le')
         w(f'  side_a_{l}: "dir_{l} > 0 ? fwd_{l} : 1 - fwd_{l}"')
+        # the same from the edges' fixed twins (lef, tef, fmf, bmf: where the template placed
+        # them), for what must not follow moves (period_end_*: gradings do not follow)
+        w(f'  fwdf_{l}: "tef_{l}.s < lef_{l}.s ? tef_{l}.s - lef_{l}.s + 1 : tef_{l}.s - lef_{l}.s"')
+        w(f'  dirf_{l}: "sin(fmf_{l}.theta - bmf_{l}.theta) < 0 ? 1 : -1"')
+        w(f'  side_af_{l}: "dirf_{l} > 0 ? fwdf_{l} : 1 - fwdf_{l}"')
+        w(f'  chordf_{l}: "sqrt((tef_{l}.axial - lef_{l}.axial)^2 + (lef_{l}.radius*(tef_{l}.theta - lef_{l}.theta))^2)"')
         w(f'  chord_{l}: "sqrt((te_{l}.axial - le_{l}.axial)^2 + (rm_{l}*(te_{l}.theta - le_{l}.theta))^2)"')
         for e in ('le', 'te'):
             # camber direction at the edge: from the mid-point of the two probes to the edge tip
@@ -450,7 +456,7 @@ def template_text():
         # grid other than the template's with the corner given there, TestMeshPlan)
         sa = f'({d3(f"oa_f0_{l}", f"oa_m0_{l}")} + {d3(f"oa_m0_{l}", f"oa_r0_{l}")})'
         sb = f'({d3(f"ob_f0_{l}", f"ob_m0_{l}")} + {d3(f"ob_m0_{l}", f"ob_r0_{l}")})'
-        w(f'  period_end_{l}: "period_follow > 0 ? period_follow*o_width*chord_{l}*o_cell*n_side*(1/{sa} + 1/{sb})/2 : period_end"      # the periodic lines\' end cells over their mean cell')
+        w(f'  period_end_{l}: "period_follow > 0 ? period_follow*o_width*chordf_{l}*o_cell*n_side*(1/{sa} + 1/{sb})/2 : period_end"      # the periodic lines\' end cells over their mean cell')
     w('')
     w('carriers:')
     w('  hub: {revolve: hub, axis: machine, extend: extend}')
@@ -476,6 +482,9 @@ def template_text():
         # fixed copies of the edges and their probes (shear_camber's camber direction)
         for e, ext, sa, sb in (('le', 'min', '+', '-'), ('te', 'max', '-', '+')):
             w(f'  {e}f_{l}: {{on_curve: blade_{l}, at: {{{ext}: axial}}, fixed: true}}')
+            if e == 'te':
+                w(f'  fmf_{l}: {{on_curve: blade_{l}, at: "lef_{l}.s + fwdf_{l}/2", fixed: true}}')
+                w(f'  bmf_{l}: {{on_curve: blade_{l}, at: "lef_{l}.s + fwdf_{l}/2 + 0.5", fixed: true}}')
             w(f'  pfa_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sa} dir_{l}*probe", fixed: true}}')
             w(f'  pfb_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sb} dir_{l}*probe", fixed: true}}')
         w(f'  ole_{l}: {{project: le_{l}, onto: o_{l}}}')
@@ -516,10 +525,11 @@ def template_text():
             w(f'  f{b}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"c{b}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
             # the foot kept o_tip (fraction of the loop) from the edge: at a sharp edge every
             # point of the O curve's arc round the tip projects onto the tip itself
-            x = f'dir_{l}*(f{b}_{l}.s - {e}_{l}.s)'
+            # (from the edge's fixed twin: a fixed helper follows nothing)
+            x = f'dirf_{l}*(f{b}_{l}.s - {e}f_{l}.s)'
             off = f'({x} - rint({x}))'
             lim = f'max({off}, o_tip)' if towards == '+' else f'min({off}, -o_tip)'
-            w(f'  k{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{lim}", fixed: true}}')
+            w(f'  k{b}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s + dirf_{l}*{lim}", fixed: true}}')
             w(f'  r{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"k{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
             w(f'  kf{b}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"k{b}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
             corner = distance2(f"r{b}_{l}")
@@ -528,7 +538,7 @@ def template_text():
                 # o_back from the edge, so that the edge block holds the whole fan round the
                 # tip or round the cap's corners and meets the sides with cells on the flanks
                 limb = f'max({off}, o_back)' if towards == '+' else f'min({off}, -o_back)'
-                w(f'  kb{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{limb}", fixed: true}}')
+                w(f'  kb{b}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s + dirf_{l}*{limb}", fixed: true}}')
                 w(f'  rb{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"kb{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
                 corner = f'(shear_{e} ? {corner} : {distance2(f"rb{b}_{l}")})'
             rule = f'on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {corner} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}'
@@ -561,11 +571,11 @@ def template_text():
         w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "shear_le || shear_te ? fb_r_{l}.s + dir_{l}*({gb} - rint({gb} - 0.5))/2 : le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
         w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')
         w(f'  ob_m_{l}: {{project: b_m_{l}, onto: o_{l}}}')
-        # their twins where the template placed them (fixed), for period_end_*
-        for side, at in (('a', f"shear_le || shear_te ? fa_f_{l}.s + dir_{l}*({ga} - rint({ga} - 0.5))/2 : le_{l}.s + dir_{l}*side_a_{l}/2"),
-                         ('b', f"shear_le || shear_te ? fb_r_{l}.s + dir_{l}*({gb} - rint({gb} - 0.5))/2 : le_{l}.s - dir_{l}*(1 - side_a_{l})/2")):
-            w(f'  {side}_m0_{l}: {{on_curve: blade_{l}, at: "{at}", fixed: true}}')
-            w(f'  o{side}_m0_{l}: {{project: {side}_m0_{l}, onto: o_{l}, fixed: true}}')
+        # their twins where the template placed them, for period_end_*: a search places a
+        # helper once (fixed: it follows nothing; the sides' mid-points follow the edges,
+        # which the optimizer and manual moves can move, and a grading does not follow)
+        for side in ('a', 'b'):
+            w(f'  o{side}_m0_{l}: {{on_curve: o_{l}, at: {{min: {near(f"o{side}_m_{l}")}, within: ["o{side}_m_{l}.s - 0.05", "o{side}_m_{l}.s + 0.05"]}}, fixed: true}}')
         w(f'  # mid-passage points between side a and the side b of the blade one pitch below')
         # (at a sharp edge lo_f / lo_r leave the middle across it: {e}_turn above)
         for f in ('f', 'm', 'r'):
