@@ -514,7 +514,7 @@ TEST(OptimizerPassage, RejectedTrialsPutBackGiveTheSameSearch)
     const model::TemplateInputs inputs = test::readTemplateInputs(
       std::string(BLOCKFORGE_SOURCE_DIR) + "/Data/distributor/BladeGen.inf");
     const std::string text = test::readText(test::templatePath("axial_passage_oh.yaml"));
-    const std::string ends = "k: {ends: [span_end, span_end]";
+    const std::string ends = "k: {ends: [span_wall, span_wall]";
     int spanwiseEnds = 0;
     for (std::size_t at = text.find(ends); at != std::string::npos;
          at = text.find(ends, at + ends.size()))
