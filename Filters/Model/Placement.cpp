@@ -384,6 +384,23 @@ std::vector<std::vector<int>> vertexDependents(const BlockModel& model)
   return dependents;
 }
 
+std::vector<char> movableVertices(const BlockModel& model)
+{
+  const PlacementGraph graph = placementGraph(model);
+  std::vector<int> controlPoints;
+  for (int v = 0; v < graph.vertexCount; ++v)
+  {
+    const Vertex& vertex = model.vertices[v];
+    if (vertex.rule.kind == VertexRule::Kind::OnCarrier && !vertex.fixed)
+    {
+      controlPoints.push_back(v);
+    }
+  }
+  std::vector<char> reached = graph.reach(controlPoints, false);
+  reached.resize(graph.vertexCount);
+  return reached;
+}
+
 std::vector<int> placementOrder(const BlockModel& model)
 {
   const PlacementGraph graph = placementGraph(model);

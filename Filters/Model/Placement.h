@@ -108,6 +108,11 @@ void applyRule(BlockModel& model, const CarrierGeometry& geometry, int vertex);
 /// curve drawn through it) the vertices on that curve and on carriers built on it.
 std::vector<std::vector<int>> vertexDependents(const BlockModel& model);
 
+/// For every vertex, whether a move can shift it: a control point the optimizer or a
+/// manual move may change (on a carrier, not marked `fixed`), or a vertex that follows
+/// one (through rules, expressions or curves drawn through it).
+std::vector<char> movableVertices(const BlockModel& model);
+
 /// Every vertex once, each after the vertices it follows. Throws TemplateError naming
 /// a vertex on a cycle.
 std::vector<int> placementOrder(const BlockModel& model);

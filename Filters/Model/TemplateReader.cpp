@@ -431,8 +431,10 @@ void TemplateReader::readGrading(const MapEntry& grading, const std::string& ent
     const std::string direction(1, static_cast<char>('i' + d));
     if (const MapEntry* law = syntax::findEntry(keys, direction))
     {
+      Referenced.emplace_back();
       const DistributionLaw value = syntax::parseLaw(law->value, law->line, entityText,
         "grading " + direction, numberReader(entityText), Report, edgeReader(entityText));
+      refuseMovableReferences(law->line, entityText, "grading " + direction);
       for (int e = 0; e < 12; ++e)
       {
         if (edgeDirection(e) == d)
@@ -455,8 +457,37 @@ void TemplateReader::readGrading(const MapEntry& grading, const std::string& ent
     for (const MapEntry& law : overrides)
     {
       const int e = std::stoi(law.key.substr(1)) - 1;
+      Referenced.emplace_back();
       block.laws[e] = syntax::parseLaw(law.value, law.line, entityText,
         "grading " + law.key, numberReader(entityText), Report, edgeReader(entityText));
+      refuseMovableReferences(law.line, entityText, "grading " + law.key);
+    }
+  }
+}
+
+void TemplateReader::refuseMovableReferences(
+  int line, const std::string& entityText, const std::string& what)
+{
+  const std::set<int> referenced = std::move(Referenced.back());
+  Referenced.pop_back();
+  if (referenced.empty())
+  {
+    return;
+  }
+  if (Movable.size() != Model.vertices.size())
+  {
+    Movable = movableVertices(Model);
+  }
+  for (const int v : referenced)
+  {
+    if (Movable[v])
+    {
+      // A law's values are numbers once read: moved, the vertex would leave the live
+      // model's grid other than the template's with the vertex given there.
+      fail(line, entityText,
+        "'" + what + "' refers to vertex '" + Model.vertices[v].name +
+          "', which the optimizer or a manual move can move, and a grading does not follow "
+          "moves: refer to vertices marked 'fixed: true' (and placed from such alone)");
     }
   }
 }

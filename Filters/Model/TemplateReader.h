@@ -166,6 +166,9 @@ private:
   void readBlocks();
 
   void readGrading(const MapEntry& grading, const std::string& entityText, Block& block);
+  /// Pops Referenced (pushed before reading `what`) and fails when `what` refers to a
+  /// vertex a move can shift (movableVertices): its value would not follow the move.
+  void refuseMovableReferences(int line, const std::string& entityText, const std::string& what);
 
   /// Format 2 `notes`: `name: {when: <expression>, say: "text with {expression}s"}`; the
   /// text of every note whose `when` is not 0 goes to Model.notes, each {expression}
@@ -401,6 +404,8 @@ private:
   /// what a vertex placed by expressions follows (PlacementExpressions).
   std::vector<std::set<int>> Referenced;
   std::vector<std::set<int>> DefinitionVertices;
+  /// movableVertices(Model), once the blocks' gradings need it.
+  std::vector<char> Movable;
   syntax::Reporter Report;
   ExpressionEvaluator Evaluator;
   std::vector<MapEntry> Sections;

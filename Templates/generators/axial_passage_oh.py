@@ -233,8 +233,8 @@ parameters:
   n_side: 18              # cells along each blade side (16 left the turbine's grid at density 0.5 0.59 % off its volume: its sides' middle cells, between the O corners' small ones, chord its cambered O-grid sides)
   n_o: 5                  # cells across the O-grid (6 before stop 19: with k_o 1.35 five give an outer cell of 0.0100 chords, wall cell 0.0030)
   n_span: 12              # cells from hub to shroud
-  k_o: 1.35               # (1.25 before stop 19, with n_o 6; see span_end) expansion ratio away from the blade in the O-grid: its outer cell (0.0081 chords; 0.0069 with 1.15) is what the H blocks beside it start with (`match`), and checkMesh's cell determinant fails H cells that thin against their length along the blade and the span (distributor M_L / M_R 104 / 81 -> 39 / 36 at density 1, placed); thicker still (1.3-1.4, or o_width 0.04-0.05) the optimizer ends at 41-45 deg on the distributor (the O corners' cells, the group cell of the arcs and H edges there, grow with it), 1.28-1.3 leave the compressor's optimized U_M with face tets
-  span_end: 0.5           # spanwise (law `ends` in every block, stop 19; two-sided geometric k_span 1.1 before): the cells on hub and shroud this fraction of the mean spanwise cell. Those cells have no face on hub or shroud that checkMesh's cell determinant counts, so a thin H cell beside the O-grid (its outer radial cell) fails there about 6 times sooner than at mid-span: shorter they pass (with k_o 1.35, n_o 5, period_follow 1.25, H cells failing at density 1 placed / optimized 27 / 2, 3 / 0, 45 / 22, 1 / 0 -> 2 / 0, 0 / 0, 27 / 2, 0 / 0 on distributor, Rotor 37, compressor, turbine). Before k_span: expansion ratio away from hub and shroud (two-sided): the cells on hub and shroud have no face there to count in checkMesh's cell determinant, so a thin H cell beside the O-grid fails it sooner there (the distributor's M_L at the hub); shorter spanwise (1.1: 0.034 instead of 0.041 m on the distributor) fewer fail (H cells 193 -> 171 on the distributor, 48 -> 32 on Rotor 37), the optimizer's angles the same within 0.2 deg; 1.15 gives the compressor face tets
+  k_o: 1.35               # (1.25 before stop 19, with n_o 6; see span_wall) expansion ratio away from the blade in the O-grid: its outer cell (0.0081 chords; 0.0069 with 1.15) is what the H blocks beside it start with (`match`), and checkMesh's cell determinant fails H cells that thin against their length along the blade and the span (distributor M_L / M_R 104 / 81 -> 39 / 36 at density 1, placed); thicker still (1.3-1.4, or o_width 0.04-0.05) the optimizer ends at 41-45 deg on the distributor (the O corners' cells, the group cell of the arcs and H edges there, grow with it), 1.28-1.3 leave the compressor's optimized U_M with face tets
+  span_wall: 0.5          # spanwise (law `ends` in every block, stop 19; two-sided geometric k_span 1.1 before): the cells on hub and shroud this fraction of the mean spanwise cell. Those cells have no face on hub or shroud that checkMesh's cell determinant counts, so a thin H cell beside the O-grid (its outer radial cell) fails there about 6 times sooner than at mid-span: shorter they pass (with k_o 1.35, n_o 5, period_follow 1.25, H cells failing at density 1 placed / optimized 27 / 2, 3 / 0, 45 / 22, 1 / 0 -> 2 / 0, 0 / 0, 27 / 2, 0 / 0 on distributor, Rotor 37, compressor, turbine). Before k_span: expansion ratio away from hub and shroud (two-sided): the cells on hub and shroud have no face there to count in checkMesh's cell determinant, so a thin H cell beside the O-grid fails it sooner there (the distributor's M_L at the hub); shorter spanwise (1.1: 0.034 instead of 0.041 m on the distributor) fewer fail (H cells 193 -> 171 on the distributor, 48 -> 32 on Rotor 37), the optimizer's angles the same within 0.2 deg; 1.15 gives the compressor face tets
   span_flat: 2            # ... and that flat in between
   side_arc_flat: 2        # the blade sides' O-grid arcs (law `match` from the O corners' cells, `flat`): between their small end cells the shape of the law `ends` with this flatness, not cells grown by o_match to a uniform middle (2.7 times the mean cell at density 0.5) ...
   period_end: 0.11        # ... and the periodic lines beside them (law `ends`): end cells this fraction of their mean cell (near the sides' arcs' end cells, which are the O-grid's outer radial cell: with k_o 1.25 and k_span 1.05 at 0.1 the optimizer ended at 44.6 deg on the distributor, at 0.11 47.7; 0.105 / 0.115 45.1 / 45.7 deg on the distributor / Rotor 37: the optimizer's end point moves by 2-3 deg with it) ...
@@ -251,18 +251,18 @@ parameters:
 """
 
 FOOTER = """blocks:
-  O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], min_cells: [1, 1, min_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_le_h}, E5: {project_from: ol_le_s}}}}
-  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, min_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_a_h}, E5: {project_from: ol_a_s}}}}
-  O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], min_cells: [1, 1, min_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
-  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, min_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
-  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
-  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E1: {match: o_match, at_most: in_at_most}, E5: {match: o_match, at_most: in_at_most}}}, interpolation: {i: end_widths, j: adaptive}}
-  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
-  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, min_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E4: {ends: [period_end_h, period_end_h], flat: period_flat}, E8: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
-  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, min_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E2: {ends: [period_end_h, period_end_h], flat: period_flat}, E6: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
-  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
-  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}, edges: {E3: {match: o_match, at_most: wake_cap}, E7: {match: o_match, at_most: wake_cap}}}, interpolation: {i: end_widths, j: adaptive}}
-  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_end, span_end], flat: span_flat}}, interpolation: end_cells}
+  O_le: {vertices: [b_f_h, a_f_h, oa_f_h, ob_f_h, b_f_s, a_f_s, oa_f_s, ob_f_s], cells: [n_le, n_o, n_span], min_cells: [1, 1, min_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {ends: [span_wall, span_wall], flat: span_flat}, edges: {E1: {project_from: ol_le_h}, E5: {project_from: ol_le_s}}}}
+  O_a: {vertices: [a_f_h, a_r_h, oa_r_h, oa_f_h, a_f_s, a_r_s, oa_r_s, oa_f_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, min_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {ends: [span_wall, span_wall], flat: span_flat}, edges: {E1: {project_from: ol_a_h}, E5: {project_from: ol_a_s}}}}
+  O_te: {vertices: [a_r_h, b_r_h, ob_r_h, oa_r_h, a_r_s, b_r_s, ob_r_s, oa_r_s], cells: [n_te, n_o, n_span], min_cells: [1, 1, min_span], grading: {i: {match: o_match}, j: {geometric: k_o}, k: {ends: [span_wall, span_wall], flat: span_flat}, edges: {E1: {project_from: ol_te_h}, E5: {project_from: ol_te_s}}}}
+  O_b: {vertices: [b_r_h, b_f_h, ob_f_h, ob_r_h, b_r_s, b_f_s, ob_f_s, ob_r_s], cells: [n_side, n_o, n_span], min_cells: [min_side, 1, min_span], grading: {i: {match: o_match, flat: side_arc_flat}, j: {geometric: k_o}, k: {ends: [span_wall, span_wall], flat: span_flat}, edges: {E1: {project_from: ol_b_h}, E5: {project_from: ol_b_s}}}}
+  U_L: {vertices: [lo_in_h, a_in_h, oa_f_h, lo_f_h, lo_in_s, a_in_s, oa_f_s, lo_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_wall, span_wall], flat: span_flat}}, interpolation: end_cells}
+  U_M: {vertices: [a_in_h, b_in_h, ob_f_h, oa_f_h, a_in_s, b_in_s, ob_f_s, oa_f_s], cells: [n_le, n_up, n_span], min_cells: [1, min_up, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_wall, span_wall], flat: span_flat}, edges: {E1: {match: o_match, at_most: in_at_most}, E5: {match: o_match, at_most: in_at_most}}}, interpolation: {i: end_widths, j: adaptive}}
+  U_R: {vertices: [b_in_h, hi_in_h, hi_f_h, ob_f_h, b_in_s, hi_in_s, hi_f_s, ob_f_s], cells: [n_pitch, n_up, n_span], min_cells: [min_pitch, min_up, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_wall, span_wall], flat: span_flat}}, interpolation: end_cells}
+  M_L: {vertices: [lo_f_h, oa_f_h, oa_r_h, lo_r_h, lo_f_s, oa_f_s, oa_r_s, lo_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, min_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {ends: [span_wall, span_wall], flat: span_flat}, edges: {E4: {ends: [period_end_h, period_end_h], flat: period_flat}, E8: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
+  M_R: {vertices: [ob_f_h, hi_f_h, hi_r_h, ob_r_h, ob_f_s, hi_f_s, hi_r_s, ob_r_s], cells: [n_pitch, n_side, n_span], min_cells: [min_pitch, min_side, min_span], grading: {i: {match: o_match}, j: {match: o_match, flat: side_arc_flat}, k: {ends: [span_wall, span_wall], flat: span_flat}, edges: {E2: {ends: [period_end_h, period_end_h], flat: period_flat}, E6: {ends: [period_end_s, period_end_s], flat: period_flat}}}}
+  D_L: {vertices: [lo_r_h, oa_r_h, a_out_h, lo_out_h, lo_r_s, oa_r_s, a_out_s, lo_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_wall, span_wall], flat: span_flat}}, interpolation: end_cells}
+  D_M: {vertices: [oa_r_h, ob_r_h, b_out_h, a_out_h, oa_r_s, ob_r_s, b_out_s, a_out_s], cells: [n_te, n_down, n_span], min_cells: [1, min_down, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_wall, span_wall], flat: span_flat}, edges: {E3: {match: o_match, at_most: wake_cap}, E7: {match: o_match, at_most: wake_cap}}}, interpolation: {i: end_widths, j: adaptive}}
+  D_R: {vertices: [ob_r_h, hi_r_h, hi_out_h, b_out_h, ob_r_s, hi_r_s, hi_out_s, b_out_s], cells: [n_pitch, n_down, n_span], min_cells: [min_pitch, min_down, min_span], grading: {i: {match: o_match}, j: {match: o_match}, k: {ends: [span_wall, span_wall], flat: span_flat}}, interpolation: end_cells}
 
 faces:
   hub_faces: {on_surface: hub, faces: [O_le.k0, O_a.k0, O_te.k0, O_b.k0, U_L.k0, U_M.k0, U_R.k0, M_L.k0, M_R.k0, D_L.k0, D_M.k0, D_R.k0]}
@@ -300,13 +300,16 @@ def template_text():
     w('  outlet_axial: "min(outlet_wanted, min(hub.axial_max, shroud.axial_max) - 1e-9*blade_axial)"')
     for l, S in L.items():
         w(f'  # --- {S} (_{l}): lengths in the unrolled (axial, r*theta) plane at r = rm_{l}')
-        w(f'  rm_{l}: le_{l}.radius')
-        w(f'  rm0_{l}: lef_{l}.radius      # the same from the fixed copy of the edge (o_width_sharp)')
-        w(f'  fwd0_{l}: "tef_{l}.s < lef_{l}.s ? tef_{l}.s - lef_{l}.s + 1 : tef_{l}.s - lef_{l}.s"      # fwd from the fixed copies of the edges (o_width_sharp)')
-        w(f'  dir0_{l}: "sin(fm0_{l}.theta - bm0_{l}.theta) < 0 ? 1 : -1"      # dir from fixed helpers (o_width_sharp)')
+        w(f'  rm_{l}: lef_{l}.radius')      # (the fixed twin: a reference radius follows no moves)
         w(f'  fwd_{l}: "te_{l}.s < le_{l}.s ? te_{l}.s - le_{l}.s + 1 : te_{l}.s - le_{l}.s"        # u from le to te, increasing u')
         w(f'  dir_{l}: "sin(fm_{l}.theta - bm_{l}.theta) < 0 ? 1 : -1"   # +1: side a (towards periodic_low) lies in increasing u from le')
         w(f'  side_a_{l}: "dir_{l} > 0 ? fwd_{l} : 1 - fwd_{l}"')
+        # the same from the edges' fixed twins (lef, tef, fmf, bmf: where the template placed
+        # them), for what must not follow moves (period_end_*: gradings do not follow)
+        w(f'  fwdf_{l}: "tef_{l}.s < lef_{l}.s ? tef_{l}.s - lef_{l}.s + 1 : tef_{l}.s - lef_{l}.s"')
+        w(f'  dirf_{l}: "sin(fmf_{l}.theta - bmf_{l}.theta) < 0 ? 1 : -1"')
+        w(f'  side_af_{l}: "dirf_{l} > 0 ? fwdf_{l} : 1 - fwdf_{l}"')
+        w(f'  chordf_{l}: "sqrt((tef_{l}.axial - lef_{l}.axial)^2 + (lef_{l}.radius*(tef_{l}.theta - lef_{l}.theta))^2)"')
         w(f'  chord_{l}: "sqrt((te_{l}.axial - le_{l}.axial)^2 + (rm_{l}*(te_{l}.theta - le_{l}.theta))^2)"')
         for e in ('le', 'te'):
             # camber direction at the edge: from the mid-point of the two probes to the edge tip
@@ -323,10 +326,10 @@ def template_text():
         for e, (a, b) in (('le', ('a_f', 'b_f')), ('te', ('a_r', 'b_r'))):
             outer = f'sqrt((r{a}_{l}.axial - r{b}_{l}.axial)^2 + (rm_{l}*(r{a}_{l}.theta - r{b}_{l}.theta))^2)'
             inner = f'sqrt((k{a}_{l}.axial - k{b}_{l}.axial)^2 + (rm_{l}*(k{a}_{l}.theta - k{b}_{l}.theta))^2)'
-            # (this layer alone, from fixed helpers: kf where k starts, rm0; decided on both
+            # (this layer alone, from fixed helpers: kf where k starts; decided on both
             # layers below, it must not follow {e}'s moves on the other layer)
-            inner0 = f'sqrt((kf{a}_{l}.axial - kf{b}_{l}.axial)^2 + (rm0_{l}*(kf{a}_{l}.theta - kf{b}_{l}.theta))^2)'
-            outer0 = f'sqrt((r{a}_{l}.axial - r{b}_{l}.axial)^2 + (rm0_{l}*(r{a}_{l}.theta - r{b}_{l}.theta))^2)'
+            inner0 = f'sqrt((kf{a}_{l}.axial - kf{b}_{l}.axial)^2 + (rm_{l}*(kf{a}_{l}.theta - kf{b}_{l}.theta))^2)'
+            outer0 = f'sqrt((r{a}_{l}.axial - r{b}_{l}.axial)^2 + (rm_{l}*(r{a}_{l}.theta - r{b}_{l}.theta))^2)'
             w(f'  off1_{e}_{l}: "{outer0} <= o_fan*{inner0}"      # this layer alone (off_{e}: both layers)')
             # with o_fan_prisms, a fan's feet are one point (t below); the same test on fixed
             # helpers (kf: where k starts), so that the feet do not follow {e} (which off_{e}
@@ -369,13 +372,15 @@ def template_text():
             fy0 = f'rm_{l}*({e}f_{l}.theta - (pfa_{e}_{l}.theta + pfb_{e}_{l}.theta)/2)'
             w(f'  {e}_fux_{l}: "({fx0})/sqrt(({fx0})^2 + ({fy0})^2)"      # camber direction at the edge, from fixed helpers')
             w(f'  {e}_fuy_{l}: "({fy0})/sqrt(({fx0})^2 + ({fy0})^2)"')
-            # the same at the fixed radius rm0 (o_width_sharp's decision, which feeds the O curve
+            # the same at the fixed radius rm (o_width_sharp's decision, which feeds the O curve
             # and period_end: from fixed helpers alone) and its normal towards side a
-            gy0 = f'rm0_{l}*({e}f_{l}.theta - (pfa_{e}_{l}.theta + pfb_{e}_{l}.theta)/2)'
-            w(f'  {e}_gux_{l}: "({fx0})/sqrt(({fx0})^2 + ({gy0})^2)"      # camber direction at the edge, fixed helpers and radius')
-            w(f'  {e}_guy_{l}: "({gy0})/sqrt(({fx0})^2 + ({gy0})^2)"')
-            ax = f'(pfa_{e}_{l}.axial - pfb_{e}_{l}.axial)'
-            ay = f'(rm0_{l}*(pfa_{e}_{l}.theta - pfb_{e}_{l}.theta))'
+            # (probes pga/pgb: pfa/pfb placed with dirf, the fixed twin of dir)
+            gx0 = f'{e}f_{l}.axial - (pga_{e}_{l}.axial + pgb_{e}_{l}.axial)/2'
+            gy0 = f'rm_{l}*({e}f_{l}.theta - (pga_{e}_{l}.theta + pgb_{e}_{l}.theta)/2)'
+            w(f'  {e}_gux_{l}: "({gx0})/sqrt(({gx0})^2 + ({gy0})^2)"      # camber direction at the edge, fixed helpers alone')
+            w(f'  {e}_guy_{l}: "({gy0})/sqrt(({gx0})^2 + ({gy0})^2)"')
+            ax = f'(pga_{e}_{l}.axial - pgb_{e}_{l}.axial)'
+            ay = f'(rm_{l}*(pga_{e}_{l}.theta - pgb_{e}_{l}.theta))'
             ux, uy = f'{e}_gux_{l}', f'{e}_guy_{l}'
             vx0 = f'({ax} - ({ax}*{ux} + {ay}*{uy})*{ux})'
             vy0 = f'({ay} - ({ax}*{ux} + {ay}*{uy})*{uy})'
@@ -395,14 +400,13 @@ def template_text():
         span = lambda p, q: f'sqrt(({p}.axial - {q}.axial)^2 + (rm_{l}*({p}.theta - {q}.theta))^2)'
         for e, a, b in (('le', 'a_f', 'b_f'), ('te', 'a_r', 'b_r')):
             w(f'  round_{e}_{l}: "{span(f"h{a}_{l}", f"h{b}_{l}")} <= o_fan*{span(f"g{a}_{l}", f"g{b}_{l}")}"')
-        span0 = lambda p, q: f'sqrt(({p}.axial - {q}.axial)^2 + (rm0_{l}*({p}.theta - {q}.theta))^2)'
+        span0 = lambda p, q: f'sqrt(({p}.axial - {q}.axial)^2 + (rm_{l}*({p}.theta - {q}.theta))^2)'
         # o_width_sharp: the same round test on the probe curve o0 (the O curve at o_width from
         # fixed helpers: o_{l} itself cannot decide its own width), with the stagger of the
         # camber at the edge (fixed helpers) against o_shear
         for e, a, b in (('le', 'a_f', 'b_f'), ('te', 'a_r', 'b_r')):
             w(f'  round0_{e}_{l}: "{span0(f"p{a}_{l}", f"p{b}_{l}")} <= o_fan*{span0(f"gp{a}_{l}", f"gp{b}_{l}")}"')
             w(f'  stagger0_{e}_{l}: "abs({e}_guy_{l})*tan(o_shear) > abs({e}_gux_{l})"      # 1: the camber at the edge wants the shear (o_shear)')
-        w(f'  chord0_{l}: "sqrt((tef_{l}.axial - lef_{l}.axial)^2 + (rm0_{l}*(tef_{l}.theta - lef_{l}.theta))^2)"      # chord from fixed helpers')
         w(f'  o_width_{l}: "o_width_sharp > 0 && ((stagger0_le_{l} && (round0_le_h && round0_le_s) < 0.5) || (stagger0_te_{l} && (round0_te_h && round0_te_s) < 0.5)) ? o_width_sharp : o_width"      # the O-grid width on this layer')
         # an edge is sheared on both layers or on none (a corner moved on one layer only would
         # twist the edge block between hub and shroud): shear_le/te below
@@ -492,7 +496,7 @@ def template_text():
         # grid other than the template's with the corner given there, TestMeshPlan)
         sa = f'({d3(f"oa_f0_{l}", f"oa_m0_{l}")} + {d3(f"oa_m0_{l}", f"oa_r0_{l}")})'
         sb = f'({d3(f"ob_f0_{l}", f"ob_m0_{l}")} + {d3(f"ob_m0_{l}", f"ob_r0_{l}")})'
-        w(f'  period_end_{l}: "period_follow > 0 ? period_follow*o_width_{l}*chord_{l}*o_cell*n_side*(1/{sa} + 1/{sb})/2 : period_end"      # the periodic lines\' end cells over their mean cell')
+        w(f'  period_end_{l}: "period_follow > 0 ? period_follow*o_width_{l}*chordf_{l}*o_cell*n_side*(1/{sa} + 1/{sb})/2 : period_end"      # the periodic lines\' end cells over their mean cell')
     w('')
     w('carriers:')
     w('  hub: {revolve: hub, axis: machine, extend: extend}')
@@ -500,7 +504,7 @@ def template_text():
     w('  blade: {gordon: sections, blending: spline, closed: true, align: axial}   # every section: leading edge at s = 0.25, trailing edge at 0.75')
     for l, S in L.items():
         w(f'  blade_{l}: {{intersect: [blade, {S}]}}')
-        w(f'  o0_{l}: {{offset: blade_{l}, on: {S}, distance: "o_width*chord0_{l}"}}      # probe curve: the O curve at o_width from fixed helpers (o_width_sharp)')
+        w(f'  o0_{l}: {{offset: blade_{l}, on: {S}, distance: "o_width*chordf_{l}"}}      # probe curve: the O curve at o_width from fixed helpers (o_width_sharp)')
         w(f'  o_{l}: {{offset: blade_{l}, on: {S}, distance: "o_width_{l}*chord_{l}"}}      # outer boundary of the O-grid')
         w(f'  lo_{l}: {{surface_curve: {S}, through: [lo_f_{l}, lo_m_{l}, lo_r_{l}]}}      # periodic_low line, mid-passage')
     w('')
@@ -519,20 +523,23 @@ def template_text():
         # fixed copies of the edges and their probes (shear_camber's camber direction)
         for e, ext, sa, sb in (('le', 'min', '+', '-'), ('te', 'max', '-', '+')):
             w(f'  {e}f_{l}: {{on_curve: blade_{l}, at: {{{ext}: axial}}, fixed: true}}')
+            if e == 'te':
+                w(f'  fmf_{l}: {{on_curve: blade_{l}, at: "lef_{l}.s + fwdf_{l}/2", fixed: true}}')
+                w(f'  bmf_{l}: {{on_curve: blade_{l}, at: "lef_{l}.s + fwdf_{l}/2 + 0.5", fixed: true}}')
             w(f'  pfa_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sa} dir_{l}*probe", fixed: true}}')
             w(f'  pfb_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sb} dir_{l}*probe", fixed: true}}')
+            w(f'  pga_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sa} dirf_{l}*probe", fixed: true}}')
+            w(f'  pgb_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sb} dirf_{l}*probe", fixed: true}}')
         w(f'  ole_{l}: {{project: le_{l}, onto: o_{l}}}')
         w(f'  ote_{l}: {{project: te_{l}, onto: o_{l}}}')
         # the probe curve o0's o_corner points (p) and their feet (gp), from fixed helpers: round0_le/te
-        w(f'  fm0_{l}: {{on_curve: blade_{l}, at: "lef_{l}.s + fwd0_{l}/2", fixed: true}}')
-        w(f'  bm0_{l}: {{on_curve: blade_{l}, at: "lef_{l}.s + fwd0_{l}/2 + 0.5", fixed: true}}')
         w(f'  ole0_{l}: {{on_curve: o0_{l}, at: {{min: "(x - lef_{l}.x)^2 + (y - lef_{l}.y)^2 + (z - lef_{l}.z)^2"}}, fixed: true}}')
         w(f'  ote0_{l}: {{on_curve: o0_{l}, at: {{min: "(x - tef_{l}.x)^2 + (y - tef_{l}.y)^2 + (z - tef_{l}.z)^2"}}, fixed: true}}')
         for v, e, side, towards in (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+')):
             dx = f'(cos(o_corner)*{e}_gux_{l} {side} sin(o_corner)*{e}_fvx_{l})'
             dy = f'(cos(o_corner)*{e}_guy_{l} {side} sin(o_corner)*{e}_fvy_{l})'
-            far = f'o{e}0_{l}.s {towards} dir0_{l}*o_window'
-            w(f'  p{v[1:]}_{l}: {{on_curve: o0_{l}, at: {{max: "{dx}*axial + {dy}*rm0_{l}*theta", within: ["min(o{e}0_{l}.s, {far})", "max(o{e}0_{l}.s, {far})"]}}, fixed: true}}')
+            far = f'o{e}0_{l}.s {towards} dirf_{l}*o_window'
+            w(f'  p{v[1:]}_{l}: {{on_curve: o0_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}0_{l}.s, {far})", "max(o{e}0_{l}.s, {far})"]}}, fixed: true}}')
             w(f'  gp{v[1:]}_{l}: {{on_curve: blade_{l}, at: {{min: "(x - p{v[1:]}_{l}.x)^2 + (y - p{v[1:]}_{l}.y)^2 + (z - p{v[1:]}_{l}.z)^2", within: ["{e}f_{l}.s - 0.25", "{e}f_{l}.s + 0.25"]}}, fixed: true}}')
         # each corner is searched on its own side only: from the edge towards side a (b)
         corners = (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+'))
@@ -570,10 +577,11 @@ def template_text():
             w(f'  f{b}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"c{b}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
             # the foot kept o_tip (fraction of the loop) from the edge: at a sharp edge every
             # point of the O curve's arc round the tip projects onto the tip itself
-            x = f'dir_{l}*(f{b}_{l}.s - {e}_{l}.s)'
+            # (from the edge's fixed twin: a fixed helper follows nothing)
+            x = f'dirf_{l}*(f{b}_{l}.s - {e}f_{l}.s)'
             off = f'({x} - rint({x}))'
             lim = f'max({off}, o_tip)' if towards == '+' else f'min({off}, -o_tip)'
-            w(f'  k{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{lim}", fixed: true}}')
+            w(f'  k{b}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s + dirf_{l}*{lim}", fixed: true}}')
             w(f'  r{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"k{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
             w(f'  kf{b}_{l}: {{on_curve: blade_{l}, at: {{min: {near(f"k{b}_{l}")}, within: ["{e}_{l}.s - 0.25", "{e}_{l}.s + 0.25"]}}, fixed: true}}')
             corner = distance2(f"r{b}_{l}")
@@ -582,7 +590,7 @@ def template_text():
                 # o_back from the edge, so that the edge block holds the whole fan round the
                 # tip or round the cap's corners and meets the sides with cells on the flanks
                 limb = f'max({off}, o_back)' if towards == '+' else f'min({off}, -o_back)'
-                w(f'  kb{b}_{l}: {{on_curve: blade_{l}, at: "{e}_{l}.s + dir_{l}*{limb}", fixed: true}}')
+                w(f'  kb{b}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s + dirf_{l}*{limb}", fixed: true}}')
                 w(f'  rb{b}_{l}: {{on_curve: o_{l}, at: {{min: {near(f"kb{b}_{l}")}, within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}, fixed: true}}')
                 corner = f'(shear_{e} ? {corner} : {distance2(f"rb{b}_{l}")})'
             rule = f'on_curve: o_{l}, at: {{min: "off_{e}_{l} ? {corner} : {distance2(f"c{b}_{l}")}", within: ["o{e}_{l}.s - 0.25", "o{e}_{l}.s + 0.25"]}}'
@@ -615,11 +623,11 @@ def template_text():
         w(f'  b_m_{l}: {{on_curve: blade_{l}, at: "shear_le || shear_te ? fb_r_{l}.s + dir_{l}*({gb} - rint({gb} - 0.5))/2 : le_{l}.s - dir_{l}*(1 - side_a_{l})/2"}}')
         w(f'  oa_m_{l}: {{project: a_m_{l}, onto: o_{l}}}')
         w(f'  ob_m_{l}: {{project: b_m_{l}, onto: o_{l}}}')
-        # their twins where the template placed them (fixed), for period_end_*
-        for side, at in (('a', f"shear_le || shear_te ? fa_f_{l}.s + dir_{l}*({ga} - rint({ga} - 0.5))/2 : le_{l}.s + dir_{l}*side_a_{l}/2"),
-                         ('b', f"shear_le || shear_te ? fb_r_{l}.s + dir_{l}*({gb} - rint({gb} - 0.5))/2 : le_{l}.s - dir_{l}*(1 - side_a_{l})/2")):
-            w(f'  {side}_m0_{l}: {{on_curve: blade_{l}, at: "{at}", fixed: true}}')
-            w(f'  o{side}_m0_{l}: {{project: {side}_m0_{l}, onto: o_{l}, fixed: true}}')
+        # their twins where the template placed them, for period_end_*: a search places a
+        # helper once (fixed: it follows nothing; the sides' mid-points follow the edges,
+        # which the optimizer and manual moves can move, and a grading does not follow)
+        for side in ('a', 'b'):
+            w(f'  o{side}_m0_{l}: {{on_curve: o_{l}, at: {{min: {near(f"o{side}_m_{l}")}, within: ["o{side}_m_{l}.s - 0.05", "o{side}_m_{l}.s + 0.05"]}}, fixed: true}}')
         w(f'  # mid-passage points between side a and the side b of the blade one pitch below')
         # (at a sharp edge lo_f / lo_r leave the middle across it: {e}_turn above)
         for f in ('f', 'm', 'r'):

@@ -366,6 +366,27 @@ TEST(Placement, ExpressionAndCurveChainsFollowMovesAsTheTemplateWould)
   expectSameAsFreshMesher(plan);
 }
 
+TEST(Placement, GradingsReferToNoVertexAMoveShifts)
+{
+  // A law's values are numbers once read: one that referred to a corner the optimizer moves
+  // would leave the live model's grid other than the template's with the corner given
+  // there (the periodic lines' end cells, period_end_*, once followed the O corners). The
+  // reader refuses it, naming the block, the law and the vertex; the template's own laws
+  // refer to fixed twins placed where the corners were.
+  const std::string law = "E4: {ends: [period_end_h, period_end_h]";
+  CarrierGeometry carriers;
+  test::expectError([&] { rotor37With(law, "E4: {ends: [oa_f_h.s + 0.1, period_end_h]", carriers); },
+    { "block 'M_L'", "'grading E4' refers to vertex 'oa_f_h'", "fixed: true" });
+  // through a definition and a vertex following a moved one (a_m_h follows le_h)
+  test::expectError([&] { rotor37With(law, "E4: {ends: [0.1 + 0*a_m_h.x, period_end_h]", carriers); },
+    { "block 'M_L'", "refers to vertex 'a_m_h'" });
+  test::expectError([&] { rotor37With(law, "E4: {ends: [0.1 + 0*chord_h, period_end_h]", carriers); },
+    { "block 'M_L'", "refers to vertex 'le_h'" });
+  // a fixed helper placed by a search is what a grading may refer to
+  const BlockModel model = rotor37With(law, "E4: {ends: [0.1 + 0*oa_f0_h.x, period_end_h]", carriers);
+  EXPECT_EQ(model.blocks[model.findBlock("M_L")].laws[3].firstCellSize, 0.1);
+}
+
 TEST(Placement, ManualMovesThroughTheDocumentFollowAsTheTemplateWould)
 {
   // ControlPointMoves as BlockOptimizer applies them, on the model read back from its

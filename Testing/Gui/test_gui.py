@@ -60,7 +60,7 @@ class GuiTest(unittest.TestCase):
     def test_gui_ran_with_the_plugin(self):
         self.assertIn("plugin_loaded", self.results, self.log[-3000:])
         self.assertEqual(self.results["plugin_loaded"], ["1"])
-        self.assertEqual(self.results["cells"], ["12960"])
+        self.assertEqual(self.results["cells"], ["12288"])
 
     def test_screenshot_matches_baseline(self):
         shot = os.path.join(self.output, "distributor_gui.png")

@@ -194,7 +194,7 @@ class BlockTemplateTest(unittest.TestCase):
         blocks = leaves(grid)
         self.assertEqual(len(blocks), 12)
         cells = sum(b.GetNumberOfCells() for b in blocks)
-        self.assertEqual(cells, 12960)
+        self.assertEqual(cells, 12288)
         jacobian = np.concatenate([np.array(dsa.WrapDataObject(b).CellData["ScaledJacobian"])
                                    for b in blocks])
         self.assertEqual(len(jacobian), cells)

@@ -203,7 +203,7 @@ class AxialPassageOHTest(unittest.TestCase):
     GridQuality on Templates/axial_passage_oh.yaml, for both bundled data sets."""
     BLOCKS = ["D_L", "D_M", "D_R", "M_L", "M_R", "O_a", "O_b", "O_le", "O_te",
               "U_L", "U_M", "U_R"]
-    CELLS = 12960  # at density 1: the default cell counts of the template
+    CELLS = 12288  # at density 1: the default cell counts of the template
 
     def check_grid(self, input_file, blade_count):
         quality = blockforge.mesh_template(AXIAL_OH, input_file=input_file)
@@ -313,7 +313,7 @@ class CommandLineTest(unittest.TestCase):
         path = os.path.join(self.directory, "oh.vtm")
         status, out, err = self.run_main(AXIAL_OH, "-i", DISTRIBUTOR_INF, "-o", path)
         self.assertEqual(status, 0, err)
-        self.assertIn("cells: 12960", out)
+        self.assertIn("cells: 12288", out)
         self.assertIn("grid written to", out)
         # the .vtm and its pieces, nothing else (no temporary left behind)
         folder, files = self.pieces(path)
@@ -321,7 +321,7 @@ class CommandLineTest(unittest.TestCase):
         self.assertEqual(len(files), 12)
         grid = self.read_grid(path)
         self.assertEqual(len(named_leaves(grid)), 12)
-        self.assertEqual(sum(block.GetNumberOfCells() for _, block in named_leaves(grid)), 12960)
+        self.assertEqual(sum(block.GetNumberOfCells() for _, block in named_leaves(grid)), 12288)
         for _, block in named_leaves(grid):
             self.assertIsNotNone(block.GetCellData().GetArray("ScaledJacobian"))
 

@@ -94,7 +94,7 @@ class ClientServer(unittest.TestCase):
                 np.testing.assert_array_equal(a, b, err_msg=f"{name} {array}")
         classes = servermanager.Fetch(quality, idx=1)
         self.assertEqual(classes.GetNumberOfRows(), 5)
-        self.assertEqual(sum(classes.GetValue(r, 1).ToInt() for r in range(5)), 12960)
+        self.assertEqual(sum(classes.GetValue(r, 1).ToInt() for r in range(5)), 12288)
         for proxy in (quality, grid, optimized, model, reader):
             simple.Delete(proxy)
 

@@ -171,7 +171,7 @@ class OptimizerProxyTest(unittest.TestCase):
         before = field_values(model, "MinAngleBefore")[0]
         after = field_values(model, "MinAngleAfter")[0]
         self.assertGreater(after, before)
-        self.assertEqual(sum(field_values(model, "MinAngleClassCountsAfter")), 12960)
+        self.assertEqual(sum(field_values(model, "MinAngleClassCountsAfter")), 12288)
         self.assertEqual(len(leaves(model)), 12)
         Delete(optimizer)
         Delete(template)
