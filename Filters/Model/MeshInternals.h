@@ -237,6 +237,19 @@ bool runsAgainst(const BlockModel& model, const UniqueEdge& edge, const UniqueEd
 void spreadFootBunches(std::vector<double>& params, const std::vector<Vec3>& feet,
   const std::vector<Vec3>& outer);
 /**
+ * spreadFootBunches' fallback where too few cells lie round the corner to grade them
+ * (the turbine's cap at density 1, main's defaults k_o 1.35, n_o 5: feet 0.058 / 0.003 /
+ * 0.8 mm, O_te's wall cells there at checkMesh's interpolation weight, 0.0509 against
+ * 0.05): the run s..e (cells) is spread among the nodes next to it, node `middle` (the
+ * corner) staying: the nodes from the run's first node before it to its first node after
+ * it, or up to localReach (2) more on either side where that leaves neighbour ratios
+ * above localTarget (3), each moved between its neighbours to where the worst ratio of the
+ * cells beside it is least (sweeps of golden sections). Kept only where the worst ratio
+ * in the window is then at most FanSideGrowth (10) and under half the projected one;
+ * otherwise params stay as they were.
+ */
+void spreadBunchLocally(std::vector<double>& params, int s, int e, int middle);
+/**
  * Node parameters of projected edge `e`: the closest points on its curve of the interior
  * nodes of the edge it projects from (whose parameters must be current), as arc-length
  * fractions; fails naming both edges when their cell counts differ or the projections are
