@@ -237,6 +237,22 @@ bool runsAgainst(const BlockModel& model, const UniqueEdge& edge, const UniqueEd
 void spreadFootBunches(std::vector<double>& params, const std::vector<Vec3>& feet,
   const std::vector<Vec3>& outer);
 /**
+ * spreadFootBunches' fallback where too few cells lie round the corner to grade them
+ * (the turbine's cap at density 1, main's defaults k_o 1.35, n_o 5: feet 0.058 / 0.003 /
+ * 0.8 mm, O_te's wall cells there at checkMesh's interpolation weight, 0.0509 against
+ * 0.05): the run s..e (cells) is spread between the nodes next to it, one of its nodes
+ * (`middle`, the bisector's, unless another leaves the cells more alike) staying on the
+ * corner: the run's other nodes, each moved between its neighbours to where the worst
+ * ratio of the cells beside it is least (sweeps of golden sections), then back towards their projected
+ * places as far as keeps the worst ratio among these cells and the one beyond either end
+ * at localMost (5; the spread feet lean the lines: O_te's smallest angle at the turbine's
+ * cap 63.6 -> 41.8 deg, 37.9 at the optimum's 3.3). Where no spread brings it to 5 or
+ * halves the projected one, params stay as they were. Turbine, density 1: feet 0.058 /
+ * 0.003 / 0.799 -> 0.058 / 0.131 / 0.670 mm (hub), checkMesh's interpolation weight
+ * 0.0509 -> 0.171 placed, 0.0508 -> 0.148 optimized.
+ */
+void spreadBunchLocally(std::vector<double>& params, int s, int e, int middle);
+/**
  * Node parameters of projected edge `e`: the closest points on its curve of the interior
  * nodes of the edge it projects from (whose parameters must be current), as arc-length
  * fractions; fails naming both edges when their cell counts differ or the projections are

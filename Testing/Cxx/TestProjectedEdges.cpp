@@ -3,6 +3,7 @@
 // concentric offset (the projected nodes at the source's angles), parallel straight
 // edges, with graded and matched sources, at density multipliers, through the model
 // document and the mesh plan; and the errors for mismatched counts, cycles and names.
+#include "MeshInternals.h"
 #include "MeshPlan.h"
 #include "Mesher.h"
 #include "ModelDocument.h"
@@ -931,4 +932,69 @@ TEST(ProjectedEdges, FeetBunchedRoundABluntCornerAreSpreadRoundIt)
       EXPECT_NEAR(foot.y(), mirror.x(), 1e-9) << i;
     }
   }
+}
+
+TEST(ProjectedEdges, FeetBunchedWithTooFewCellsToGradeAreSpreadBetweenTheirNeighbours)
+{
+  // The turbine's cap corner at density 1 (main's k_o 1.35, n_o 5): 0.058 mm of flank, a
+  // 0.003 mm cell on the corner, 0.8 mm across the cap, then 1.94 mm cells. Graded from the
+  // corner by 1.5 the cells would still jump more than 10 times (too few of them: the edge's
+  // other end, at side b, is graded down to 0.29 mm), so
+  // spreadFootBunches used to keep them as projected: O_te's wall cells there at checkMesh's
+  // interpolation weight (0.0509 against 0.05). The run's nodes are spread between their
+  // neighbours instead (spreadBunchLocally): one end of the corner cell stays (here the
+  // flank's, which leaves the cells most alike), the other goes onto the cap; the nodes
+  // outside keep their bits.
+  const std::vector<double> projected = { 0.0, 0.058, 0.061, 0.86, 2.799, 4.742, 6.687, 8.635,
+    9.809, 10.396, 10.69 };
+  // feet and outer nodes (mm) of O_te's hub edge (the outer ones on the O curve)
+  const std::vector<Vec3> feet = { Vec3(14.655, 249.238, -3.831),
+    Vec3(14.709, 249.235, -3.812),
+    Vec3(14.711, 249.235, -3.809),
+    Vec3(14.584, 249.253, -3.021),
+    Vec3(14.118, 249.292, -1.138),
+    Vec3(13.436, 249.327, 0.680),
+    Vec3(12.553, 249.361, 2.414),
+    Vec3(11.484, 249.393, 4.041),
+    Vec3(10.757, 249.413, 4.963),
+    Vec3(10.371, 249.423, 5.406),
+    Vec3(10.173, 249.428, 5.623) };
+  const std::vector<Vec3> outer = { Vec3(14.972, 249.207, -4.700),
+    Vec3(15.247, 249.196, -4.564),
+    Vec3(15.597, 249.187, -4.070),
+    Vec3(15.492, 249.209, -2.851),
+    Vec3(15.000, 249.249, -0.864),
+    Vec3(14.281, 249.284, 1.054),
+    Vec3(13.351, 249.316, 2.879),
+    Vec3(12.227, 249.346, 4.590),
+    Vec3(11.463, 249.365, 5.559),
+    Vec3(11.057, 249.374, 6.024),
+    Vec3(10.849, 249.379, 6.252) };
+  std::vector<double> params = projected;
+  spreadFootBunches(params, feet, outer);
+  ASSERT_EQ(params.size(), projected.size());
+  EXPECT_EQ(params[0], projected[0]);
+  EXPECT_EQ(params[1], projected[1]); // the corner
+  for (std::size_t i = 3; i < params.size(); ++i)
+  {
+    EXPECT_EQ(params[i], projected[i]) << i;
+  }
+  double worst = 1.0;
+  for (std::size_t i = 0; i + 2 < params.size(); ++i)
+  {
+    const double a = params[i + 1] - params[i], b = params[i + 2] - params[i + 1];
+    ASSERT_GT(a, 0.0);
+    worst = std::max(worst, std::max(a / b, b / a));
+  }
+  std::printf("cells %.3f %.3f %.3f %.3f, worst neighbour ratio %.2f (projected 266)\n",
+    params[1] - params[0], params[2] - params[1], params[3] - params[2], params[4] - params[3],
+    worst);
+  EXPECT_LT(worst, 5.0 + 1e-6); // spread no farther than ratios of 5 (the spread feet lean
+  EXPECT_GT(worst, 4.9);        // the lines: the smallest angle)
+  // a bunch the spread cannot bring within 5 (a lone sliver between cells 1000 times
+  // wider) stays as projected
+  const std::vector<double> lone = { 0.0, 1.0, 1.001, 1001.0, 2001.0 };
+  params = lone;
+  spreadFootBunches(params, {}, {});
+  EXPECT_EQ(params, lone);
 }
