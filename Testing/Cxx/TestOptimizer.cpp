@@ -580,7 +580,9 @@ TEST(OptimizerPassage, RejectedTrialsPutBackGiveTheSameSearch)
  * 1.6 times (ObjectiveSettings::maximumInterfaceRatio; unguarded 2.50 and 3.58), 47.12 and
  * 47.40 degrees. Stop 17 (issue 10): no more cells failing checkMesh's cell determinant
  * than placed (ControlProblem; unguarded Rotor 37 309 -> 311): 47.40 degrees, 638 -> 483
- * cells (unguarded 47.52, 474), and 47.38, 309 -> 309.
+ * cells (unguarded 47.52, 474), and 47.38, 309 -> 309. Stop 19 (thicker O-grid outer cell,
+ * end-wall layers): 46.54 and 47.57 with period_follow 1.25 (the distributor's search
+ * settles on M_L's corner cell at oa_r on the hub), 48.35 and 48.01 with 1.28.
  */
 TEST(OptimizerPassage, ShearedOGridReachesFortyDegrees)
 {
