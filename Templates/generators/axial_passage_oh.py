@@ -175,6 +175,16 @@ HEADER = """# Written by Templates/generators/axial_passage_oh.py: edit that, th
 #   distributor 171 / 49 -> 78 / 31, Rotor 37 32 / 31 -> 24 / 10, compressor 180 / 129 ->
 #   180 / 109, turbine 21 / 8 -> 16 / 8; optimizer 47.40 / 47.38 / 23.25 / 34.63 deg ->
 #   48.28 / 47.09 / 23.39 / 38.94.
+# - stop 19 (issue 10: checkMesh's cell determinant only in wall layers): the O-grid's outer
+#   cell thicker (k_o 1.35, n_o 5: 0.0100 chords, wall cell 0.0030), the periodic lines'
+#   end cells following the sides' O arcs (period_follow 1.28, period_flat 2), end-wall
+#   layers in every block (span_wall 0.5, span_flat 2: a hub or shroud cell has no face
+#   there that the determinant counts, and fails about 6 times sooner than at mid-span), at
+#   least min_span cells spanwise, and at a sharp staggered edge a wider O-grid
+#   (o_width_sharp). H cells failing the determinant at density 1, placed / optimized:
+#   distributor 78 / 24 -> 2 / 0, Rotor 37 24 / 4 -> 0 / 0, compressor 180 / 67 -> 5 / 0,
+#   turbine 16 / 3 -> 0 / 0; optimizer 48.28 / 47.12 / 23.55 / 40.54 -> 48.35 / 48.01 /
+#   25.48 / 40.20 deg; 12288 cells at density 1 (12960 before).
 # - at a sharp edge (a fan on the tip, on hub or shroud) the strip in front of it (U_M) and
 #   the wake strip behind it (D_M) widen towards the inlet / outlet to at least in_share /
 #   out_share (0.35) of the pitch, about their middle (a_in/b_in, a_out/b_out: the O corners'
