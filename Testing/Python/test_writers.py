@@ -448,9 +448,10 @@ class NativeCommandLineTest(unittest.TestCase):
         block interfaces to max(R, the placed grid's); 0 lets it go. On Rotor 37 at density 1
         the unheld optimum jumped 3.24 between U_M and U_R at the inlet (stop 17), 2.76
         between D_L and D_M at the outlet (stop 18, 1.46 held at the default 1.6); since stop
-        19's thicker O-grid outer cell it jumps 1.47 (D_M against O_te), within the default
-        1.6, so the hold is shown at 1.3: the placed grid's 1.34 is then the bound, and the
-        held optimum stays within it (1.32). Both command lines pass it on alike."""
+        19's thicker O-grid outer cell it jumps 1.64 (O_b against M_R), hardly over the
+        default 1.6, so the hold is shown at 1.3: the placed grid's ratio (1.34) is then the
+        bound, and the held optimum stays within it (1.33). Both command lines pass it on
+        alike."""
         sys.path.insert(0, os.path.join(SOURCE, "Benchmark"))
         try:
             import interface_ratios
