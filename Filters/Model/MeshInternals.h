@@ -215,6 +215,11 @@ inline double endCell(const UniqueEdge& edge, int end)
 /// Whether `edge` runs against `source` (its a end nearer the source's b end): their nearer
 /// ends decide, so a projected edge takes its source's nodes in the right order.
 bool runsAgainst(const BlockModel& model, const UniqueEdge& edge, const UniqueEdge& source);
+/// Beside a fan (ProjectedEdges.cpp, gradeBesideFan) the side's wall cells, and round a
+/// corner the spread feet (FootBunches.cpp), grow by at most this from cell to cell:
+/// checkMesh's interpolation weight (0.05) fails between cells whose centres lie more than
+/// 19 times as far from their face.
+constexpr double FanSideGrowth = 10.0;
 /**
  * Feet bunched on a convex corner inside a projected edge (`params`, its node parameters, 0
  * to 1; `feet` and `outer`, the projected feet and the source's nodes, the edge's ends

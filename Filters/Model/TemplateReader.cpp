@@ -426,15 +426,20 @@ void TemplateReader::readGrading(const MapEntry& grading, const std::string& ent
   const auto keys =
     syntax::mapEntries(grading.value, grading.line, entityText, "'grading'", Report);
   syntax::checkKeys(keys, { "i", "j", "k", "edges" }, entityText, Report);
+  // a law, refused when its values refer to a vertex a move can shift
+  const auto readLaw = [&](const MapEntry& law, const std::string& what) {
+    Referenced.emplace_back();
+    const DistributionLaw value = syntax::parseLaw(law.value, law.line, entityText, what,
+      numberReader(entityText), Report, edgeReader(entityText));
+    refuseMovableReferences(law.line, entityText, what);
+    return value;
+  };
   for (int d = 0; d < 3; ++d)
   {
     const std::string direction(1, static_cast<char>('i' + d));
     if (const MapEntry* law = syntax::findEntry(keys, direction))
     {
-      Referenced.emplace_back();
-      const DistributionLaw value = syntax::parseLaw(law->value, law->line, entityText,
-        "grading " + direction, numberReader(entityText), Report, edgeReader(entityText));
-      refuseMovableReferences(law->line, entityText, "grading " + direction);
+      const DistributionLaw value = readLaw(*law, "grading " + direction);
       for (int e = 0; e < 12; ++e)
       {
         if (edgeDirection(e) == d)
@@ -457,10 +462,7 @@ void TemplateReader::readGrading(const MapEntry& grading, const std::string& ent
     for (const MapEntry& law : overrides)
     {
       const int e = std::stoi(law.key.substr(1)) - 1;
-      Referenced.emplace_back();
-      block.laws[e] = syntax::parseLaw(law.value, law.line, entityText,
-        "grading " + law.key, numberReader(entityText), Report, edgeReader(entityText));
-      refuseMovableReferences(law.line, entityText, "grading " + law.key);
+      block.laws[e] = readLaw(law, "grading " + law.key);
     }
   }
 }
