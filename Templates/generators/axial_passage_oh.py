@@ -382,16 +382,11 @@ def template_text():
             fy0 = f'rm_{l}*({e}f_{l}.theta - (pfa_{e}_{l}.theta + pfb_{e}_{l}.theta)/2)'
             w(f'  {e}_fux_{l}: "({fx0})/sqrt(({fx0})^2 + ({fy0})^2)"      # camber direction at the edge, from fixed helpers')
             w(f'  {e}_fuy_{l}: "({fy0})/sqrt(({fx0})^2 + ({fy0})^2)"')
-            # the same at the fixed radius rm (o_width_sharp's decision, which feeds the O curve
-            # and period_end: from fixed helpers alone) and its normal towards side a
-            # (probes pga/pgb: pfa/pfb placed with dirf, the fixed twin of dir)
-            gx0 = f'{e}f_{l}.axial - (pga_{e}_{l}.axial + pgb_{e}_{l}.axial)/2'
-            gy0 = f'rm_{l}*({e}f_{l}.theta - (pga_{e}_{l}.theta + pgb_{e}_{l}.theta)/2)'
-            w(f'  {e}_gux_{l}: "({gx0})/sqrt(({gx0})^2 + ({gy0})^2)"      # camber direction at the edge, fixed helpers alone')
-            w(f'  {e}_guy_{l}: "({gy0})/sqrt(({gx0})^2 + ({gy0})^2)"')
-            ax = f'(pga_{e}_{l}.axial - pgb_{e}_{l}.axial)'
-            ay = f'(rm_{l}*(pga_{e}_{l}.theta - pgb_{e}_{l}.theta))'
-            ux, uy = f'{e}_gux_{l}', f'{e}_guy_{l}'
+            # and its normal towards side a (o_width_sharp's decision, which feeds the O curve
+            # and period_end: from fixed helpers alone)
+            ax = f'(pfa_{e}_{l}.axial - pfb_{e}_{l}.axial)'
+            ay = f'(rm_{l}*(pfa_{e}_{l}.theta - pfb_{e}_{l}.theta))'
+            ux, uy = f'{e}_fux_{l}', f'{e}_fuy_{l}'
             vx0 = f'({ax} - ({ax}*{ux} + {ay}*{uy})*{ux})'
             vy0 = f'({ay} - ({ax}*{ux} + {ay}*{uy})*{uy})'
             w(f'  {e}_fvx_{l}: "{vx0}/sqrt({vx0}^2 + {vy0}^2)"      # unit normal of the camber at the edge towards side a, fixed helpers')
@@ -416,7 +411,7 @@ def template_text():
         # camber at the edge (fixed helpers) against o_shear
         for e, a, b in (('le', 'a_f', 'b_f'), ('te', 'a_r', 'b_r')):
             w(f'  round0_{e}_{l}: "{span0(f"p{a}_{l}", f"p{b}_{l}")} <= o_fan*{span0(f"gp{a}_{l}", f"gp{b}_{l}")}"')
-            w(f'  stagger0_{e}_{l}: "abs({e}_guy_{l})*tan(o_shear) > abs({e}_gux_{l})"      # 1: the camber at the edge wants the shear (o_shear)')
+            w(f'  stagger0_{e}_{l}: "abs({e}_fuy_{l})*tan(o_shear) > abs({e}_fux_{l})"      # 1: the camber at the edge wants the shear (o_shear)')
         w(f'  o_width_{l}: "o_width_sharp > 0 && ((stagger0_le_{l} && (round0_le_h && round0_le_s) < 0.5) || (stagger0_te_{l} && (round0_te_h && round0_te_s) < 0.5)) ? o_width_sharp : o_width"      # the O-grid width on this layer')
         # an edge is sheared on both layers or on none (a corner moved on one layer only would
         # twist the edge block between hub and shroud): shear_le/te below
@@ -536,18 +531,17 @@ def template_text():
             if e == 'te':
                 w(f'  fmf_{l}: {{on_curve: blade_{l}, at: "lef_{l}.s + fwdf_{l}/2", fixed: true}}')
                 w(f'  bmf_{l}: {{on_curve: blade_{l}, at: "lef_{l}.s + fwdf_{l}/2 + 0.5", fixed: true}}')
-            w(f'  pfa_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sa} dir_{l}*probe", fixed: true}}')
-            w(f'  pfb_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sb} dir_{l}*probe", fixed: true}}')
-            w(f'  pga_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sa} dirf_{l}*probe", fixed: true}}')
-            w(f'  pgb_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sb} dirf_{l}*probe", fixed: true}}')
+            # (with dirf, dir's fixed twin: a fixed helper follows nothing)
+            w(f'  pfa_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sa} dirf_{l}*probe", fixed: true}}')
+            w(f'  pfb_{e}_{l}: {{on_curve: blade_{l}, at: "{e}f_{l}.s {sb} dirf_{l}*probe", fixed: true}}')
         w(f'  ole_{l}: {{project: le_{l}, onto: o_{l}}}')
         w(f'  ote_{l}: {{project: te_{l}, onto: o_{l}}}')
         # the probe curve o0's o_corner points (p) and their feet (gp), from fixed helpers: round0_le/te
         w(f'  ole0_{l}: {{on_curve: o0_{l}, at: {{min: "(x - lef_{l}.x)^2 + (y - lef_{l}.y)^2 + (z - lef_{l}.z)^2"}}, fixed: true}}')
         w(f'  ote0_{l}: {{on_curve: o0_{l}, at: {{min: "(x - tef_{l}.x)^2 + (y - tef_{l}.y)^2 + (z - tef_{l}.z)^2"}}, fixed: true}}')
         for v, e, side, towards in (('oa_f', 'le', '+', '+'), ('ob_f', 'le', '-', '-'), ('oa_r', 'te', '+', '-'), ('ob_r', 'te', '-', '+')):
-            dx = f'(cos(o_corner)*{e}_gux_{l} {side} sin(o_corner)*{e}_fvx_{l})'
-            dy = f'(cos(o_corner)*{e}_guy_{l} {side} sin(o_corner)*{e}_fvy_{l})'
+            dx = f'(cos(o_corner)*{e}_fux_{l} {side} sin(o_corner)*{e}_fvx_{l})'
+            dy = f'(cos(o_corner)*{e}_fuy_{l} {side} sin(o_corner)*{e}_fvy_{l})'
             far = f'o{e}0_{l}.s {towards} dirf_{l}*o_window'
             w(f'  p{v[1:]}_{l}: {{on_curve: o0_{l}, at: {{max: "{dx}*axial + {dy}*rm_{l}*theta", within: ["min(o{e}0_{l}.s, {far})", "max(o{e}0_{l}.s, {far})"]}}, fixed: true}}')
             w(f'  gp{v[1:]}_{l}: {{on_curve: blade_{l}, at: {{min: "(x - p{v[1:]}_{l}.x)^2 + (y - p{v[1:]}_{l}.y)^2 + (z - p{v[1:]}_{l}.z)^2", within: ["{e}f_{l}.s - 0.25", "{e}f_{l}.s + 0.25"]}}, fixed: true}}')
